@@ -1,0 +1,99 @@
+"""Generate the committed reference trajectories in ``data/reference/``.
+
+Independent of the package's equations of motion: the reference integrates Hamilton's
+equations in canonical momenta, with the Hamiltonian assembled numerically from the kinetic
+energy's mass matrix (seed eq. 8) and the potential (seed eq. 9),
+
+    H(phi, p) = 1/2 p^T M(phi)^-1 p + V(phi),
+    M = [[(m1+m2) l1^2, m2 l1 l2 cos(phi1-phi2)], [m2 l1 l2 cos(phi1-phi2), m2 l2^2]],
+
+and its partial derivatives taken by complex-step differentiation (exact to rounding), so no
+hand-derived acceleration formula is involved. SciPy's DOP853 at rtol = 1e-13 integrates it;
+a second run with Radau at rtol = 1e-12 estimates the reference's own error, written to
+``reference_meta.json``.
+
+Usage: ``python data/reference/make_reference.py`` (needs numpy and scipy).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+HERE = Path(__file__).resolve().parent
+# The seed pendulum (double_pendulum.parameters defaults), written out so this script stands alone.
+M1, M2, L1, L2, G = 0.301, 0.297, 0.2964, 0.1971, 9.81
+CASES = {
+    "regular": {"y0": (0.3, 0.3, 0.0, 0.0), "stop_time": 10.0},
+    "chaotic": {"y0": (2.0, 2.0, 0.0, 0.0), "stop_time": 3.0},
+}
+OUTPUT_INTERVAL = 0.01
+STEP = 1e-20
+
+
+def mass_matrix(phi1, phi2):
+    c = np.cos(phi1 - phi2)
+    return np.array([[(M1 + M2) * L1**2, M2 * L1 * L2 * c], [M2 * L1 * L2 * c, M2 * L2**2]])
+
+
+def hamiltonian(q, p):
+    minv = np.linalg.inv(mass_matrix(*q))
+    potential = (M1 + M2) * G * L1 * (1 - np.cos(q[0])) + M2 * G * L2 * (1 - np.cos(q[1]))
+    return 0.5 * p @ minv @ p + potential
+
+
+def hamilton_rhs(t, z):
+    q, p = z[:2].astype(complex), z[2:].astype(complex)
+    dq, dp = np.zeros(2), np.zeros(2)
+    for k in range(2):
+        e = np.zeros(2)
+        e[k] = STEP
+        dq[k] = hamiltonian(q, p + 1j * e).imag / STEP
+        dp[k] = -hamiltonian(q + 1j * e, p).imag / STEP
+    return np.concatenate([dq, dp])
+
+
+def to_momenta(y):
+    return np.concatenate([y[:2], mass_matrix(y[0], y[1]) @ y[2:]])
+
+
+def to_velocities(z):
+    return np.concatenate([z[:2], np.linalg.solve(mass_matrix(z[0], z[1]), z[2:])])
+
+
+def integrate(y0, stop_time, method, rtol, atol):
+    times = np.round(np.arange(0.0, stop_time + OUTPUT_INTERVAL / 2, OUTPUT_INTERVAL), 10)
+    sol = solve_ivp(
+        hamilton_rhs,
+        (0.0, stop_time),
+        to_momenta(np.array(y0, float)),
+        method=method,
+        rtol=rtol,
+        atol=atol,
+        t_eval=times,
+    )
+    return times, np.array([to_velocities(z) for z in sol.y.T])
+
+
+def main() -> None:
+    meta = {"parameters": {"m1": M1, "m2": M2, "l1": L1, "l2": L2, "g": G}, "cases": {}}
+    for name, case in CASES.items():
+        times, ref = integrate(case["y0"], case["stop_time"], "DOP853", 1e-13, 1e-14)
+        _, check = integrate(case["y0"], case["stop_time"], "Radau", 1e-12, 1e-14)
+        header = '"time [s]","phi1 [rad]","phi2 [rad]","omega1 [rad/s]","omega2 [rad/s]"'
+        rows = [",".join(repr(float(v)) for v in (t, *y)) for t, y in zip(times, ref)]
+        (HERE / f"{name}.csv").write_text(header + "\n" + "\n".join(rows) + "\n")
+        meta["cases"][name] = {
+            "start": dict(zip(("phi1_0", "phi2_0", "omega1_0", "omega2_0"), case["y0"])),
+            "stop_time_s": case["stop_time"],
+            "max_abs_difference_dop853_vs_radau": float(np.max(np.abs(ref - check))),
+        }
+    (HERE / "reference_meta.json").write_text(json.dumps(meta, indent=2) + "\n")
+    print(json.dumps(meta, indent=2))
+
+
+if __name__ == "__main__":
+    main()

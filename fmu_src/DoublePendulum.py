@@ -1,0 +1,90 @@
+"""pythonfmu adapter: maps FMI 2.0 co-simulation calls onto ``double_pendulum.cosimulation``.
+
+All physics, numerics and validation live in the ``double_pendulum`` package, which the build
+bundles into the FMU's resources next to this file. The bundled copy is loaded under a private
+module name so the FMU always runs its own code, whatever ``double_pendulum`` the host process
+may have imported.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+from pathlib import Path
+
+from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Real, String
+from pythonfmu.default_experiment import DefaultExperiment
+from pythonfmu.enums import Fmi2Status
+
+_BUNDLE_NAME = "_double_pendulum_fmu_bundle"
+
+
+def _load_package():
+    """Import the bundled package (resources/double_pendulum) or, at build time, the installed one."""
+    bundled = Path(__file__).resolve().parent / "double_pendulum"
+    if not (bundled / "__init__.py").is_file():
+        return importlib.import_module("double_pendulum")
+    if _BUNDLE_NAME not in sys.modules:
+        spec = importlib.util.spec_from_file_location(
+            _BUNDLE_NAME, bundled / "__init__.py", submodule_search_locations=[str(bundled)]
+        )
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[_BUNDLE_NAME] = module
+        spec.loader.exec_module(module)
+    return sys.modules[_BUNDLE_NAME]
+
+
+_package = _load_package()
+_cosim = importlib.import_module(_package.__name__ + ".cosimulation")
+_interface = importlib.import_module(_package.__name__ + ".fmu_interface")
+_FMI_TYPES = {"Real": Real, "Boolean": Boolean, "String": String}
+
+
+class DoublePendulum(Fmi2Slave):
+    author = "double-pendulum-fmu contributors"
+    license = "MIT"
+    version = _package.__version__
+    description = _interface.MODEL_DESCRIPTION
+    default_experiment = DefaultExperiment(**_interface.DEFAULT_EXPERIMENT)
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self._sim = _cosim.DoublePendulumCoSimulation()
+        for var in _interface.fmu_variables():
+            self._register(var)
+
+    def _register(self, var) -> None:
+        name = var.name
+        if var.causality == "parameter":
+            variable = _FMI_TYPES[var.fmi_type](
+                name,
+                causality=Fmi2Causality.parameter,
+                variability=Fmi2Variability.fixed,
+                description=var.description,
+                getter=lambda: self._sim.get(name),
+                setter=lambda value: self._sim.set(name, value),
+            )
+        else:
+            variable = Real(
+                name,
+                causality=Fmi2Causality.output,
+                variability=Fmi2Variability.continuous,
+                description=var.description,
+                getter=lambda: self._sim.outputs[name],
+            )
+        self.register_variable(variable)
+
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self._sim.set_start_time(start_time)
+
+    def exit_initialization_mode(self):
+        self._sim.initialise()
+
+    def do_step(self, current_time, step_size):
+        try:
+            self._sim.do_step(current_time, step_size)
+        except (_cosim.SolverError, _cosim.CoSimulationError) as error:
+            self.log(f"doStep failed: {error}", Fmi2Status.error)
+            return False
+        return True

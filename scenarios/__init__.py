@@ -1,0 +1,8 @@
+"""Scenario scripts: each module runs the FMU through fmpy and writes CSV, plots and a summary.
+
+A scenario module has ``DESCRIPTION`` (one line) and ``run(runner, out_dir, *, quick=False) ->
+dict`` (the summary, also written to ``out_dir/summary.json``). ``quick`` shortens the run for
+smoke tests. Each scenario enables only the model parts it needs.
+"""
+
+SCENARIOS: tuple[str, ...] = ("free_swing",)

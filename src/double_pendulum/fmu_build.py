@@ -1,0 +1,150 @@
+"""Build ``DoublePendulum.fmu`` with pythonfmu and complete its modelDescription.
+
+pythonfmu writes the FMU from ``fmu_src/DoublePendulum.py``; this package is bundled into the
+FMU's ``resources/`` so the FMU runs without the project installed. pythonfmu's
+modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the build then
+
+* adds ``UnitDefinitions`` (SI base-unit exponents) and a ``unit`` attribute on every physical
+  Real variable, from :func:`double_pendulum.fmu_interface.fmu_variables`;
+* lists every output under ``ModelStructure/InitialUnknowns`` (they are computed at
+  initialisation), so ``fmpy.validation.validate_fmu`` reports no problems;
+* writes ``resources/requirements.txt`` with what the FMU needs at run time.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import shutil
+import tempfile
+import zipfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from .fmu_interface import MODEL_IDENTIFIER, fmu_variables
+
+PACKAGE_DIR = Path(__file__).resolve().parent
+DEFAULT_FMU_PATH = Path("build") / f"{MODEL_IDENTIFIER}.fmu"
+
+# SI base-unit exponents of every unit the interface uses (FMI 2.0 section 2.2.2).
+UNIT_EXPONENTS: dict[str, dict[str, int]] = {
+    "s": {"s": 1},
+    "m": {"m": 1},
+    "kg": {"kg": 1},
+    "rad": {"rad": 1},
+    "rad/s": {"rad": 1, "s": -1},
+    "rad/s2": {"rad": 1, "s": -2},
+    "m/s": {"m": 1, "s": -1},
+    "m/s2": {"m": 1, "s": -2},
+    "m2": {"m": 2},
+    "kg/m3": {"kg": 1, "m": -3},
+    "N": {"kg": 1, "m": 1, "s": -2},
+    "N/m": {"kg": 1, "s": -2},
+    "N.s/m": {"kg": 1, "s": -1},
+    "N.m": {"kg": 1, "m": 2, "s": -2},
+    "N.m.s/rad": {"kg": 1, "m": 2, "s": -1, "rad": -1},
+    "J": {"kg": 1, "m": 2, "s": -2},
+    "W": {"kg": 1, "m": 2, "s": -3},
+}
+
+# What the FMU imports at run time beyond the standard library (pythonfmu's Python part is
+# bundled by pythonfmu itself, but its binary needs the interpreter with pythonfmu installed).
+RUNTIME_REQUIREMENTS = ["pythonfmu>=0.6.5"]
+
+
+def adapter_script() -> Path:
+    """Return the path of ``fmu_src/DoublePendulum.py`` (source tree or installed copy)."""
+    in_tree = PACKAGE_DIR.parents[1] / "fmu_src" / f"{MODEL_IDENTIFIER}.py"
+    if in_tree.is_file():
+        return in_tree
+    spec = importlib.util.find_spec("fmu_src")
+    if spec is None or not spec.submodule_search_locations:
+        raise FileNotFoundError("cannot find fmu_src/DoublePendulum.py: is double-pendulum-fmu installed?")
+    return Path(next(iter(spec.submodule_search_locations))) / f"{MODEL_IDENTIFIER}.py"
+
+
+def _copy_package(dest: Path) -> Path:
+    """Copy this package's Python sources (no caches) into ``dest/double_pendulum``."""
+    target = dest / PACKAGE_DIR.name
+    shutil.copytree(PACKAGE_DIR, target, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    return target
+
+
+def complete_model_description(xml_text: bytes) -> bytes:
+    """Add unit definitions, unit attributes and InitialUnknowns to a pythonfmu modelDescription."""
+    root = ET.fromstring(xml_text)
+    units = {v.name: v.unit for v in fmu_variables() if v.fmi_type == "Real" and v.unit not in ("", "1")}
+    used = sorted(set(units.values()))
+    unknown = [u for u in used if u not in UNIT_EXPONENTS]
+    if unknown:
+        raise ValueError(f"no SI definition for unit(s) {unknown}: add them to UNIT_EXPONENTS")
+
+    unit_defs = ET.Element("UnitDefinitions")
+    for unit in used:
+        unit_el = ET.SubElement(unit_defs, "Unit", name=unit)
+        ET.SubElement(unit_el, "BaseUnit", {k: str(v) for k, v in UNIT_EXPONENTS[unit].items()})
+    position = list(root).index(root.find("CoSimulation")) + 1
+    root.insert(position, unit_defs)
+
+    outputs_index = []
+    for index, sv in enumerate(root.find("ModelVariables"), start=1):
+        real = sv.find("Real")
+        if real is not None and sv.get("name") in units:
+            real.set("unit", units[sv.get("name")])
+        if sv.get("causality") == "output":
+            outputs_index.append(index)
+
+    structure = root.find("ModelStructure")
+    for old in structure.findall("InitialUnknowns"):
+        structure.remove(old)
+    initial = ET.SubElement(structure, "InitialUnknowns")
+    for index in outputs_index:
+        ET.SubElement(initial, "Unknown", index=str(index))
+    ET.indent(root, space="  ")
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+def _rewrite_fmu(fmu: Path) -> None:
+    """Rewrite the zip with the completed modelDescription and requirements.txt."""
+    tmp = fmu.with_suffix(".fmu.tmp")
+    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
+        for item in src.infolist():
+            data = src.read(item.filename)
+            if item.filename == "modelDescription.xml":
+                data = complete_model_description(data)
+            dst.writestr(item, data, compress_type=zipfile.ZIP_DEFLATED)
+        dst.writestr("resources/requirements.txt", "\n".join(RUNTIME_REQUIREMENTS) + "\n")
+    tmp.replace(fmu)
+
+
+def build_fmu(dest: str | Path = DEFAULT_FMU_PATH) -> Path:
+    """Build the FMU at ``dest`` (a ``.fmu`` path or a folder) and return its path.
+
+    The FMU is first written to a temporary folder and moved into place at the end, so a failed
+    build never leaves a broken FMU behind.
+    """
+    from pythonfmu.builder import FmuBuilder
+
+    dest = Path(dest)
+    fmu_path = dest if dest.suffix == ".fmu" else dest / f"{MODEL_IDENTIFIER}.fmu"
+    fmu_path.parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix="dp_fmu_build_") as tmp:
+        tmp_dir = Path(tmp)
+        package_copy = _copy_package(tmp_dir)
+        built = FmuBuilder.build_FMU(
+            adapter_script(),
+            dest=tmp_dir / f"{MODEL_IDENTIFIER}.fmu",
+            project_files=[package_copy],
+        )
+        _rewrite_fmu(Path(built))
+        shutil.move(str(built), fmu_path)
+    return fmu_path
+
+
+def fmu_is_current(fmu_path: str | Path) -> bool:
+    """True if ``fmu_path`` exists and is newer than every source file it is built from."""
+    fmu_path = Path(fmu_path)
+    if not fmu_path.is_file():
+        return False
+    built = fmu_path.stat().st_mtime
+    sources = [adapter_script(), *PACKAGE_DIR.rglob("*.py")]
+    return all(src.stat().st_mtime <= built for src in sources)

@@ -1,0 +1,121 @@
+"""Model parameters, initial state and solver settings: one frozen dataclass each.
+
+Every field carries its unit, a description and a validity rule in its metadata. The FMU's
+start values, its variable descriptions and unit definitions, the analysis defaults and the
+error messages for bad input are all derived from these fields, so each number lives here once.
+
+Defaults describe the pendulum built in the seed report (section 3): m1 = 301 g, m2 = 297 g;
+the rod lengths are the ones measured from the report's camera track (Table 1,
+``data/seed_table1.csv``): a least-squares circle fit of the upper mass gives
+l1 = 0.2964 m (scatter 0.5 mm) and the mean distance between the two masses l2 = 0.1971 m
+(scatter 3.9 mm); ``tests/test_parameters.py`` recomputes both from the data.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+
+class ParameterError(ValueError):
+    """A parameter, start value or setting is out of its valid range.
+
+    The message names the variable, its value and unit, and the rule it breaks.
+    """
+
+
+def spec(
+    default: Any,
+    unit: str,
+    description: str,
+    *,
+    rule: str = "finite",
+) -> Any:
+    """Declare a dataclass field with its unit, description and validity rule.
+
+    ``rule`` is one of ``"finite"``, ``"positive"`` (finite and > 0), ``"nonnegative"``
+    (finite and >= 0), ``"bool"`` or ``"str"``.
+    """
+    return field(default=default, metadata={"unit": unit, "description": description, "rule": rule})
+
+
+def check_value(name: str, value: Any, unit: str, rule: str) -> None:
+    """Raise :class:`ParameterError` if ``value`` breaks ``rule``."""
+    shown = f"{name} = {value!r}" + (f" {unit}" if unit and unit != "1" else "")
+    if rule == "bool":
+        if not isinstance(value, bool):
+            raise ParameterError(f"invalid {shown}: must be a Boolean")
+        return
+    if rule == "str":
+        if not isinstance(value, str):
+            raise ParameterError(f"invalid {shown}: must be a string")
+        return
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ParameterError(f"invalid {shown}: must be a real number")
+    if not math.isfinite(value):
+        raise ParameterError(f"invalid {shown}: must be finite")
+    if rule == "positive" and not value > 0.0:
+        raise ParameterError(f"invalid {shown}: must be > 0")
+    if rule == "nonnegative" and not value >= 0.0:
+        raise ParameterError(f"invalid {shown}: must be >= 0")
+
+
+class _Validated:
+    """Mixin: validate every field against its declared rule after construction."""
+
+    def __post_init__(self) -> None:
+        for f in fields(self):  # type: ignore[arg-type]
+            check_value(f.name, getattr(self, f.name), f.metadata["unit"], f.metadata["rule"])
+
+
+@dataclass(frozen=True)
+class PendulumParameters(_Validated):
+    """Physical parameters of the planar double pendulum (point masses on massless rods).
+
+    Angles are measured from the downward vertical; y points up, the pivot is the origin.
+    """
+
+    m1: float = spec(0.301, "kg", "mass of the upper bob", rule="positive")
+    m2: float = spec(0.297, "kg", "mass of the lower bob", rule="positive")
+    l1: float = spec(0.2964, "m", "length of the upper rod (pivot to upper bob)", rule="positive")
+    l2: float = spec(0.1971, "m", "length of the lower rod (upper bob to lower bob)", rule="positive")
+    g: float = spec(9.81, "m/s2", "gravitational acceleration", rule="positive")
+
+
+@dataclass(frozen=True)
+class InitialState(_Validated):
+    """Start values of the generalised coordinates and their rates."""
+
+    phi1_0: float = spec(1.0, "rad", "initial angle of the upper rod from the downward vertical")
+    phi2_0: float = spec(1.0, "rad", "initial angle of the lower rod from the downward vertical")
+    omega1_0: float = spec(0.0, "rad/s", "initial angular velocity of the upper rod")
+    omega2_0: float = spec(0.0, "rad/s", "initial angular velocity of the lower rod")
+
+    def as_list(self) -> list[float]:
+        """Return ``[phi1, phi2, omega1, omega2]`` (rad, rad, rad/s, rad/s)."""
+        return [self.phi1_0, self.phi2_0, self.omega1_0, self.omega2_0]
+
+
+@dataclass(frozen=True)
+class SolverSettings(_Validated):
+    """Choice of integrator and its accuracy settings (see :mod:`double_pendulum.solvers`)."""
+
+    solver: str = spec("dop853", "", "integration method: dop853, dopri5, rk4 or euler", rule="str")
+    rtol: float = spec(1e-9, "1", "relative tolerance of the adaptive solvers", rule="positive")
+    atol: float = spec(1e-12, "1", "absolute tolerance of the adaptive solvers (rad, rad/s)", rule="positive")
+    fixed_step: float = spec(1e-3, "s", "step size of the fixed-step solvers (rk4, euler)", rule="positive")
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        from .solvers.registry import check_solver_name
+
+        check_solver_name(self.solver)
+
+
+def field_specs(cls: type) -> list[tuple[str, Any, str, str, str]]:
+    """Return ``(name, default, unit, description, rule)`` for every field of ``cls``."""
+    return [
+        (f.name, f.default, f.metadata["unit"], f.metadata["description"], f.metadata["rule"])
+        for f in fields(cls)
+    ]

@@ -1,0 +1,89 @@
+"""Result files: CSV with units in the header, summary JSON; written atomically.
+
+CSV layout: a header row of ``"name [unit]"`` columns (``time [s]`` first), then one row per
+output time with ``repr``-exact floats. :func:`fmpy.util.read_csv` reads it as is (the column
+names then carry the units); :func:`read_results_csv` strips the units again.
+
+Every file is written to a temporary name in the target folder and renamed into place, so an
+interrupted run never leaves a half-written file and never destroys a file written earlier.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+
+def _atomic_write_text(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", newline="\n") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def column_header(name: str, unit: str) -> str:
+    """Return ``"name [unit]"`` (or just ``name`` for a dimensionless column)."""
+    return f"{name} [{unit}]" if unit and unit != "1" else name
+
+
+def write_results_csv(path: str | Path, result: np.ndarray, units: Mapping[str, str]) -> Path:
+    """Write a structured array (fields ``time`` and outputs) as CSV with units in the header."""
+    path = Path(path)
+    names = result.dtype.names
+    header = ",".join(f'"{column_header(n, "s" if n == "time" else units.get(n, ""))}"' for n in names)
+    columns = [np.asarray(result[n], dtype=float) for n in names]
+    lines = [header]
+    for row in zip(*columns):
+        lines.append(",".join(repr(float(v)) for v in row))
+    _atomic_write_text(path, "\n".join(lines) + "\n")
+    return path
+
+
+def read_results_csv(path: str | Path) -> np.ndarray:
+    """Read a CSV written by :func:`write_results_csv` into a structured array (plain names)."""
+    with open(path) as fh:
+        header = fh.readline().rstrip("\n").split(",")
+    names = [h.strip('"').split(" [")[0] for h in header]
+    data = np.loadtxt(path, delimiter=",", skiprows=1, ndmin=2)
+    return np.rec.fromarrays(data.T, names=names).view(np.ndarray)
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, Mapping):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_jsonable(v) for v in value]
+    if isinstance(value, (np.floating, float)):
+        value = float(value)
+        return value if math.isfinite(value) else None
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.ndarray):
+        return _jsonable(value.tolist())
+    return value
+
+
+def write_json(path: str | Path, data: Mapping[str, Any]) -> Path:
+    """Write ``data`` as indented JSON (NumPy scalars converted, non-finite floats as null)."""
+    path = Path(path)
+    _atomic_write_text(path, json.dumps(_jsonable(data), indent=2, sort_keys=False) + "\n")
+    return path
+
+
+def write_text(path: str | Path, text: str) -> Path:
+    """Write a text file (e.g. a report) atomically."""
+    path = Path(path)
+    _atomic_write_text(path, text)
+    return path

@@ -1,0 +1,59 @@
+"""In-process simulation with the same co-simulation component the FMU runs.
+
+:func:`simulate` mirrors :func:`fmpy.simulate_fmu` for this model: same start values by name,
+same communication grid, same structured result array. Running the same settings through the
+FMU gives the same numbers (``tests/test_fmu.py`` checks this), without the FMI layer's cost.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from .cosimulation import DoublePendulumCoSimulation
+from .outputs import OUTPUT_NAMES
+
+
+def communication_points(
+    start_time: float, stop_time: float, interval: float
+) -> Iterator[tuple[float, float]]:
+    """Yield ``(current_time, step_size)`` pairs on fmpy's grid ``start + n * interval``.
+
+    The last step is shortened to end at ``stop_time``, as fmpy does for FMUs that can
+    handle a variable communication step size.
+    """
+    if not (math.isfinite(interval) and interval > 0.0):
+        raise ValueError(f"invalid output_interval = {interval!r} s: must be > 0")
+    time = start_time
+    n = 0
+    while not (time > stop_time or math.isclose(time, stop_time)):
+        nxt = start_time + (n + 1) * interval
+        if nxt > stop_time and not math.isclose(nxt, stop_time):
+            nxt = stop_time
+        yield time, nxt - time
+        time = nxt
+        n += 1
+
+
+def simulate(
+    start_values: Mapping[str, Any] | None = None,
+    *,
+    stop_time: float = 10.0,
+    output_interval: float = 0.01,
+    start_time: float = 0.0,
+    outputs: Sequence[str] = OUTPUT_NAMES,
+) -> np.ndarray:
+    """Simulate in-process and return a structured array with ``time`` and ``outputs``."""
+    sim = DoublePendulumCoSimulation(start_time)
+    for name, value in (start_values or {}).items():
+        sim.set(name, value)
+    sim.initialise()
+    rows = [(sim.time, *(sim.outputs[n] for n in outputs))]
+    for current, step in communication_points(start_time, stop_time, output_interval):
+        sim.do_step(current, step)
+        rows.append((sim.time, *(sim.outputs[n] for n in outputs)))
+    dtype = [("time", np.float64)] + [(n, np.float64) for n in outputs]
+    return np.array(rows, dtype=dtype)

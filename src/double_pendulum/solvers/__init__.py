@@ -1,0 +1,19 @@
+"""Integrators, kept apart from the right-hand sides they integrate.
+
+* :mod:`.runge_kutta` — the methods (one step, error estimate, dense output);
+* :mod:`.integrator` — step-size control, dense output and persistent state;
+* :mod:`.registry` — the names users pass as ``solver``.
+"""
+
+from .integrator import Integrator, SolverError
+from .registry import METHODS, UnknownSolverError, check_solver_name, make_integrator, make_method
+
+__all__ = [
+    "Integrator",
+    "METHODS",
+    "SolverError",
+    "UnknownSolverError",
+    "check_solver_name",
+    "make_integrator",
+    "make_method",
+]

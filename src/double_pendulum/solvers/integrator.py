@@ -1,0 +1,233 @@
+"""A persistent integrator: step control and dense output around any method of this package.
+
+The integrator takes its own steps (adaptive: the step-size controller below; fixed: the grid
+``t0 + n * fixed_step``) and answers ``advance_to(t)`` by interpolating the last step with the
+method's continuous extension. The sequence of steps therefore does not depend on the times at
+which results are requested: an FMU communication step of 1 ms or 50 ms sees the same
+trajectory, up to the interpolation error, and the integrator's state (including its step size)
+carries over from one ``doStep`` to the next.
+
+Step-size control (Hairer, Norsett, Wanner I, II.4): a step is accepted when the scaled error
+norm ``err <= 1``; the next step is ``h * min(10, max(0.2, 0.9 * err^(-1/(q+1))))`` with ``q`` the
+order of the error estimate, never growing right after a rejection.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .runge_kutta import VectorField
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+DEFAULT_MAX_STEPS_PER_CALL = 1_000_000
+
+
+class SolverError(RuntimeError):
+    """The integration could not continue (step size underflow, non-finite state, step budget)."""
+
+
+def _all_finite(values: list[float]) -> bool:
+    return all(math.isfinite(v) for v in values)
+
+
+class Integrator:
+    """Integrate ``dy/dt = f(t, y)`` forward from ``(t0, y0)`` with ``method``.
+
+    ``rtol``/``atol`` [state units] control adaptive methods, ``fixed_step`` [s] fixed-step ones.
+    Counters: ``n_steps`` (accepted), ``n_rejected``, ``nfev`` (right-hand side evaluations).
+    """
+
+    def __init__(
+        self,
+        f: VectorField,
+        t0: float,
+        y0: list[float],
+        method: Any,
+        *,
+        rtol: float = 1e-9,
+        atol: float = 1e-12,
+        fixed_step: float = 1e-3,
+        max_step: float = math.inf,
+        max_steps_per_call: int = DEFAULT_MAX_STEPS_PER_CALL,
+    ) -> None:
+        y0 = [float(v) for v in y0]
+        if not _all_finite(y0):
+            raise SolverError(f"non-finite initial state {y0}")
+        self.f = f
+        self.method = method
+        self.rtol = rtol
+        self.atol = atol
+        self.fixed_step = fixed_step
+        self.max_step = max_step
+        self.max_steps_per_call = max_steps_per_call
+        self.t0 = float(t0)
+        self.t = self.t0
+        self.y = y0
+        self.fy = f(self.t, y0)
+        self.nfev = 1
+        self.n_steps = 0
+        self.n_rejected = 0
+        # The last accepted step [t_prev, t], kept for dense output.
+        self.t_prev = self.t
+        self.y_prev = list(y0)
+        self.fy_prev = list(self.fy)
+        self.stages: list[list[float]] = []
+        self._interp = None
+        if method.adaptive:
+            self.h = self._initial_step()
+        else:
+            self.h = fixed_step
+
+    # ------------------------------------------------------------------ stepping
+    def _initial_step(self) -> float:
+        """Hairer's starting step estimate (Solving ODEs I, II.4, algorithm on p. 169)."""
+        f, t, y, fy = self.f, self.t, self.y, self.fy
+        scale = [self.atol + self.rtol * abs(v) for v in y]
+        d0 = math.sqrt(sum((v / s) ** 2 for v, s in zip(y, scale)) / len(y))
+        d1 = math.sqrt(sum((v / s) ** 2 for v, s in zip(fy, scale)) / len(y))
+        h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+        h0 = min(h0, self.max_step)
+        y1 = [v + h0 * d for v, d in zip(y, fy)]
+        f1 = f(t + h0, y1)
+        self.nfev += 1
+        d2 = math.sqrt(sum(((a - b) / s) ** 2 for a, b, s in zip(f1, fy, scale)) / len(y)) / h0
+        if d1 <= 1e-15 and d2 <= 1e-15:
+            h1 = max(1e-6, h0 * 1e-3)
+        else:
+            h1 = (0.01 / max(d1, d2)) ** (1.0 / (self.method.error_order + 1))
+        return min(100.0 * h0, h1, self.max_step)
+
+    def _accept(self, h: float, y_new: list[float], f_new: list[float], stages: list[list[float]]) -> None:
+        self.t_prev, self.y_prev, self.fy_prev = self.t, self.y, self.fy
+        self.stages = stages
+        self._interp = None
+        self.y, self.fy = y_new, f_new
+        self.n_steps += 1
+
+    def _fixed_step(self) -> None:
+        n = self.n_steps + 1
+        t_new = self.t0 + n * self.fixed_step
+        h = t_new - self.t
+        y_new, f_new, stages = self.method.step(self.f, self.t, self.y, self.fy, h)
+        self.nfev += self.method.evals_per_step
+        if not _all_finite(y_new):
+            raise SolverError(
+                f"{self.method.name}: state became non-finite at t = {t_new:.6g} s "
+                f"(fixed_step = {self.fixed_step:g} s is too large for this motion)"
+            )
+        self._accept(h, y_new, f_new, stages)
+        self.t = t_new
+
+    def _adaptive_step(self) -> None:
+        method = self.method
+        exponent = -1.0 / (method.error_order + 1)
+        h = min(self.h, self.max_step)
+        rejected = False
+        while True:
+            h_min = 16.0 * math.ulp(max(abs(self.t), 1.0))
+            if h < h_min:
+                raise SolverError(
+                    f"{method.name}: step size underflow (h = {h:.3g} s) at t = {self.t:.6g} s; "
+                    "the problem may be stiff or the state has blown up"
+                )
+            y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h)
+            self.nfev += method.evals_per_step
+            err = method.error_norm(self.y, y_new, stages, h, self.rtol, self.atol)
+            if err <= 1.0 and _all_finite(y_new) and _all_finite(f_new):
+                factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**exponent)
+                if rejected:
+                    factor = min(1.0, factor)
+                self._accept(h, y_new, f_new, stages)
+                self.t = self.t + h
+                self.h = h * factor
+                return
+            self.n_rejected += 1
+            rejected = True
+            if math.isfinite(err):
+                h *= max(MIN_FACTOR, SAFETY * err**exponent)
+            else:
+                h *= MIN_FACTOR
+
+    def step(self) -> None:
+        """Take one accepted step."""
+        if self.method.adaptive:
+            self._adaptive_step()
+        else:
+            self._fixed_step()
+
+    # ------------------------------------------------------------------ output
+    def advance_to(self, t_out: float) -> list[float]:
+        """Integrate until ``t >= t_out`` and return the state at ``t_out`` (dense output)."""
+        if t_out < self.t_prev:
+            raise SolverError(f"cannot return to t = {t_out:.9g} s: the integrator is at t = {self.t:.9g} s")
+        budget = self.max_steps_per_call
+        while self.t < t_out:
+            if budget == 0:
+                raise SolverError(
+                    f"{self.method.name}: more than {self.max_steps_per_call} steps before "
+                    f"t = {t_out:.6g} s (stuck at t = {self.t:.6g} s, h = {self.h:.3g} s); "
+                    "the problem may be stiff"
+                )
+            self.step()
+            budget -= 1
+        return self.state_at(t_out)
+
+    def state_at(self, t_out: float) -> list[float]:
+        """Return the state at ``t_out`` within the last step ``[t_prev, t]``."""
+        if t_out == self.t:
+            return list(self.y)
+        if t_out == self.t_prev:
+            return list(self.y_prev)
+        if not self.t_prev <= t_out <= self.t:
+            raise SolverError(
+                f"t = {t_out:.9g} s is outside the last step [{self.t_prev:.9g}, {self.t:.9g}] s"
+            )
+        if self._interp is None:
+            h = self.t - self.t_prev
+            self._interp = self.method.interpolant(
+                self.f, self.t_prev, self.y_prev, self.y, self.fy_prev, self.fy, h, self.stages
+            )
+            self.nfev += self.method.dense_evals
+        return self._interp((t_out - self.t_prev) / (self.t - self.t_prev))
+
+    # ------------------------------------------------------------------ state
+    _STATE_FIELDS = (
+        "t0",
+        "t",
+        "y",
+        "fy",
+        "h",
+        "t_prev",
+        "y_prev",
+        "fy_prev",
+        "stages",
+        "nfev",
+        "n_steps",
+        "n_rejected",
+    )
+
+    def get_state(self) -> dict[str, Any]:
+        """Return everything that determines the future steps, as JSON-serialisable data."""
+        return {
+            name: (
+                [list(s) for s in value]
+                if name == "stages"
+                else (list(value) if isinstance(value, list) else value)
+            )
+            for name in self._STATE_FIELDS
+            for value in [getattr(self, name)]
+        }
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        """Restore a state from :meth:`get_state`; later steps are bit-identical."""
+        for name in self._STATE_FIELDS:
+            value = state[name]
+            if name == "stages":
+                value = [list(s) for s in value]
+            elif isinstance(value, list):
+                value = list(value)
+            setattr(self, name, value)
+        self._interp = None

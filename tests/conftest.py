@@ -1,0 +1,26 @@
+"""Shared fixtures: the FMU is built once per test session into a temporary folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from double_pendulum.fmu_build import build_fmu
+from double_pendulum.runner import FmuRunner
+
+REPO = Path(__file__).resolve().parents[1]
+DATA = REPO / "data"
+
+
+@pytest.fixture(scope="session")
+def fmu_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A freshly built DoublePendulum.fmu (built once per session)."""
+    return build_fmu(tmp_path_factory.mktemp("fmu") / "DoublePendulum.fmu")
+
+
+@pytest.fixture(scope="session")
+def runner(fmu_path: Path):
+    """An fmpy runner for the session's FMU."""
+    with FmuRunner(fmu_path) as r:
+        yield r

@@ -1,0 +1,210 @@
+"""The FMU through fmpy: validity, units, physics on its outputs, agreement with in-process runs."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import sysconfig
+import textwrap
+import zipfile
+from xml.etree import ElementTree as ET
+
+import numpy as np
+import pytest
+from conftest import DATA
+from scipy.special import ellipk
+
+from double_pendulum.dynamics import linearised_normal_modes
+from double_pendulum.outputs import OUTPUT_NAMES
+from double_pendulum.parameters import PendulumParameters
+from double_pendulum.results_io import read_results_csv
+from double_pendulum.runner import FmuRunError
+from double_pendulum.simulate import simulate
+
+
+def _model_description(fmu_path) -> ET.Element:
+    with zipfile.ZipFile(fmu_path) as z:
+        return ET.fromstring(z.read("modelDescription.xml"))
+
+
+def test_validate_fmu_reports_no_problems(fmu_path):
+    from fmpy.validation import validate_fmu
+
+    assert validate_fmu(str(fmu_path)) == []
+
+
+def test_physical_variables_carry_fmi_units_and_descriptions(fmu_path):
+    root = _model_description(fmu_path)
+    defined = {u.get("name") for u in root.find("UnitDefinitions")}
+    units = {}
+    for sv in root.find("ModelVariables"):
+        real = sv.find("Real")
+        if real is not None and real.get("unit"):
+            units[sv.get("name")] = real.get("unit")
+            assert f"[{real.get('unit')}]" in sv.get("description")
+    assert set(units.values()) <= defined
+    assert units["l1"] == "m" and units["m2"] == "kg" and units["phi1"] == "rad"
+    assert units["omega2"] == "rad/s" and units["E_total"] == "J" and units["g"] == "m/s2"
+    assert root.find("DefaultExperiment") is not None
+    assert set(OUTPUT_NAMES) <= {sv.get("name") for sv in root.find("ModelVariables")}
+
+
+def test_fmu_bundles_the_package_and_lists_runtime_requirements(fmu_path):
+    with zipfile.ZipFile(fmu_path) as z:
+        names = z.namelist()
+        assert "resources/double_pendulum/dynamics.py" in names
+        assert "resources/DoublePendulum.py" in names
+        assert "pythonfmu" in z.read("resources/requirements.txt").decode()
+        assert not any("__pycache__" in n for n in names)
+
+
+def test_fmu_runs_without_the_project_installed(fmu_path, tmp_path):
+    """In a Python that cannot import double_pendulum, the FMU still runs from its resources."""
+    site_packages = sysconfig.get_paths()["purelib"]
+    script = textwrap.dedent(f"""
+        import sys
+        sys.path.append({site_packages!r})  # fmpy, numpy; no .pth files, so no editable project
+        try:
+            import double_pendulum
+        except ImportError:
+            pass
+        else:
+            raise SystemExit("double_pendulum is importable: the test would prove nothing")
+        from fmpy import simulate_fmu
+        r = simulate_fmu({str(fmu_path)!r}, stop_time=1.0, output_interval=0.1,
+                         start_values={{"phi1_0": 1.5}}, output=["phi1"])
+        print(repr(float(r["phi1"][-1])))
+    """)
+    out = subprocess.run(
+        [sys.executable, "-S", "-c", script], capture_output=True, text=True, cwd=tmp_path, timeout=120
+    )
+    assert out.returncode == 0, out.stderr
+    expected = simulate({"phi1_0": 1.5}, stop_time=1.0, output_interval=0.1, outputs=["phi1"])["phi1"][-1]
+    assert float(out.stdout.strip()) == expected
+
+
+def test_frictionless_energy_drift_below_1e9_over_30s(runner):
+    r = runner.simulate(
+        {"phi1_0": 2.0, "phi2_0": 2.0, "rtol": 1e-12, "atol": 1e-14}, stop_time=30.0, output_interval=0.01
+    )
+    e = r["E_total"]
+    drift = np.max(np.abs(e - e[0])) / abs(e[0])
+    assert drift < 1e-9
+    assert np.max(np.abs(r["phi2"])) > math.pi  # the chaotic start really flips over
+
+
+def _zero_crossing_times(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    i = np.nonzero(np.sign(x[:-1]) * np.sign(x[1:]) < 0)[0]
+    return t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
+
+
+@pytest.mark.parametrize("mode", [0, 1])
+def test_small_angle_motion_has_the_analytic_normal_mode_frequencies(runner, mode):
+    """Started in a pure linear mode with 1e-4 rad amplitude, the FMU oscillates at omega_k."""
+    omegas, shapes = linearised_normal_modes(PendulumParameters())
+    amp = 1e-4
+    start = {"phi1_0": amp, "phi2_0": amp * shapes[mode][1], "rtol": 1e-12, "atol": 1e-16}
+    periods = 20
+    stop = periods * 2 * math.pi / omegas[mode]
+    r = runner.simulate(start, stop_time=stop, output_interval=stop / 20000)
+    crossings = _zero_crossing_times(r["time"], r["phi1"])
+    measured = math.pi * (len(crossings) - 1) / (crossings[-1] - crossings[0])
+    assert measured == pytest.approx(omegas[mode], rel=1e-4)
+    # The other mode is not excited: phi2/phi1 stays at the mode shape.
+    big = np.abs(r["phi1"]) > 0.5 * amp
+    assert np.median(r["phi2"][big] / r["phi1"][big]) == pytest.approx(shapes[mode][1], rel=1e-3)
+
+
+def test_vanishing_lower_mass_reduces_to_the_single_pendulum(runner):
+    """m2 -> 0: phi1 swings with the exact large-amplitude period 4 sqrt(l/g) K(sin^2(theta/2))."""
+    p = PendulumParameters()
+    theta = 1.0
+    r = runner.simulate(
+        {"m2": 1e-9, "phi1_0": theta, "phi2_0": theta, "rtol": 1e-12, "atol": 1e-14},
+        stop_time=10.0,
+        output_interval=1e-3,
+    )
+    crossings = _zero_crossing_times(r["time"], r["phi1"])
+    period = 2 * (crossings[-1] - crossings[0]) / (len(crossings) - 1)
+    exact = 4 * math.sqrt(p.l1 / p.g) * ellipk(math.sin(theta / 2) ** 2)
+    assert period == pytest.approx(exact, rel=1e-6)
+    assert np.max(np.abs(r["phi1"])) == pytest.approx(theta, rel=1e-6)
+
+
+@pytest.mark.parametrize("solver", ["dop853", "dopri5", "rk4", "euler"])
+def test_fmu_equals_in_process_results_of_the_same_solver(runner, solver):
+    start = {
+        "phi1_0": 2.0,
+        "phi2_0": 1.0,
+        "omega2_0": 1.0,
+        "solver": solver,
+        "rtol": 1e-8,
+        "fixed_step": 1e-3,
+    }
+    a = runner.simulate(start, stop_time=2.0, output_interval=0.02)
+    b = simulate(start, stop_time=2.0, output_interval=0.02)
+    for name in a.dtype.names:
+        np.testing.assert_array_equal(a[name], b[name])
+
+
+@pytest.mark.parametrize("solver", ["dop853", "dopri5", "rk4"])
+def test_result_does_not_depend_on_the_communication_step(runner, solver):
+    start = {"phi1_0": 2.0, "phi2_0": 2.0, "solver": solver, "rtol": 1e-10, "atol": 1e-12, "fixed_step": 1e-3}
+    fine = runner.simulate(start, stop_time=3.0, output_interval=1e-3)
+    coarse = runner.simulate(start, stop_time=3.0, output_interval=0.05)
+    for name in ("phi1", "phi2", "omega1", "omega2"):
+        assert fine[name][-1] == pytest.approx(coarse[name][-1], abs=1e-8)
+        # also at every coarse point (dense output on both grids)
+        np.testing.assert_allclose(fine[name][::50], coarse[name], atol=1e-8, rtol=0)
+
+
+@pytest.mark.parametrize("case", ["regular", "chaotic"])
+def test_agrees_with_the_committed_reference_trajectory(runner, case):
+    """data/reference/*.csv: Hamilton's equations, independent of our accelerations (make_reference.py)."""
+    ref = read_results_csv(DATA / "reference" / f"{case}.csv")
+    start = {"phi1_0": ref["phi1"][0], "phi2_0": ref["phi2"][0], "rtol": 1e-12, "atol": 1e-14}
+    r = runner.simulate(start, stop_time=float(ref["time"][-1]), output_interval=0.01)
+    tol = 1e-9 if case == "regular" else 1e-7
+    for name in ("phi1", "phi2", "omega1", "omega2"):
+        np.testing.assert_allclose(r[name], ref[name], atol=tol, rtol=0)
+
+
+@pytest.mark.parametrize(
+    ("start", "names"),
+    [
+        ({"l1": -0.3}, "l1 = -0.3 m"),
+        ({"l2": 0.0}, "l2 = 0.0 m"),
+        ({"m1": -1.0}, "m1 = -1.0 kg"),
+        ({"phi1_0": math.nan}, "phi1_0 = nan rad"),
+        ({"omega2_0": math.inf}, "omega2_0 = inf rad/s"),
+        ({"solver": "leapfrog"}, "solver = 'leapfrog'"),
+        ({"rtol": 0.0}, "rtol = 0.0"),
+        ({"fixed_step": -1e-3}, "fixed_step = -0.001 s"),
+    ],
+)
+def test_bad_parameters_give_an_error_status_naming_the_variable(runner, start, names):
+    with pytest.raises(FmuRunError, match="status") as info:
+        runner.simulate(start, stop_time=1.0)
+    assert names in str(info.value)
+    # and the runner still works afterwards, with a new instance
+    assert runner.simulate({}, stop_time=0.1)["time"][-1] == pytest.approx(0.1)
+
+
+def test_bad_parameters_raise_in_plain_fmpy_too(fmu_path):
+    from fmpy import simulate_fmu
+    from fmpy.fmi1 import FMICallException
+
+    with pytest.raises(FMICallException):
+        simulate_fmu(str(fmu_path), stop_time=1.0, start_values={"l1": -1.0})
+
+
+def test_numerical_blow_up_is_reported_not_returned(runner):
+    with pytest.raises(FmuRunError, match="numerical instability") as info:
+        runner.simulate(
+            {"solver": "euler", "fixed_step": 0.5, "phi1_0": 3.0, "omega2_0": 40.0},
+            stop_time=100.0,
+            output_interval=1.0,
+        )
+    partial = info.value.partial_result
+    assert partial is not None and np.all(np.isfinite(partial["E_total"]))
