@@ -19,7 +19,8 @@ from double_pendulum.runner import FmuRunner, ensure_fmu
 
 def _median_spread(samples: list[float]) -> str:
     med = statistics.median(samples)
-    return f"{med * 1e6:9.1f} us  (min {min(samples) * 1e6:.1f}, max {max(samples) * 1e6:.1f}, n={len(samples)})"
+    lo, hi = min(samples) * 1e6, max(samples) * 1e6
+    return f"{med * 1e6:9.1f} us  (min {lo:.1f}, max {hi:.1f}, n={len(samples)})"
 
 
 def startup_times(runner: FmuRunner, repeats: int) -> list[float]:
@@ -72,8 +73,10 @@ def main() -> None:
     args = parser.parse_args()
     with FmuRunner(ensure_fmu(args.fmu)) as runner:
         print(f"energy drift, chaotic start, 30 s, dop853 rtol 1e-12: {energy_drift(runner):.2e} (relative)")
-        print(f"doStep through fmpy, 1 ms step, dop853 rtol 1e-9:     {_median_spread(do_step_times(runner, args.repeats))}")
-        print(f"FMU start-up (instantiate..exitInitializationMode):   {_median_spread(startup_times(runner, args.repeats))}")
+        steps = _median_spread(do_step_times(runner, args.repeats))
+        print(f"doStep through fmpy, 1 ms step, dop853 rtol 1e-9:     {steps}")
+        startup = _median_spread(startup_times(runner, args.repeats))
+        print(f"FMU start-up (instantiate..exitInitializationMode):   {startup}")
 
 
 if __name__ == "__main__":

@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 
 from conftest import REPO
+
 from double_pendulum.fmu_interface import fmu_variables
 
 README = (REPO / "README.md").read_text()
