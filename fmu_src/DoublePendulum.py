@@ -81,6 +81,14 @@ class DoublePendulum(Fmi2Slave):
     def exit_initialization_mode(self):
         self._sim.initialise()
 
+    # FMU state (fmi2Get/SetFMUstate, fmi2(De)SerializeFMUstate): the co-simulation's complete
+    # state, including the integrator's hidden state, as JSON-serialisable data.
+    def _get_fmu_state(self):
+        return self._sim.get_state()
+
+    def _set_fmu_state(self, state):
+        self._sim.set_state(state)
+
     def do_step(self, current_time, step_size):
         try:
             self._sim.do_step(current_time, step_size)

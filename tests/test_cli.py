@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 
+import pytest
+
 from double_pendulum.cli import main
 from double_pendulum.results_io import read_results_csv
 
@@ -39,3 +41,22 @@ def test_unknown_scenario_is_a_clear_error(capsys):
         assert "unknown scenario 'nope'" in str(exc)
     else:
         raise AssertionError("expected SystemExit")
+
+
+def test_run_friction_budget_accounts_for_the_loss(fmu_path, tmp_path):
+    assert main(["run", "friction_budget", "--quick", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 0
+    summary = json.loads((tmp_path / "friction_budget" / "summary.json").read_text())
+    shares = summary["share_of_loss_all_on"]
+    assert sum(shares.values()) == pytest.approx(1.0, abs=1e-6)  # every joule accounted for
+    assert all(v > 0 for v in shares.values())
+    assert all(b < 0 for b in summary["decay_rate_b_per_s"].values())
+    for name in ("energy_per_mechanism", "energy_budget_stacked"):
+        assert (tmp_path / "friction_budget" / f"{name}.png").is_file()
+
+
+def test_variables_prints_the_readme_table(capsys):
+    from conftest import REPO
+
+    assert main(["variables"]) == 0
+    table = capsys.readouterr().out.strip()
+    assert table in (REPO / "README.md").read_text()

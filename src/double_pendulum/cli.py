@@ -1,4 +1,4 @@
-"""Command line: ``double-pendulum build | run SCENARIO | list``."""
+"""Command line: ``double-pendulum build | run SCENARIO | list | variables``."""
 
 from __future__ import annotations
 
@@ -32,6 +32,19 @@ def cmd_build(args: argparse.Namespace) -> int:
 def cmd_list(args: argparse.Namespace) -> int:
     for name in _scenario_names():
         print(f"{name:24s} {_load_scenario(name).DESCRIPTION}")
+    return 0
+
+
+def cmd_variables(args: argparse.Namespace) -> int:
+    """Print the FMU's variables as the Markdown table used in the README."""
+    from .fmu_interface import fmu_variables
+
+    print("| name | causality | type | unit | start | description |")
+    print("|---|---|---|---|---|---|")
+    for v in fmu_variables():
+        text = v.description.rsplit(" [", 1)[0] if v.unit else v.description
+        start = "" if v.start is None else v.start
+        print(f"| `{v.name}` | {v.causality} | {v.fmi_type} | {v.unit or '-'} | {start} | {text} |")
     return 0
 
 
@@ -76,9 +89,27 @@ def main(argv: list[str] | None = None) -> int:
     p_list = sub.add_parser("list", help="list the scenarios")
     p_list.set_defaults(func=cmd_list)
 
+    p_vars = sub.add_parser("variables", help="print the FMU's variables (Markdown table)")
+    p_vars.set_defaults(func=cmd_variables)
+
     args = parser.parse_args(argv)
     return args.func(args)
 
 
 if __name__ == "__main__":
     raise SystemExit(main())
+
+
+def entry() -> None:
+    """Console-script entry point: run :func:`main` and leave without interpreter teardown.
+
+    pythonfmu (<= 0.7.0, upstream issue NTNU-IHB/PythonFMU#228) can corrupt the heap during
+    process teardown after its FMUs were used, turning a finished run into an abort. All results
+    are written by the time :func:`main` returns, so the process exits directly with its code.
+    """
+    import os
+
+    code = main()
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)

@@ -19,18 +19,28 @@ import math
 from dataclasses import fields
 from typing import Any
 
-from .dynamics import fixed_pivot_vector_field
-from .outputs import OUTPUT_NAMES, output_values
+from .model import Model, ModelConfig, ModelError, build_model
+from .outputs import MODEL_OUTPUT_NAMES, output_values
 from .parameters import (
+    AirDragParameters,
+    BearingParameters,
     InitialState,
     ParameterError,
     PendulumParameters,
     SolverSettings,
+    SuspensionParameters,
     check_value,
 )
 from .solvers import Integrator, SolverError, make_integrator
 
-PARAMETER_GROUPS: tuple[type, ...] = (PendulumParameters, InitialState, SolverSettings)
+PARAMETER_GROUPS: tuple[type, ...] = (
+    PendulumParameters,
+    InitialState,
+    AirDragParameters,
+    BearingParameters,
+    SuspensionParameters,
+    SolverSettings,
+)
 ENERGY_BLOWUP_FACTOR = 1e3
 
 
@@ -60,10 +70,10 @@ class DoublePendulumCoSimulation:
         self.time = float(start_time)
         self.initialised = False
         self.integrator: Integrator | None = None
-        self.params = PendulumParameters()
+        self.model: Model = build_model(ModelConfig())
         self.outputs: dict[str, float] = {}
-        self.initial_energy = 0.0
-        self._update_outputs(InitialState().as_list())
+        self.initial_energy: float | None = None
+        self._update_outputs(self.model.initial_state(*InitialState().as_list()))
 
     # ------------------------------------------------------------------ parameters
     def set(self, name: str, value: Any) -> None:
@@ -101,20 +111,26 @@ class DoublePendulumCoSimulation:
 
     def initialise(self) -> None:
         """Validate all parameters together and start the integrator at the start time."""
-        self.params = self._group(PendulumParameters)
+        config = ModelConfig(
+            pendulum=self._group(PendulumParameters),
+            air=self._group(AirDragParameters),
+            bearing=self._group(BearingParameters),
+            suspension=self._group(SuspensionParameters),
+        )
         initial = self._group(InitialState)
         settings = self._group(SolverSettings)
-        f = fixed_pivot_vector_field(self.params)
-        y0 = initial.as_list()
+        self.model = build_model(config)
+        y0 = self.model.initial_state(*initial.as_list())
         self.integrator = make_integrator(
             settings.solver,
-            f,
+            self.model.vector_field,
             self.time,
             y0,
             rtol=settings.rtol,
             atol=settings.atol,
             fixed_step=settings.fixed_step,
         )
+        self.initial_energy = None
         self._update_outputs(y0)
         self.initial_energy = self.outputs["E_total"]
         self.initialised = True
@@ -136,11 +152,51 @@ class DoublePendulumCoSimulation:
                 f"point t = {self.time!r} s"
             )
         t_end = current_time + step_size
-        y = self.integrator.advance_to(t_end)
-        outputs = dict(zip(OUTPUT_NAMES, output_values(y, self.params)))
+        try:
+            y = self.integrator.advance_to(t_end)
+        except ModelError as error:
+            raise SolverError(str(error)) from error
+        outputs = self._outputs_at(y)
         self._check_bounded(outputs, t_end)
         self.time = t_end
         self.outputs = outputs
+
+    # ------------------------------------------------------------------ FMU state
+    STATE_VERSION = 1
+
+    def get_state(self) -> dict[str, Any]:
+        """Return the complete state (parameters, time, integrator) as JSON-serialisable data.
+
+        Restoring it with :meth:`set_state`, in this or a fresh instance, continues bit-identically:
+        the integrator's hidden state (step size, last step, stage derivatives) is included.
+        """
+        return {
+            "version": self.STATE_VERSION,
+            "values": dict(self.values),
+            "time": self.time,
+            "initialised": self.initialised,
+            "initial_energy": self.initial_energy,
+            "outputs": dict(self.outputs),
+            "integrator": self.integrator.get_state() if self.integrator is not None else None,
+        }
+
+    def set_state(self, state: dict[str, Any]) -> None:
+        """Restore a state from :meth:`get_state` (FMI fmi2SetFMUstate)."""
+        if state.get("version") != self.STATE_VERSION:
+            raise CoSimulationError(f"unsupported FMU state version {state.get('version')!r}")
+        values = dict(state["values"])
+        if set(values) != set(self.values):
+            raise CoSimulationError("FMU state does not match this model's parameters")
+        self.values = values
+        self.initialised = False
+        self.integrator = None
+        self.time = float(state["time"])
+        if state["initialised"]:
+            self.initialise()  # rebuilds model and integrator from the restored parameters
+            self.integrator.set_state(state["integrator"])
+            self.time = float(state["time"])
+        self.initial_energy = state["initial_energy"]
+        self.outputs = dict(state["outputs"])
 
     def _check_bounded(self, outputs: dict[str, float], t_end: float) -> None:
         """Raise :class:`SolverError` if the motion has blown up numerically.
@@ -151,17 +207,25 @@ class DoublePendulumCoSimulation:
         with too large a step); it is reported instead of returning meaningless numbers.
         """
         energy = outputs["E_total"]
-        p = self.params
-        limit = ENERGY_BLOWUP_FACTOR * (abs(self.initial_energy) + (p.m1 + p.m2) * p.g * (p.l1 + p.l2))
+        p = self.model.config.pendulum
+        e0 = self.initial_energy or 0.0
+        limit = ENERGY_BLOWUP_FACTOR * (abs(e0) + (p.m1 + p.m2) * p.g * (p.l1 + p.l2))
         if not all(math.isfinite(v) for v in outputs.values()) or abs(energy) > limit:
             raise SolverError(
                 f"numerical instability at t = {t_end:.6g} s: E_total = {energy:.6g} J, started at "
-                f"{self.initial_energy:.6g} J (solver {self.values['solver']}; reduce fixed_step or "
+                f"{e0:.6g} J (solver {self.values['solver']}; reduce fixed_step or "
                 "use an adaptive solver)"
             )
 
+    def _outputs_at(self, y: list[float]) -> dict[str, float]:
+        outputs = dict(zip(MODEL_OUTPUT_NAMES, output_values(self.model, y, self.initial_energy)))
+        it = self.integrator
+        outputs["solver_steps"] = float(it.n_steps) if it is not None else 0.0
+        outputs["solver_rhs_evaluations"] = float(it.nfev) if it is not None else 0.0
+        return outputs
+
     def _update_outputs(self, y: list[float]) -> None:
-        self.outputs = dict(zip(OUTPUT_NAMES, output_values(y, self.params)))
+        self.outputs = self._outputs_at(y)
 
 
 __all__ = [

@@ -134,6 +134,8 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH) -> Path:
             adapter_script(),
             dest=tmp_dir / f"{MODEL_IDENTIFIER}.fmu",
             project_files=[package_copy],
+            canGetAndSetFMUstate=True,
+            canSerializeFMUstate=True,
         )
         _rewrite_fmu(Path(built))
         shutil.move(str(built), fmu_path)

@@ -84,8 +84,74 @@ class PendulumParameters(_Validated):
 
 
 @dataclass(frozen=True)
+class AirDragParameters(_Validated):
+    """Quadratic air drag (seed eq. 23), F = -1/2 rho c_W A |v| v, on the bobs and optionally the rods.
+
+    Defaults: rho = 1.2 kg/m^3 and, for the rods, c_W = 2 are the seed's numbers (section 4.2.3).
+    The rods are the acrylic plates of section 3.1 moving broadside through the air: the upper
+    member is two plates 4 mm thick (frontal width 8 mm), the lower one plate 6 mm thick. The
+    report gives no bob geometry: each bob's frontal area defaults to the seed's example area
+    1.5e-3 m^2 (a 300 g steel cylinder of about 3 cm x 5 cm seen from the side) with c_W = 1
+    (a short cylinder in cross flow at Reynolds numbers of 1e3..1e4).
+    """
+
+    air_drag: bool = spec(False, "", "switch: quadratic air drag on the bobs", rule="bool")
+    rho_air: float = spec(1.2, "kg/m3", "density of air", rule="nonnegative")
+    cw: float = spec(1.0, "1", "drag coefficient of the bobs", rule="nonnegative")
+    A1: float = spec(1.5e-3, "m2", "frontal area of the upper bob", rule="nonnegative")
+    A2: float = spec(1.5e-3, "m2", "frontal area of the lower bob", rule="nonnegative")
+    rod_drag: bool = spec(False, "", "switch: also drag on the rods (needs air_drag)", rule="bool")
+    cw_rod: float = spec(2.0, "1", "drag coefficient of the rods (flat plates broadside)", rule="nonnegative")
+    d_rod1: float = spec(8e-3, "m", "frontal width of the upper rod (two 4 mm plates)", rule="nonnegative")
+    d_rod2: float = spec(6e-3, "m", "frontal width of the lower rod (one 6 mm plate)", rule="nonnegative")
+
+
+@dataclass(frozen=True)
+class BearingParameters(_Validated):
+    """Rolling friction in the ball bearings (seed eq. 24, F_R = c_R F_N) as a joint torque.
+
+    Torque magnitude c_R r_b |F_joint| with F_joint the reaction force the joint carries, opposing
+    the joint's relative angular velocity (pivot: omega1, elbow: omega2 - omega1); the sign
+    function is regularised as tanh(omega / omega_reg). Defaults: c_R = 1e-3 (the seed's range
+    0.5e-3 to 1e-3 for ball bearings), r_b = 4 mm (the bore radius of a 608 bearing).
+    An optional viscous torque b_v * omega per joint adds to it.
+    """
+
+    bearing_friction: bool = spec(False, "", "switch: rolling friction in both bearings", rule="bool")
+    c_R1: float = spec(1e-3, "1", "rolling friction coefficient of the pivot bearing", rule="nonnegative")
+    c_R2: float = spec(1e-3, "1", "rolling friction coefficient of the elbow bearing", rule="nonnegative")
+    r_b1: float = spec(4e-3, "m", "friction radius of the pivot bearing", rule="nonnegative")
+    r_b2: float = spec(4e-3, "m", "friction radius of the elbow bearing", rule="nonnegative")
+    omega_reg: float = spec(
+        1e-3, "rad/s", "regularisation speed of the friction sign function", rule="positive"
+    )
+    b_v1: float = spec(0.0, "N.m.s/rad", "viscous friction of the pivot bearing", rule="nonnegative")
+    b_v2: float = spec(0.0, "N.m.s/rad", "viscous friction of the elbow bearing", rule="nonnegative")
+
+
+@dataclass(frozen=True)
+class SuspensionParameters(_Validated):
+    """Damped suspension carrying the pivot (seed 2.4.3): mass M_s on springs and dampers.
+
+    The pivot coordinates xs, ys are displacements from the static equilibrium (the spring
+    preload carries the weight of everything). The seed gives no numbers: the defaults are an
+    illustrative stiff table mount; ``suspension_transfer`` identifies values from the measured
+    energy decay.
+    """
+
+    suspension: bool = spec(False, "", "switch: the pivot sits on a damped suspension", rule="bool")
+    suspension_x: bool = spec(True, "", "suspension moves horizontally (with suspension on)", rule="bool")
+    suspension_y: bool = spec(True, "", "suspension moves vertically (with suspension on)", rule="bool")
+    M_s: float = spec(2.0, "kg", "mass of the suspension (moving with the pivot)", rule="positive")
+    k_x: float = spec(2e4, "N/m", "horizontal spring stiffness of the suspension", rule="nonnegative")
+    k_y: float = spec(2e4, "N/m", "vertical spring stiffness of the suspension", rule="nonnegative")
+    c_x: float = spec(20.0, "N.s/m", "horizontal damping of the suspension", rule="nonnegative")
+    c_y: float = spec(20.0, "N.s/m", "vertical damping of the suspension", rule="nonnegative")
+
+
+@dataclass(frozen=True)
 class InitialState(_Validated):
-    """Start values of the generalised coordinates and their rates."""
+    """Start values of the rod angles and their rates (the suspension starts at rest)."""
 
     phi1_0: float = spec(1.0, "rad", "initial angle of the upper rod from the downward vertical")
     phi2_0: float = spec(1.0, "rad", "initial angle of the lower rod from the downward vertical")

@@ -72,3 +72,301 @@ def plot_phase_portraits(runs: Mapping[str, np.ndarray], path: str | Path) -> Pa
             ax.set(title=f"{label}: rod {k}", xlabel=f"phi{k} [rad] (wrapped)", ylabel=f"omega{k} [rad/s]")
             ax.grid(alpha=0.3)
     return _save(fig, path)
+
+
+def plot_energy_decay(
+    t: np.ndarray,
+    energy: np.ndarray,
+    sigma: np.ndarray,
+    curves: Mapping[str, np.ndarray],
+    t_curve: np.ndarray,
+    path: str | Path,
+    *,
+    used: np.ndarray | None = None,
+    residual_curve: str | None = None,
+) -> Path:
+    """Measured energy [J] with error bars over time [s] and fitted decay curves (the seed's fig. 7).
+
+    ``curves`` maps a label to the curve's values on ``t_curve``; frames with ``used`` false are
+    drawn grey (not fitted). With ``residual_curve`` a lower panel shows (E - curve) / sigma.
+    """
+    used = np.isfinite(energy) if used is None else used & np.isfinite(energy)
+    rows = 2 if residual_curve else 1
+    fig, axes = plt.subplots(rows, 1, figsize=(10, 4 + 2.5 * (rows - 1)), squeeze=False, sharex=True)
+    ax = axes[0, 0]
+    ax.errorbar(t[used], energy[used], yerr=sigma[used], fmt=".", ms=2, lw=0.5, alpha=0.6, label="measured")
+    skip = ~used & np.isfinite(energy)
+    if skip.any():
+        ax.plot(t[skip], energy[skip], "x", color="0.5", ms=4, label="not fitted")
+    for label, values in curves.items():
+        ax.plot(t_curve, values, lw=1.5, label=label)
+    ax.set(ylabel="E [J]", title="energy of the measured pendulum")
+    ax.legend(loc="upper right", fontsize=8)
+    ax.grid(alpha=0.3)
+    if residual_curve:
+        ax_r = axes[1, 0]
+        model = np.interp(t[used], t_curve, curves[residual_curve])
+        ax_r.plot(t[used], (energy[used] - model) / sigma[used], ".", ms=2)
+        ax_r.axhline(0.0, color="k", lw=0.8)
+        ax_r.set(ylabel=f"(E - {residual_curve}) / sigma", title="normalised residuals")
+        ax_r.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("t [s]")
+    return _save(fig, path)
+
+
+def plot_circle_fit(
+    x1: np.ndarray,
+    y1: np.ndarray,
+    x2: np.ndarray,
+    y2: np.ndarray,
+    t: np.ndarray,
+    l1: float,
+    l2: float,
+    path: str | Path,
+    *,
+    valid: np.ndarray | None = None,
+) -> Path:
+    """Track in pivot coordinates [m] with the fitted circle, and the rod-length residuals [mm] over time [s].
+
+    Positions are relative to the fitted pivot; flagged frames (``valid`` false) are marked red.
+    """
+    valid = np.ones(len(t), dtype=bool) if valid is None else valid
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5), gridspec_kw={"width_ratios": [1, 1.4, 1.4]})
+    ax = axes[0]
+    phi = np.arctan2(x1[valid], -y1[valid])
+    ang = np.linspace(phi.min() - 0.3, phi.max() + 0.3, 200)
+    ax.plot(x2[valid], y2[valid], ".", ms=1.5, alpha=0.5, label="lower bob")
+    ax.plot(x1[valid], y1[valid], ".", ms=1.5, label="upper bob")
+    ax.plot(l1 * np.sin(ang), -l1 * np.cos(ang), "k-", lw=0.6, label=f"fit, l1 = {1e3 * l1:.1f} mm")
+    ax.plot(x1[~valid], y1[~valid], "rx", ms=5, label="flagged")
+    ax.plot([0.0], [0.0], "k+", ms=10, label="fitted pivot")
+    ax.set(xlabel="x [m]", ylabel="y [m]", aspect="equal", title="track relative to the fitted pivot")
+    ax.legend(loc="upper center", fontsize=7, ncols=2)
+    ax.grid(alpha=0.3)
+    for ax, r, length, name in (
+        (axes[1], np.hypot(x1, y1), l1, "r1 - l1 (upper bob to pivot)"),
+        (axes[2], np.hypot(x2 - x1, y2 - y1), l2, "|r2 - r1| - l2 (between the bobs)"),
+    ):
+        ax.plot(t[valid], 1e3 * (r[valid] - length), ".", ms=2)
+        ax.plot(t[~valid], 1e3 * (r[~valid] - length), "rx", ms=5)
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set(xlabel="t [s]", ylabel="residual [mm]", title=name)
+        ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def plot_energy_per_mechanism(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
+    """E_total [J] over time [s] for each run, log scale (straight lines mean exponential decay)."""
+    fig, ax = plt.subplots(figsize=(9, 5))
+    for label, r in runs.items():
+        ax.semilogy(r["time"], r["E_total"], label=label)
+    ax.set(xlabel="t [s]", ylabel="E_total [J]", title="Energy of the pendulum and its suspension")
+    ax.legend()
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_energy_budget_stacked(result: np.ndarray, path: str | Path) -> Path:
+    """Where the energy went: stacked E_pendulum, E_suspension and each W_* [J] over time [s]."""
+    names = ("E_pendulum", "E_suspension", "W_air", "W_bearing", "W_suspension")
+    fig, ax = plt.subplots(figsize=(9, 5))
+    ax.stackplot(result["time"], *(result[n] for n in names), labels=names, alpha=0.85)
+    ax.axhline(result["E_total"][0], color="k", lw=0.8, ls="--", label="E_total(0)")
+    ax.set(xlabel="t [s]", ylabel="energy [J]", title="Energy budget, all mechanisms on")
+    ax.legend(loc="lower left", fontsize=8)
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+# ---------------------------------------------------------------------------- chaos (issue 7)
+def plot_lower_mass_traces(
+    traces: Mapping[str, tuple[np.ndarray, np.ndarray]],
+    path: str | Path,
+    *,
+    diverge: tuple[float, float] | None = None,
+    title: str = "",
+) -> Path:
+    """Traces of the lower bob (x2, y2) [m], one panel per run and all overlaid (seed figs. 4-6).
+
+    ``diverge`` marks the point (x2, y2) [m] where the runs part (the seed's red arrow).
+    """
+    n = len(traces)
+    fig, axes = plt.subplots(1, n + 1, figsize=(4.2 * (n + 1), 4.4), squeeze=False)
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for i, (label, (x, y)) in enumerate(traces.items()):
+        for ax in (axes[0, i], axes[0, n]):
+            ax.plot(x, y, lw=0.7, color=colours[i % len(colours)], label=label)
+    for ax in axes[0]:
+        ax.plot([0], [0], "k+", ms=10)
+        if diverge is not None:
+            ax.annotate(
+                "",
+                xy=diverge,
+                xytext=(diverge[0] + 0.08, diverge[1] + 0.08),
+                arrowprops={"color": "red", "width": 1.5, "headwidth": 7},
+            )
+        ax.set(xlabel="x2 [m]", ylabel="y2 [m]", aspect="equal")
+        ax.grid(alpha=0.3)
+    for i, label in enumerate(traces):
+        axes[0, i].set_title(label)
+    axes[0, n].set_title("overlaid")
+    axes[0, n].legend(loc="lower right", fontsize=7)
+    if title:
+        fig.suptitle(title)
+    return _save(fig, path)
+
+
+def plot_ensemble_clouds(
+    snapshots: Mapping[float, tuple[np.ndarray, np.ndarray]], path: str | Path, *, title: str = ""
+) -> Path:
+    """Positions of the lower bob [m] of every ensemble member at a few times: the cloud spreading."""
+    n = len(snapshots)
+    fig, axes = plt.subplots(1, n, figsize=(3.2 * n, 3.6), squeeze=False, sharex=True, sharey=True)
+    for ax, (t, (x, y)) in zip(axes[0], snapshots.items()):
+        ax.plot(x, y, ".", ms=2, alpha=0.6)
+        ax.plot([0], [0], "k+", ms=8)
+        ax.set(title=f"t = {t:g} s", xlabel="x2 [m]", aspect="equal")
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel("y2 [m]")
+    if title:
+        fig.suptitle(title)
+    return _save(fig, path)
+
+
+def plot_ensemble_spread(
+    times: np.ndarray, spreads: Mapping[str, np.ndarray], thresholds: list[float] | tuple[float, ...], path: str | Path
+) -> Path:
+    """RMS spread [m] of the lower bob's position within each ensemble over time (log scale)."""
+    fig, ax = plt.subplots(figsize=(9, 5))
+    for label, s in spreads.items():
+        ax.semilogy(times, np.maximum(s, 1e-12), lw=1.0, label=label)
+    for d in thresholds:
+        ax.axhline(d, color="k", ls="--", lw=0.8)
+        ax.text(times[-1], d, f" {d * 100:g} cm", va="bottom", ha="right", fontsize=8)
+    ax.set(xlabel="t [s]", ylabel="spread of the lower bob [m]", title="ensemble spread (start uncertainty sigma)")
+    ax.legend(fontsize=7, ncol=2, loc="lower right")
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_predictability(
+    sigmas: np.ndarray, horizons: Mapping[str, np.ndarray], lyapunov: float, path: str | Path
+) -> Path:
+    """Predictability horizon [s] against the start uncertainty [m], with the slope -1/lambda."""
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for label, hz in horizons.items():
+        line = ax.semilogx(sigmas, hz, "o-", label=label)[0]
+        ok = np.isfinite(hz)
+        if np.count_nonzero(ok) >= 2 and lyapunov > 0:
+            anchor = np.argmax(ok)
+            guide = hz[anchor] - np.log(sigmas / sigmas[anchor]) / lyapunov
+            ax.semilogx(sigmas, guide, ":", color=line.get_color(), lw=1)
+    ax.set(
+        xlabel="start uncertainty sigma [m]",
+        ylabel="predictability horizon [s]",
+        title=f"horizon vs uncertainty; dotted: slope -1/lambda, lambda = {lyapunov:.2f} 1/s",
+    )
+    ax.legend()
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_lyapunov_convergence(
+    curves: Mapping[str, tuple[np.ndarray, np.ndarray]], path: str | Path, *, title: str = ""
+) -> Path:
+    """Running Benettin estimates lambda(t) [1/s] against the averaging time t [s]."""
+    fig, ax = plt.subplots(figsize=(8, 5))
+    for label, (t, lam) in curves.items():
+        ax.semilogx(t, lam, lw=1.0, label=label)
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set(xlabel="averaging time t [s]", ylabel="lambda(t) [1/s]", title=title or "convergence of lambda")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_lyapunov_vs_energy(
+    theta0: np.ndarray, energy_ratio: np.ndarray, lam: np.ndarray, path: str | Path
+) -> Path:
+    """Largest exponent [1/s] against the release angle theta0 [rad] (phi1 = phi2 = theta0, at rest)."""
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    ax1.plot(theta0, lam, "o-")
+    ax1.set(xlabel="theta0 [rad]", ylabel="lambda [1/s]", title="largest Lyapunov exponent, release from rest")
+    ax2.plot(energy_ratio, lam, "o-")
+    ax2.axvline(1.0, color="r", ls="--", lw=0.8, label="E = E_flip (a rod can flip)")
+    ax2.set(xlabel="E / E_flip", ylabel="lambda [1/s]", title="against energy")
+    ax2.legend(fontsize=8)
+    for ax in (ax1, ax2):
+        ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def plot_lyapunov_spectrum(
+    times: np.ndarray, running: np.ndarray, bound: np.ndarray, path: str | Path
+) -> Path:
+    """Running estimates of all four exponents [1/s] and of their sum, with the sum's bound."""
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    for i in range(running.shape[1]):
+        ax1.semilogx(times, running[:, i], label=f"lambda{i + 1}")
+    ax1.axhline(0.0, color="k", lw=0.6)
+    ax1.set(xlabel="t [s]", ylabel="[1/s]", title="Lyapunov spectrum (QR)")
+    ax1.legend(fontsize=8)
+    ax2.loglog(times, np.abs(running.sum(axis=1)), label="|sum of the exponents|")
+    ax2.loglog(times, np.abs(running[:, 0] + running[:, -1]), label="|lambda1 + lambda4|")
+    ax2.loglog(times, bound, "k--", label="bound ln((m1+m2)/m1) / t")
+    ax2.set(xlabel="t [s]", ylabel="[1/s]", title="pairing (lambda, 0, 0, -lambda)")
+    ax2.legend(fontsize=8)
+    for ax in (ax1, ax2):
+        ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_flip_map(
+    phi1: np.ndarray,
+    phi2: np.ndarray,
+    flip_time: np.ndarray,
+    energy: np.ndarray,
+    threshold: float,
+    path: str | Path,
+    *,
+    t_max: float,
+) -> Path:
+    """Time to the first flip [s] over the release angles (log colour), no flip in white.
+
+    The black curve is V(phi1, phi2) = E_flip: inside it flipping is energetically impossible.
+    """
+    fig, ax = plt.subplots(figsize=(7.5, 6.5))
+    extent = (phi1[0], phi1[-1], phi2[0], phi2[-1])
+    masked = np.ma.masked_invalid(flip_time)
+    image = ax.imshow(
+        masked,
+        origin="lower",
+        extent=extent,
+        cmap="viridis",
+        norm=matplotlib.colors.LogNorm(vmin=max(np.nanmin(flip_time), 1e-2), vmax=t_max),
+        interpolation="nearest",
+        aspect="equal",
+    )
+    ax.contour(phi1, phi2, energy, levels=[threshold], colors="k", linewidths=1.2)
+    ax.contourf(phi1, phi2, energy, levels=[energy.min() - 1.0, threshold], colors="none", hatches=["//"])
+    fig.colorbar(image, ax=ax, label="time to the first flip [s]")
+    ax.set(
+        xlabel="phi1 at release [rad]",
+        ylabel="phi2 at release [rad]",
+        title=f"flip-time map (white: no flip in {t_max:g} s; hatched: E < E_flip)",
+    )
+    return _save(fig, path)
+
+
+def plot_poincare_sections(
+    sections: Mapping[str, tuple[np.ndarray, np.ndarray, np.ndarray]], path: str | Path
+) -> Path:
+    """Poincare sections phi1 = 0, omega1 > 0: points (phi2 [rad], omega2 [rad/s]) per start."""
+    n = len(sections)
+    fig, axes = plt.subplots(1, n, figsize=(6 * n, 5), squeeze=False)
+    for ax, (label, (phi2, omega2, owner)) in zip(axes[0], sections.items()):
+        wrapped = np.angle(np.exp(1j * phi2))
+        ax.scatter(wrapped, omega2, c=owner, s=0.6, cmap="tab20", linewidths=0)
+        ax.set(title=label, xlabel="phi2 [rad] (wrapped)", ylabel="omega2 [rad/s]")
+        ax.grid(alpha=0.3)
+    return _save(fig, path)

@@ -1,0 +1,314 @@
+r"""The assembled model: which states exist, the vector field, and every output quantity.
+
+A scene switches mechanisms on or off (:class:`ModelConfig`); :func:`build_model` then builds a
+state vector with only the states the scene needs and a vector field with only the enabled terms.
+With every mechanism off the vector field *is* the frictionless core
+(:func:`double_pendulum.dynamics.fixed_pivot_vector_field`), so results are bit-identical.
+
+State vector: ``[phi1, phi2, omega1, omega2]``, then ``[xs, vxs]`` if the suspension moves
+horizontally, ``[ys, vys]`` if it moves vertically, then the dissipated work ``W_air``,
+``W_bearing``, ``W_suspension`` [J] of each enabled mechanism (integrated powers, so the energy
+budget closes to the integration tolerance).
+
+Equations with the suspension (pivot displaced by ``(xs, ys)`` from its static equilibrium,
+:math:`M_t = M_s + m_1 + m_2`), from the Lagrangian with the pivot coordinates added
+(:math:`T = \tfrac12 M_s |\dot{\vec s}|^2 + \tfrac12 m_1 |\vec v_1|^2 + \tfrac12 m_2 |\vec v_2|^2`,
+:math:`V` = pendulum potential relative to the pivot + :math:`\tfrac12 k_x x_s^2 + \tfrac12 k_y y_s^2`):
+
+.. math::
+
+    \begin{pmatrix} M_{11} & M_{12} & A_{1x} & A_{1y}\\ M_{12} & M_{22} & A_{2x} & A_{2y}\\
+    A_{1x} & A_{2x} & M_t & 0\\ A_{1y} & A_{2y} & 0 & M_t \end{pmatrix}
+    \begin{pmatrix}\ddot\varphi_1\\ \ddot\varphi_2\\ \ddot x_s\\ \ddot y_s\end{pmatrix} =
+    \begin{pmatrix} b_1\\ b_2\\
+    (m_1+m_2) l_1 s_1\omega_1^2 + m_2 l_2 s_2 \omega_2^2 - k_x x_s - c_x \dot x_s + Q_x\\
+    -(m_1+m_2) l_1 c_1\omega_1^2 - m_2 l_2 c_2 \omega_2^2 - k_y y_s - c_y \dot y_s + Q_y \end{pmatrix}
+
+with :math:`A_{1x} = (m_1+m_2) l_1 \cos\varphi_1`, :math:`A_{1y} = (m_1+m_2) l_1 \sin\varphi_1`,
+:math:`A_{2x} = m_2 l_2 \cos\varphi_2`, :math:`A_{2y} = m_2 l_2 \sin\varphi_2`, and :math:`M_{ij}, b_i` as in
+:mod:`double_pendulum.dynamics` (including the generalised forces :math:`Q_1, Q_2`). The pivot rows
+are eliminated (Schur complement) and the remaining 2x2 system solved in closed form.
+
+Bearing friction torques depend on the joint reaction forces, which depend on the accelerations:
+the coupled system is solved by fixed-point iteration (the map contracts by about
+:math:`c_R r_b / l`, ~1e-5 here, so two or three iterations reach rounding level).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+from .dynamics import fixed_pivot_vector_field
+from .energy import kinetic_energy_moving_pivot, potential_energy, suspension_energy
+from .forces import bearing_torque, quadratic_drag, rod_drag_integrals
+from .parameters import AirDragParameters, BearingParameters, PendulumParameters, SuspensionParameters
+
+MAX_FRICTION_ITERATIONS = 50
+
+
+class ModelError(RuntimeError):
+    """The model equations cannot be evaluated (e.g. the friction iteration does not converge)."""
+
+
+@dataclass(frozen=True)
+class ModelConfig:
+    """All parameters of a scene: the pendulum and each (switchable) mechanism."""
+
+    pendulum: PendulumParameters = field(default_factory=PendulumParameters)
+    air: AirDragParameters = field(default_factory=AirDragParameters)
+    bearing: BearingParameters = field(default_factory=BearingParameters)
+    suspension: SuspensionParameters = field(default_factory=SuspensionParameters)
+
+
+@dataclass(frozen=True)
+class StateLayout:
+    """Which states exist and where they sit in the state vector."""
+
+    names: tuple[str, ...]
+
+    def index(self, name: str) -> int | None:
+        """Position of state ``name``, or ``None`` if the scene does not have it."""
+        return self.names.index(name) if name in self.names else None
+
+    @property
+    def size(self) -> int:
+        return len(self.names)
+
+
+def state_layout(config: ModelConfig) -> StateLayout:
+    """Return the states needed by ``config`` (see the module docstring for the order)."""
+    s = config.suspension
+    names = ["phi1", "phi2", "omega1", "omega2"]
+    if s.suspension and s.suspension_x:
+        names += ["xs", "vxs"]
+    if s.suspension and s.suspension_y:
+        names += ["ys", "vys"]
+    if config.air.air_drag:
+        names.append("W_air")
+    if config.bearing.bearing_friction:
+        names.append("W_bearing")
+    if s.suspension:
+        names.append("W_suspension")
+    return StateLayout(tuple(names))
+
+
+class Evaluation(NamedTuple):
+    """Everything the equations produce at one state (units: SI)."""
+
+    dydt: list[float]
+    alpha1: float  # rad/s^2
+    alpha2: float  # rad/s^2
+    axs: float  # m/s^2
+    ays: float  # m/s^2
+    f_pivot_x: float  # N, force the pendulum exerts on its pivot (with the static weight)
+    f_pivot_y: float  # N
+    p_air: float  # W
+    p_bearing: float  # W
+    p_suspension: float  # W, dissipated in the suspension dampers
+
+
+def is_core(config: ModelConfig) -> bool:
+    """True if every mechanism is off: the scene is the frictionless fixed-pivot pendulum."""
+    return not (config.air.air_drag or config.bearing.bearing_friction or config.suspension.suspension)
+
+
+def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
+    """Return ``evaluate(y) -> Evaluation`` with only the enabled terms (general path)."""
+    p, air, brg, sus = config.pendulum, config.air, config.bearing, config.suspension
+    layout = state_layout(config)
+    m1, m2, l1, l2, g = p.m1, p.m2, p.l1, p.l2, p.g
+    m12 = m1 + m2
+    ix, iy = layout.index("xs"), layout.index("ys")
+    has_x, has_y = ix is not None, iy is not None
+    has_air = air.air_drag
+    has_rods = air.air_drag and air.rod_drag
+    has_bearing = brg.bearing_friction
+    k_bob1 = 0.5 * air.rho_air * air.cw * air.A1
+    k_bob2 = 0.5 * air.rho_air * air.cw * air.A2
+    kappa1 = 0.5 * air.rho_air * air.cw_rod * air.d_rod1
+    kappa2 = 0.5 * air.rho_air * air.cw_rod * air.d_rod2
+    m_t = sus.M_s + m12
+    k_x, k_y, c_x, c_y = sus.k_x, sus.k_y, sus.c_x, sus.c_y
+    n = layout.size
+    work_slots = [layout.index(name) for name in ("W_air", "W_bearing", "W_suspension")]
+    sin, cos, torque = math.sin, math.cos, bearing_torque
+    torque_scale_p = brg.c_R1 * brg.r_b1 * m12 * g + 1e-300
+    torque_scale_e = brg.c_R2 * brg.r_b2 * m2 * g + 1e-300
+
+    def evaluate(y: list[float]) -> Evaluation:
+        phi1, phi2, w1, w2 = y[0], y[1], y[2], y[3]
+        xs, vxs = (y[ix], y[ix + 1]) if has_x else (0.0, 0.0)
+        ys, vys = (y[iy], y[iy + 1]) if has_y else (0.0, 0.0)
+        s1, c1, s2, c2 = sin(phi1), cos(phi1), sin(phi2), cos(phi2)
+        sd, cd = sin(phi1 - phi2), cos(phi1 - phi2)
+        # absolute bob velocities
+        v1x = vxs + l1 * c1 * w1
+        v1y = vys + l1 * s1 * w1
+        v2x = v1x + l2 * c2 * w2
+        v2y = v1y + l2 * s2 * w2
+
+        # external (air) forces: generalised forces q1, q2, qx, qy and the total force on the pendulum
+        q1 = q2 = qx = qy = 0.0
+        fext_x = fext_y = f2x = f2y = 0.0
+        p_air = 0.0
+        if has_air:
+            f1x, f1y, p1 = quadratic_drag(v1x, v1y, k_bob1)
+            f2x, f2y, p2 = quadratic_drag(v2x, v2y, k_bob2)
+            fext_x, fext_y, p_air = f1x + f2x, f1y + f2y, p1 + p2
+            q1 = l1 * (c1 * fext_x + s1 * fext_y)
+            q2 = l2 * (c2 * f2x + s2 * f2y)
+            qx, qy = fext_x, fext_y
+            if has_rods:
+                # rod 1: normal n1 = (c1, s1), v_n = vs.n1 + s w1
+                i0, i1, i3 = rod_drag_integrals(vxs * c1 + vys * s1, w1, l1)
+                q1 -= kappa1 * i1
+                qx -= kappa1 * i0 * c1
+                qy -= kappa1 * i0 * s1
+                fext_x -= kappa1 * i0 * c1
+                fext_y -= kappa1 * i0 * s1
+                p_air += kappa1 * i3
+                # rod 2: normal n2 = (c2, s2), v_n = v1.n2 + s w2; dr/dphi1 . n2 = l1 cos(phi1 - phi2)
+                i0, i1, i3 = rod_drag_integrals(v1x * c2 + v1y * s2, w2, l2)
+                q1 -= kappa2 * i0 * l1 * cd
+                q2 -= kappa2 * i1
+                qx -= kappa2 * i0 * c2
+                qy -= kappa2 * i0 * s2
+                fext_x -= kappa2 * i0 * c2
+                fext_y -= kappa2 * i0 * s2
+                p_air += kappa2 * i3
+
+        # mass matrix and right-hand side of the angle equations
+        a11 = m12 * l1 * l1
+        a12 = m2 * l1 * l2 * cd
+        a22 = m2 * l2 * l2
+        b1 = -m2 * l1 * l2 * w2 * w2 * sd - m12 * g * l1 * s1 + q1
+        b2 = m2 * l1 * l2 * w1 * w1 * sd - m2 * g * l2 * s2 + q2
+        # eliminate the pivot coordinates (Schur complement)
+        bx = by = 0.0
+        ax1 = ax2 = ay1 = ay2 = 0.0
+        if has_x:
+            ax1, ax2 = m12 * l1 * c1, m2 * l2 * c2
+            bx = m12 * l1 * s1 * w1 * w1 + m2 * l2 * s2 * w2 * w2 - k_x * xs - c_x * vxs + qx
+            a11 -= ax1 * ax1 / m_t
+            a12 -= ax1 * ax2 / m_t
+            a22 -= ax2 * ax2 / m_t
+            b1 -= ax1 * bx / m_t
+            b2 -= ax2 * bx / m_t
+        if has_y:
+            ay1, ay2 = m12 * l1 * s1, m2 * l2 * s2
+            by = -m12 * l1 * c1 * w1 * w1 - m2 * l2 * c2 * w2 * w2 - k_y * ys - c_y * vys + qy
+            a11 -= ay1 * ay1 / m_t
+            a12 -= ay1 * ay2 / m_t
+            a22 -= ay2 * ay2 / m_t
+            b1 -= ay1 * by / m_t
+            b2 -= ay2 * by / m_t
+        det = a11 * a22 - a12 * a12
+
+        tau_p = tau_e = 0.0  # bearing torques, positive along omega1 and omega2 - omega1
+        for _ in range(MAX_FRICTION_ITERATIONS):
+            e1 = b1 - tau_p + tau_e
+            e2 = b2 - tau_e
+            alpha1 = (e1 * a22 - a12 * e2) / det
+            alpha2 = (a11 * e2 - a12 * e1) / det
+            axs = (bx - ax1 * alpha1 - ax2 * alpha2) / m_t if has_x else 0.0
+            ays = (by - ay1 * alpha1 - ay2 * alpha2) / m_t if has_y else 0.0
+            # bob accelerations and the reaction forces the joints carry
+            acc1x = axs + l1 * (c1 * alpha1 - s1 * w1 * w1)
+            acc1y = ays + l1 * (s1 * alpha1 + c1 * w1 * w1)
+            acc2x = acc1x + l2 * (c2 * alpha2 - s2 * w2 * w2)
+            acc2y = acc1y + l2 * (s2 * alpha2 + c2 * w2 * w2)
+            # force of the pivot on the pendulum: sum m a - gravity - external forces
+            fp_x = m1 * acc1x + m2 * acc2x - fext_x
+            fp_y = m1 * acc1y + m2 * acc2y + m12 * g - fext_y
+            if not has_bearing:
+                break
+            # force of the elbow on the lower bob (the small drag share of rod 2 is neglected)
+            fe_x = m2 * acc2x - f2x
+            fe_y = m2 * acc2y + m2 * g - f2y
+            new_p = torque(math.hypot(fp_x, fp_y), w1, brg.c_R1, brg.r_b1, brg.omega_reg, brg.b_v1)
+            new_e = torque(math.hypot(fe_x, fe_y), w2 - w1, brg.c_R2, brg.r_b2, brg.omega_reg, brg.b_v2)
+            # Converged to rounding level of the torque scale c_R r_b (m1 + m2) g: near-zero loads carry
+            # cancellation noise, so a purely relative test could cycle between neighbouring floats.
+            converged = abs(new_p - tau_p) <= 1e-12 * (abs(new_p) + torque_scale_p) and abs(
+                new_e - tau_e
+            ) <= (1e-12 * (abs(new_e) + torque_scale_e))
+            tau_p, tau_e = new_p, new_e
+            if converged:
+                break
+        else:
+            raise ModelError(
+                "bearing friction: the joint-load iteration did not converge; c_R * r_b is too large "
+                f"for rods of l1 = {l1} m, l2 = {l2} m"
+            )
+
+        p_bearing = tau_p * w1 + tau_e * (w2 - w1) if has_bearing else 0.0
+        p_susp = c_x * vxs * vxs + c_y * vys * vys
+        dydt = [0.0] * n
+        dydt[0], dydt[1], dydt[2], dydt[3] = w1, w2, alpha1, alpha2
+        if has_x:
+            dydt[ix], dydt[ix + 1] = vxs, axs
+        if has_y:
+            dydt[iy], dydt[iy + 1] = vys, ays
+        for slot, power in zip(work_slots, (p_air, p_bearing, p_susp)):
+            if slot is not None:
+                dydt[slot] = power
+        return Evaluation(dydt, alpha1, alpha2, axs, ays, -fp_x, -fp_y, p_air, p_bearing, p_susp)
+
+    return evaluate
+
+
+def build_vector_field(config: ModelConfig) -> Callable[[float, list[float]], list[float]]:
+    """Return ``f(t, y) -> dy/dt`` for the states of :func:`state_layout` (only enabled terms)."""
+    if is_core(config):
+        return fixed_pivot_vector_field(config.pendulum)
+    evaluate = build_evaluator(config)
+
+    def vector_field(t: float, y: list[float]) -> list[float]:
+        return evaluate(y).dydt
+
+    return vector_field
+
+
+def initial_state(config: ModelConfig, phi1: float, phi2: float, omega1: float, omega2: float) -> list[float]:
+    """Return the start vector: given angles and rates, suspension at rest at equilibrium, no work done."""
+    y = [phi1, phi2, omega1, omega2]
+    return y + [0.0] * (state_layout(config).size - 4)
+
+
+def energies(config: ModelConfig, y: list[float]) -> tuple[float, float, float]:
+    """Return ``(E_kin, E_pot, E_suspension)`` [J] of state ``y``.
+
+    ``E_kin``: both bobs, absolute velocities; ``E_pot``: pendulum potential relative to the pivot,
+    zero hanging at rest; ``E_suspension``: see :func:`double_pendulum.energy.suspension_energy`.
+    """
+    layout = state_layout(config)
+    ix, iy = layout.index("xs"), layout.index("ys")
+    xs, vxs = (y[ix], y[ix + 1]) if ix is not None else (0.0, 0.0)
+    ys, vys = (y[iy], y[iy + 1]) if iy is not None else (0.0, 0.0)
+    p, s = config.pendulum, config.suspension
+    e_kin = kinetic_energy_moving_pivot(y[0], y[1], y[2], y[3], vxs, vys, p)
+    e_pot = potential_energy(y[0], y[1], p)
+    e_sus = suspension_energy(xs, ys, vxs, vys, s.M_s, s.k_x, s.k_y) if s.suspension else 0.0
+    return e_kin, e_pot, e_sus
+
+
+@dataclass(frozen=True)
+class Model:
+    """A built scene: its configuration, state layout, vector field and full evaluator."""
+
+    config: ModelConfig
+    layout: StateLayout
+    vector_field: Callable[[float, list[float]], list[float]]
+    evaluate: Callable[[list[float]], Evaluation]
+
+    def initial_state(self, phi1: float, phi2: float, omega1: float, omega2: float) -> list[float]:
+        """Start vector for the given angles [rad] and rates [rad/s]."""
+        return initial_state(self.config, phi1, phi2, omega1, omega2)
+
+
+def build_model(config: ModelConfig) -> Model:
+    """Build the scene ``config``: only the enabled mechanisms are integrated and evaluated."""
+    return Model(config, state_layout(config), build_vector_field(config), build_evaluator(config))
