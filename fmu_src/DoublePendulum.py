@@ -63,7 +63,7 @@ class DoublePendulum(Fmi2Slave):
                 variability=Fmi2Variability.fixed,
                 description=var.description,
                 getter=lambda: self._sim.get(name),
-                setter=lambda value: self._sim.set(name, value),
+                setter=lambda value: self._guarded(self._sim.set, name, value),
             )
         else:
             variable = Real(
@@ -78,8 +78,23 @@ class DoublePendulum(Fmi2Slave):
     def setup_experiment(self, start_time, stop_time=None, tolerance=None):
         self._sim.set_start_time(start_time)
 
+    def _guarded(self, call, *args):
+        """Run ``call``; on error also print the message to stderr, then re-raise.
+
+        pythonfmu turns the exception into fmi2Fatal and passes its message to the host's logger
+        only when logging is on; stderr makes it visible to a user with logging off too.
+        """
+        try:
+            return call(*args)
+        except Exception as error:
+            self._report(error)
+            raise
+
+    def _report(self, error) -> None:
+        print(f"[{self.instance_name}] DoublePendulum: {error}", file=sys.stderr, flush=True)
+
     def exit_initialization_mode(self):
-        self._sim.initialise()
+        self._guarded(self._sim.initialise)
 
     # FMU state (fmi2Get/SetFMUstate, fmi2(De)SerializeFMUstate): the co-simulation's complete
     # state, including the integrator's hidden state, as JSON-serialisable data.
@@ -94,5 +109,6 @@ class DoublePendulum(Fmi2Slave):
             self._sim.do_step(current_time, step_size)
         except (_cosim.SolverError, _cosim.CoSimulationError) as error:
             self.log(f"doStep failed: {error}", Fmi2Status.error)
+            self._report(error)
             return False
         return True

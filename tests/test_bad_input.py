@@ -1,0 +1,131 @@
+"""Bad input through the FMU: an error status naming the variable and value, never a crash or hang."""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import textwrap
+from dataclasses import fields
+
+import pytest
+
+from double_pendulum.cosimulation import PARAMETER_GROUPS
+from double_pendulum.runner import FmuRunError
+
+INVALID_VALUES = {
+    "positive": [-1.0, 0.0, math.nan, math.inf, -math.inf],
+    "nonnegative": [-1.0, -1e-300, math.nan, math.inf],
+    "finite": [math.nan, math.inf, -math.inf],
+}
+
+
+def _bad_real_inputs() -> list[tuple[str, float]]:
+    cases = []
+    for group in PARAMETER_GROUPS:
+        for f in fields(group):
+            cases += [(f.name, v) for v in INVALID_VALUES.get(f.metadata["rule"], [])]
+    return cases
+
+
+BAD_REAL_INPUTS = _bad_real_inputs()
+
+
+def test_every_real_parameter_has_invalid_values_to_try():
+    names = {name for name, _ in BAD_REAL_INPUTS}
+    assert {"m1", "l2", "g", "phi1_0", "omega2_0", "rtol", "atol", "fixed_step", "k_x", "M_s", "omega_reg"} <= names
+    assert len(BAD_REAL_INPUTS) > 100
+
+
+@pytest.mark.parametrize(("name", "value"), BAD_REAL_INPUTS, ids=[f"{n}={v}" for n, v in BAD_REAL_INPUTS])
+def test_invalid_real_parameter_is_an_error_naming_variable_and_value(runner, name, value):
+    with pytest.raises(FmuRunError, match="failed with status") as info:
+        runner.simulate({name: value}, stop_time=0.1)
+    assert f"invalid {name} = {value!r}" in str(info.value)
+
+
+@pytest.mark.parametrize("solver", ["", "RK4", "dop 853", "radau"])
+def test_unknown_solver_names_are_errors(runner, solver):
+    if solver == "radau" and solver in _known_solvers():
+        pytest.skip("radau is a known solver in this build")
+    with pytest.raises(FmuRunError, match=f"invalid solver = {solver!r}"):
+        runner.simulate({"solver": solver}, stop_time=0.1)
+
+
+def _known_solvers() -> set[str]:
+    from double_pendulum.solvers import METHODS
+
+    return set(METHODS)
+
+
+def _slave(runner, name):
+    from fmpy.fmi2 import FMU2Slave
+
+    md = runner.model_description
+    fmu = FMU2Slave(
+        guid=md.guid, unzipDirectory=runner.unzipdir, modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name
+    )
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    return fmu, {v.name: v.valueReference for v in md.modelVariables}
+
+
+@pytest.mark.parametrize("step", [0.0, -0.01, math.nan])
+def test_non_positive_communication_step_is_discarded(runner, step):
+    from fmpy.fmi1 import FMICallException
+
+    fmu, vrs = _slave(runner, "step")
+    with pytest.raises(FMICallException) as info:
+        fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=step)
+    assert info.value.status == 2  # fmi2Discard
+    fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)  # still usable
+    assert fmu.getReal([vrs["phi1"]])[0] != 1.0
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_do_step_out_of_order_is_discarded(runner):
+    from fmpy.fmi1 import FMICallException
+
+    fmu, _ = _slave(runner, "order")
+    with pytest.raises(FMICallException):
+        fmu.doStep(currentCommunicationPoint=5.0, communicationStepSize=0.01)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_setting_a_parameter_after_initialisation_is_an_error(runner):
+    from fmpy.fmi1 import FMICallException
+
+    fmu, vrs = _slave(runner, "late")
+    with pytest.raises(FMICallException):
+        fmu.setReal([vrs["l1"]], [0.5])
+    fmu.freeInstance()
+    # a new instance works
+    assert runner.simulate({"l1": 0.5}, stop_time=0.1)["time"][-1] == pytest.approx(0.1)
+
+
+def test_with_logging_off_the_message_still_reaches_the_user(fmu_path, tmp_path):
+    """pythonfmu forwards messages only with logging on; the FMU also prints them to stderr."""
+    script = textwrap.dedent(f"""
+        import os
+        from fmpy import simulate_fmu
+        try:
+            simulate_fmu({str(fmu_path)!r}, stop_time=1.0, start_values={{"l2": -0.2}})
+        except Exception as error:
+            print("raised", type(error).__name__, flush=True)
+        os._exit(0)
+    """)
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert "raised FMICallException" in out.stdout
+    assert "invalid l2 = -0.2 m: must be > 0" in out.stderr
+
+
+def test_solver_failure_is_reported_with_the_time_and_the_run_stops_cleanly(runner):
+    with pytest.raises(FmuRunError, match="numerical instability at t = ") as info:
+        runner.simulate(
+            {"solver": "euler", "fixed_step": 0.2, "phi1_0": 3.0, "omega2_0": 30.0}, stop_time=50.0, output_interval=0.2
+        )
+    assert info.value.partial_result is not None
