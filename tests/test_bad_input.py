@@ -129,3 +129,4 @@ def test_solver_failure_is_reported_with_the_time_and_the_run_stops_cleanly(runn
             {"solver": "euler", "fixed_step": 0.2, "phi1_0": 3.0, "omega2_0": 30.0}, stop_time=50.0, output_interval=0.2
         )
     assert info.value.partial_result is not None
+
