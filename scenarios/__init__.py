@@ -5,4 +5,10 @@ dict`` (the summary, also written to ``out_dir/summary.json``). ``quick`` shorte
 smoke tests. Each scenario enables only the model parts it needs.
 """
 
-SCENARIOS: tuple[str, ...] = ("free_swing", "friction_budget", "energy_decay")
+SCENARIOS: tuple[str, ...] = (
+    "free_swing",
+    "friction_budget",
+    "energy_decay",
+    "work_precision",
+    "stability",
+)

@@ -129,6 +129,7 @@ class DoublePendulumCoSimulation:
             rtol=settings.rtol,
             atol=settings.atol,
             fixed_step=settings.fixed_step,
+            max_steps_per_call=max(1, int(settings.max_steps)),
         )
         self.initial_energy = None
         self._update_outputs(y0)

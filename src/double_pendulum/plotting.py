@@ -234,7 +234,10 @@ def plot_ensemble_clouds(
 
 
 def plot_ensemble_spread(
-    times: np.ndarray, spreads: Mapping[str, np.ndarray], thresholds: list[float] | tuple[float, ...], path: str | Path
+    times: np.ndarray,
+    spreads: Mapping[str, np.ndarray],
+    thresholds: list[float] | tuple[float, ...],
+    path: str | Path,
 ) -> Path:
     """RMS spread [m] of the lower bob's position within each ensemble over time (log scale)."""
     fig, ax = plt.subplots(figsize=(9, 5))
@@ -243,7 +246,7 @@ def plot_ensemble_spread(
     for d in thresholds:
         ax.axhline(d, color="k", ls="--", lw=0.8)
         ax.text(times[-1], d, f" {d * 100:g} cm", va="bottom", ha="right", fontsize=8)
-    ax.set(xlabel="t [s]", ylabel="spread of the lower bob [m]", title="ensemble spread (start uncertainty sigma)")
+    ax.set(xlabel="t [s]", ylabel="spread of the lower bob [m]", title="ensemble spread (start uncertainty)")
     ax.legend(fontsize=7, ncol=2, loc="lower right")
     ax.grid(alpha=0.3, which="both")
     return _save(fig, path)
@@ -291,7 +294,7 @@ def plot_lyapunov_vs_energy(
     """Largest exponent [1/s] against the release angle theta0 [rad] (phi1 = phi2 = theta0, at rest)."""
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
     ax1.plot(theta0, lam, "o-")
-    ax1.set(xlabel="theta0 [rad]", ylabel="lambda [1/s]", title="largest Lyapunov exponent, release from rest")
+    ax1.set(xlabel="theta0 [rad]", ylabel="lambda [1/s]", title="largest Lyapunov exponent, from rest")
     ax2.plot(energy_ratio, lam, "o-")
     ax2.axvline(1.0, color="r", ls="--", lw=0.8, label="E = E_flip (a rod can flip)")
     ax2.set(xlabel="E / E_flip", ylabel="lambda [1/s]", title="against energy")
@@ -366,7 +369,60 @@ def plot_poincare_sections(
     fig, axes = plt.subplots(1, n, figsize=(6 * n, 5), squeeze=False)
     for ax, (label, (phi2, omega2, owner)) in zip(axes[0], sections.items()):
         wrapped = np.angle(np.exp(1j * phi2))
-        ax.scatter(wrapped, omega2, c=owner, s=0.6, cmap="tab20", linewidths=0)
+        ax.scatter(wrapped, omega2, c=owner, s=2.0, cmap="tab20", linewidths=0)
         ax.set(title=label, xlabel="phi2 [rad] (wrapped)", ylabel="omega2 [rad/s]")
         ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def plot_lyapunov_with_friction(
+    centres: np.ndarray,
+    local: np.ndarray,
+    times: np.ndarray,
+    energy_ratio: np.ndarray,
+    path: str | Path,
+    *,
+    title: str = "",
+) -> Path:
+    """Finite-time largest exponent [1/s] per window and the energy E/E_flip as friction drains it."""
+    fig, ax = plt.subplots(figsize=(9, 5))
+    ax.step(centres, local, where="mid", color="C0", label="largest exponent in the window")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set(xlabel="t [s]", ylabel="lambda [1/s]", title=title or "Lyapunov exponent as the motion decays")
+    ax.grid(alpha=0.3)
+    twin = ax.twinx()
+    twin.plot(times, energy_ratio, color="C3", lw=1.0, label="E / E_flip")
+    twin.axhline(1.0, color="C3", ls="--", lw=0.8)
+    twin.set_ylabel("E / E_flip", color="C3")
+    lines = ax.get_legend_handles_labels()
+    lines2 = twin.get_legend_handles_labels()
+    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="upper right", fontsize=8)
+    return _save(fig, path)
+
+
+def plot_residuals(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
+    """|energy_residual| / E_total(0) over time [s], log scale, one line per run."""
+    fig, ax = plt.subplots(figsize=(9, 5))
+    for label, r in runs.items():
+        e0 = abs(r["E_total"][0]) or 1.0
+        ax.semilogy(r["time"], np.abs(r["energy_residual"]) / e0 + 1e-18, label=label)
+    ax.set(xlabel="t [s]", ylabel="|energy_residual| / E_total(0)", title="Energy residual of the worst cases")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_work_precision(rows: list[dict], path: str | Path, *, title: str = "") -> Path:
+    """Max error over the horizon against CPU time [s], log-log, one line per method (ok runs only)."""
+    fig, ax = plt.subplots(figsize=(8, 6))
+    for solver in sorted({r["solver"] for r in rows}):
+        pts = sorted((r["cpu_time_s"], r["max_error"]) for r in rows if r["solver"] == solver and r["status"] == "ok")
+        if pts:
+            ax.loglog(*zip(*pts), "o-", label=solver)
+        failed = [r for r in rows if r["solver"] == solver and r["status"] != "ok"]
+        if failed:
+            ax.plot([], [], "x", label=f"{solver}: {len(failed)} failed/unstable")
+    ax.set(xlabel="CPU time [s]", ylabel="max error over the horizon [rad, rad/s]", title=title)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
     return _save(fig, path)

@@ -87,3 +87,21 @@ def write_text(path: str | Path, text: str) -> Path:
     path = Path(path)
     _atomic_write_text(path, text)
     return path
+
+
+def write_table_csv(path: str | Path, rows: list[Mapping[str, Any]]) -> Path:
+    """Write a list of records as CSV (columns: the union of the keys, in first-seen order)."""
+    import csv
+    import io
+
+    columns: list[str] = []
+    for row in rows:
+        columns += [k for k in row if k not in columns]
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=columns, lineterminator="\n")
+    writer.writeheader()
+    for row in rows:
+        writer.writerow({k: _jsonable(v) for k, v in row.items()})
+    path = Path(path)
+    _atomic_write_text(path, buffer.getvalue())
+    return path

@@ -1,6 +1,10 @@
 """Integrators, kept apart from the right-hand sides they integrate.
 
-* :mod:`.runge_kutta` — the methods (one step, error estimate, dense output);
+* :mod:`.runge_kutta` — explicit methods (one step, error estimate, dense output) and the
+  method interface;
+* :mod:`.rosenbrock` — Rodas4, linearly implicit and L-stable, for stiff scenes;
+* :mod:`.gauss` — Gauss-Legendre collocation (symmetric, energy error bounded over long runs);
+* :mod:`.linalg` — the small dense LU they need;
 * :mod:`.integrator` — step-size control, dense output and persistent state;
 * :mod:`.registry` — the names users pass as ``solver``.
 """

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from typing import Any
 
+from .gauss import Gauss2, Gauss4
 from .integrator import Integrator
+from .rosenbrock import Rodas4
 from .runge_kutta import ClassicRK4, Dop853, Dopri5, ExplicitEuler, VectorField
 
 METHODS: dict[str, type] = {
@@ -12,6 +14,9 @@ METHODS: dict[str, type] = {
     "dopri5": Dopri5,
     "rk4": ClassicRK4,
     "euler": ExplicitEuler,
+    "rodas4": Rodas4,
+    "gauss4": Gauss4,
+    "gauss2": Gauss2,
 }
 
 

@@ -12,6 +12,12 @@ Each method is a small object with the same interface (the integrator in
 * ``interpolant(f, t, y, y_new, fy, f_new, h, stages)`` -> ``g(theta)``: the continuous
   extension on ``t + theta * h``, ``0 <= theta <= 1``, of the order given by ``dense_order``.
 
+Attributes: ``name``, ``adaptive``, ``order``, ``error_order`` (order of the error estimate),
+``dense_order``, ``evals_per_step`` (right-hand side evaluations of one ``step`` call; the
+integrator reads it after each call, so a method whose cost varies, e.g. with a Jacobian or an
+iteration, sets it in ``step``) and ``dense_evals`` (evaluations of one ``interpolant`` call).
+The implicit methods are in :mod:`.rosenbrock` (stiff) and :mod:`.gauss` (symplectic).
+
 Lists of floats are used instead of NumPy arrays: for a state of 4 to 11 components a Python
 float loop is several times cheaper per step than NumPy's per-call overhead.
 """
