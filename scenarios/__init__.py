@@ -11,4 +11,5 @@ SCENARIOS: tuple[str, ...] = (
     "energy_decay",
     "work_precision",
     "stability",
+    "chaos",
 )

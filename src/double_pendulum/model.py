@@ -278,13 +278,13 @@ def initial_state(config: ModelConfig, phi1: float, phi2: float, omega1: float, 
     return y + [0.0] * (state_layout(config).size - 4)
 
 
-def energies(config: ModelConfig, y: list[float]) -> tuple[float, float, float]:
+def energies(config: ModelConfig, y: list[float], layout: StateLayout | None = None) -> tuple[float, float, float]:
     """Return ``(E_kin, E_pot, E_suspension)`` [J] of state ``y``.
 
     ``E_kin``: both bobs, absolute velocities; ``E_pot``: pendulum potential relative to the pivot,
     zero hanging at rest; ``E_suspension``: see :func:`double_pendulum.energy.suspension_energy`.
     """
-    layout = state_layout(config)
+    layout = layout or state_layout(config)
     ix, iy = layout.index("xs"), layout.index("ys")
     xs, vxs = (y[ix], y[ix + 1]) if ix is not None else (0.0, 0.0)
     ys, vys = (y[iy], y[iy + 1]) if iy is not None else (0.0, 0.0)

@@ -64,49 +64,74 @@ OUTPUT_NAMES: tuple[str, ...] = tuple(q.name for q in OUTPUTS)
 WORK_NAMES: tuple[str, ...] = ("W_air", "W_bearing", "W_suspension")
 
 
-def output_values(model: Model, y: list[float], initial_energy: float | None = None) -> tuple[float, ...]:
-    """Return the model outputs, in :data:`MODEL_OUTPUT_NAMES` order, at state ``y``.
-
-    ``initial_energy`` [J] is E_total at the start (for the residual); ``None`` means this state
-    is the start.
-    """
-    from .model import energies
-
-    layout, p = model.layout, model.config.pendulum
-    phi1, phi2, omega1, omega2 = y[0], y[1], y[2], y[3]
+def _pivot(model: Model, y: list[float]) -> tuple[float, float, float, float]:
+    """``(xs, ys, vxs, vys)`` of state ``y`` (zeros for a fixed pivot)."""
+    layout = model.layout
     ix, iy = layout.index("xs"), layout.index("ys")
     xs, vxs = (y[ix], y[ix + 1]) if ix is not None else (0.0, 0.0)
     ys, vys = (y[iy], y[iy + 1]) if iy is not None else (0.0, 0.0)
+    return xs, ys, vxs, vys
+
+
+def kinematic_outputs(model: Model, y: list[float], initial_energy: float | None = None) -> dict[str, float]:
+    """Angles, rates, bob positions and the pivot's motion (cheap: no energies, no forces)."""
+    p = model.config.pendulum
+    phi1, phi2 = y[0], y[1]
+    xs, ys, vxs, vys = _pivot(model, y)
     x1, y1, x2, y2 = positions(phi1, phi2, p.l1, p.l2)
-    e_kin, e_pot, e_sus = energies(model.config, y)
+    return {
+        "phi1": phi1, "phi2": phi2, "omega1": y[2], "omega2": y[3],
+        "x1": x1 + xs, "y1": y1 + ys, "x2": x2 + xs, "y2": y2 + ys,
+        "xs": xs, "ys": ys, "vxs": vxs, "vys": vys,
+    }  # fmt: skip
+
+
+def energy_outputs(model: Model, y: list[float], initial_energy: float | None = None) -> dict[str, float]:
+    """Energies, dissipated works and the energy residual [J].
+
+    ``initial_energy`` is E_total at the start; ``None`` means this state is the start.
+    """
+    from .model import energies
+
+    e_kin, e_pot, e_sus = energies(model.config, y, model.layout)
     e_pend = e_kin + e_pot
     e_total = e_pend + e_sus
-    work = [y[i] if i is not None else 0.0 for i in (layout.index(n) for n in WORK_NAMES)]
+    layout = model.layout
+    work = {n: (y[i] if (i := layout.index(n)) is not None else 0.0) for n in WORK_NAMES}
+    e0 = e_total if initial_energy is None else initial_energy
+    return {
+        "E_kin": e_kin, "E_pot": e_pot, "E_total": e_total, "E_pendulum": e_pend, "E_suspension": e_sus,
+        **work, "energy_residual": e_total + sum(work.values()) - e0,
+    }  # fmt: skip
+
+
+def force_outputs(model: Model, y: list[float], initial_energy: float | None = None) -> dict[str, float]:
+    """Pivot force [N] and the power into the suspension [W] (needs the accelerations)."""
+    p = model.config.pendulum
+    _, _, vxs, vys = _pivot(model, y)
     ev = model.evaluate(y)
     # power into the suspension: the pivot force about its static value (the preload carries the weight)
     p_susp = ev.f_pivot_x * vxs + (ev.f_pivot_y + (p.m1 + p.m2) * p.g) * vys
-    e0 = e_total if initial_energy is None else initial_energy
-    return (
-        phi1,
-        phi2,
-        omega1,
-        omega2,
-        x1 + xs,
-        y1 + ys,
-        x2 + xs,
-        y2 + ys,
-        e_kin,
-        e_pot,
-        e_total,
-        xs,
-        ys,
-        vxs,
-        vys,
-        e_pend,
-        e_sus,
-        *work,
-        p_susp,
-        ev.f_pivot_x,
-        ev.f_pivot_y,
-        e_total + sum(work) - e0,
+    return {"P_to_suspension": p_susp, "F_pivot_x": ev.f_pivot_x, "F_pivot_y": ev.f_pivot_y}
+
+
+OUTPUT_GROUPS = (kinematic_outputs, energy_outputs, force_outputs)
+GROUP_OF: dict[str, int] = {
+    name: k
+    for k, names in enumerate(
+        (
+            ("phi1", "phi2", "omega1", "omega2", "x1", "y1", "x2", "y2", "xs", "ys", "vxs", "vys"),
+            ("E_kin", "E_pot", "E_total", "E_pendulum", "E_suspension", *WORK_NAMES, "energy_residual"),
+            ("P_to_suspension", "F_pivot_x", "F_pivot_y"),
+        )
     )
+    for name in names
+}
+
+
+def output_values(model: Model, y: list[float], initial_energy: float | None = None) -> tuple[float, ...]:
+    """Return the model outputs, in :data:`MODEL_OUTPUT_NAMES` order, at state ``y``."""
+    values: dict[str, float] = {}
+    for group in OUTPUT_GROUPS:
+        values.update(group(model, y, initial_energy))
+    return tuple(values[name] for name in MODEL_OUTPUT_NAMES)

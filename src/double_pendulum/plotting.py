@@ -426,3 +426,190 @@ def plot_work_precision(rows: list[dict], path: str | Path, *, title: str = "") 
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
     return _save(fig, path)
+
+
+# ---------------------------------------------------------------------------- suspension, measured vs sim (issue 4)
+def _running_mean(values: np.ndarray, width: int) -> np.ndarray:
+    """Centered moving average over ``width`` samples (shorter at the ends)."""
+    width = max(1, int(width))
+    kernel = np.ones(width)
+    return np.convolve(values, kernel, mode="same") / np.convolve(np.ones_like(values), kernel, mode="same")
+
+
+def plot_decay_rate_map(
+    panels: Mapping[str, Mapping[str, np.ndarray]],
+    levels: Mapping[str, float],
+    path: str | Path,
+    *,
+    points: Mapping[str, tuple[float, float]] | None = None,
+    slope_through: tuple[float, float] | None = None,
+) -> Path:
+    """Decay rate b [1/s] over suspension stiffness k [N/m] and damping c [N s/m], one panel per map.
+
+    Each panel maps ``k``, ``c`` (1-D) and ``b`` (shape (len(k), len(c))), optionally a finer
+    prediction ``k_fine``, ``c_fine``, ``b_fine`` drawn as dotted contours. ``levels`` label the
+    solid/dashed iso-b contours; ``points`` mark (k, c) pairs; ``slope_through`` draws c ~ k^2
+    through a point (the stiff-suspension law).
+    """
+    n = len(panels)
+    fig, axes = plt.subplots(1, n, figsize=(6.2 * n, 5.2), squeeze=False)
+    styles = ("-", "--", "-.", ":")
+    all_b = np.concatenate([np.ravel(p["b"]) for p in panels.values()])
+    vmin, vmax = float(np.min(all_b)), float(np.max(all_b))
+    for ax, (title, p) in zip(axes[0], panels.items()):
+        b = np.asarray(p["b"]).T
+        mesh = ax.pcolormesh(p["k"], p["c"], b, shading="nearest", cmap="viridis", vmin=vmin, vmax=vmax)
+        for (label, level), ls in zip(levels.items(), styles):
+            if np.min(p["b"]) < level < np.max(p["b"]):
+                ax.contour(p["k"], p["c"], np.asarray(p["b"]).T, levels=[level], colors="w", linestyles=ls)
+                ax.plot([], [], color="k", ls=ls, label=f"{label}: b = {level:.4f} 1/s")
+            if "b_fine" in p and np.min(p["b_fine"]) < level < np.max(p["b_fine"]):
+                b_fine = np.asarray(p["b_fine"]).T
+                ax.contour(p["k_fine"], p["c_fine"], b_fine, levels=[level], colors="r", linestyles=":")
+        if "b_fine" in p:
+            ax.plot([], [], "r:", label="linear response (fixed-pivot force spectrum)")
+        if slope_through is not None:
+            k0, c0 = slope_through
+            ks = np.asarray(p["k"], dtype=float)
+            ax.plot(ks, c0 * (ks / k0) ** 2, color="orange", lw=1.0, label="c ~ k^2 (stiff limit)")
+        for (label, (k, c)), marker in zip((points or {}).items(), "o^sDv"):
+            ax.plot([k], [c], marker, color="r", mec="k", ms=7, label=label)
+        ax.set(xscale="log", yscale="log", xlabel="k [N/m]", ylabel="c [N s/m]", title=title)
+        ax.set_xlim(np.min(p["k"]) / 1.2, np.max(p["k"]) * 1.2)
+        ax.set_ylim(np.min(p["c"]) / 1.5, np.max(p["c"]) * 1.5)
+        ax.legend(loc="lower right", fontsize=7)
+        fig.colorbar(mesh, ax=ax, label="b [1/s] of E_pendulum")
+    return _save(fig, path)
+
+
+def plot_decay_rate_cuts(
+    k_values: np.ndarray,
+    c_values: np.ndarray,
+    b_suspension: np.ndarray,
+    c_fine: np.ndarray,
+    b_linear_fine: np.ndarray,
+    b_quasi_static_fine: np.ndarray,
+    target: float,
+    path: str | Path,
+) -> Path:
+    """The suspension's share -(b - b0) [1/s] over c at fixed k: FMU (markers), linear response (lines),
+    stiff limit c <|dF/dt|^2> / (k^2 E) (dashed), and the share the measurement needs (black)."""
+    fig, ax = plt.subplots(figsize=(9, 6))
+    colours = plt.cm.plasma(np.linspace(0.0, 0.9, len(k_values)))
+    for i, (k, col) in enumerate(zip(k_values, colours)):
+        ax.loglog(c_values, -b_suspension[i], "o", color=col, label=f"k = {k:.3g} N/m")
+        ax.loglog(c_fine, -b_linear_fine[i], "-", color=col, lw=1.0)
+        ax.loglog(c_fine, -b_quasi_static_fine[i], "--", color=col, lw=0.7)
+    ax.axhline(-target, color="k", lw=1.2, label=f"needed: {-target:.4f} 1/s")
+    finite = -b_suspension[np.isfinite(b_suspension) & (b_suspension < 0)]
+    if finite.size:
+        ax.set_ylim(max(finite.min() / 3.0, 1e-6), finite.max() * 3.0)
+    ax.set(xlabel="c [N s/m]", ylabel="-(b - b0) [1/s]", title="suspension share of the decay rate (FMU: markers; "
+           "linear response: lines; stiff limit: dashed)")
+    ax.legend(fontsize=7, ncols=2)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)
+
+
+def plot_force_spectrum(
+    omega: np.ndarray, spectra: Mapping[str, np.ndarray], marks: Mapping[str, float], path: str | Path
+) -> Path:
+    """Power spectral densities S(omega) [N^2 s/rad] of the pivot force and omega^2 S (its rate), log-log,
+    with vertical lines at ``marks`` (e.g. suspension natural frequencies [rad/s])."""
+    fig, axes = plt.subplots(1, 2, figsize=(13, 4.8))
+    for label, s in spectra.items():
+        axes[0].loglog(omega, s, lw=0.8, label=label)
+        axes[1].loglog(omega, omega**2 * s, lw=0.8, label=label)
+    for ax in axes:
+        for (label, w), ls in zip(marks.items(), ("--", ":", "-.", "-")):
+            ax.axvline(w, color="k", ls=ls, lw=0.8, label=label)
+        ax.set_xlabel("omega [rad/s]")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7)
+    axes[0].set(ylabel="S_F [N^2 s/rad]", title="pivot force spectrum (fixed pivot)")
+    axes[1].set(ylabel="omega^2 S_F [N^2/(s rad)]", title="spectrum of dF/dt (what a stiff damper sees)")
+    for ax in axes:
+        top = max(float(np.max(line.get_ydata())) for line in ax.get_lines() if len(line.get_ydata()) > 2)
+        ax.set_ylim(top * 1e-8, top * 3.0)
+    return _save(fig, path)
+
+
+def plot_energy_flow(
+    runs: Mapping[str, np.ndarray], path: str | Path, *, smooth_s: float = 1.0, zoom_s: float = 0.5
+) -> Path:
+    """How the pendulum's energy reaches the suspension: P_to_suspension [W] (raw and averaged over
+    ``smooth_s``), a zoom on the first ``zoom_s`` seconds, E_suspension [J], and the cumulative
+    budget: pendulum energy lost, W_suspension, W_air, W_bearing and E_suspension + W_suspension [J]."""
+    fig, axes = plt.subplots(4, 1, figsize=(11, 13))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for (label, r), col in zip(runs.items(), colours):
+        t = r["time"]
+        dt = float(t[1] - t[0])
+        p = r["P_to_suspension"]
+        axes[0].plot(t, p, color=col, lw=0.3, alpha=0.35)
+        mean = _running_mean(p, round(smooth_s / dt))
+        axes[0].plot(t, mean, color=col, lw=1.5, label=f"{label} ({smooth_s:g} s mean)")
+        z = t <= t[0] + zoom_s
+        axes[1].plot(t[z], p[z], color=col, lw=1.0, label=label)
+        axes[2].semilogy(t, np.maximum(r["E_suspension"], 1e-12), color=col, lw=0.5, label=label)
+        axes[3].plot(t, r["E_pendulum"][0] - r["E_pendulum"], color=col, lw=1.5, label=f"{label}: pendulum energy lost")
+        axes[3].plot(t, r["W_suspension"], color=col, ls="--", label=f"{label}: W_suspension")
+        axes[3].plot(t, r["W_air"] + r["W_bearing"], color=col, ls=":", label=f"{label}: W_air + W_bearing")
+        axes[3].plot(t, r["E_suspension"] + r["W_suspension"], color=col, lw=0.6, alpha=0.6)
+    axes[0].set(ylabel="P_to_suspension [W]", title="power from the pendulum into the suspension")
+    axes[1].set(ylabel="P_to_suspension [W]", title=f"first {zoom_s:g} s: exchange at the suspension's frequency")
+    axes[2].set(ylabel="E_suspension [J]", title="energy stored in the suspension")
+    axes[3].set(xlabel="t [s]", ylabel="energy [J]", title="cumulative: lost by the pendulum, dissipated "
+                "(thin: E_suspension + W_suspension = integral of P_to_suspension)")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper left")
+    return _save(fig, path)
+
+
+def plot_track_comparison(
+    t: np.ndarray,
+    measured: Mapping[str, np.ndarray],
+    runs: Mapping[str, tuple[np.ndarray, Mapping[str, np.ndarray]]],
+    path: str | Path,
+    *,
+    starts: Mapping[str, float] | None = None,
+) -> Path:
+    """Measured coordinates (dots) and simulated ones (lines) over time [s], one panel per coordinate [m]
+    (the seed's figs. 11-14); ``starts`` marks start times [s]."""
+    names = list(measured)
+    fig, axes = plt.subplots(len(names), 1, figsize=(11, 2.6 * len(names)), sharex=True, squeeze=False)
+    for ax, name in zip(axes[:, 0], names):
+        ax.plot(t, measured[name], ".", color="k", ms=3, label="track")
+        for label, (ts, coords) in runs.items():
+            ax.plot(ts, coords[name], lw=1.2, label=label)
+        for t0 in (starts or {}).values():
+            ax.axvline(t0, color="0.5", ls=":", lw=0.8)
+        ax.set(ylabel=f"{name} [m]")
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=7, ncols=2, loc="upper right")
+    axes[-1, 0].set_xlabel("t [s]")
+    return _save(fig, path)
+
+
+def plot_prediction_errors(
+    curves: Mapping[str, tuple[np.ndarray, np.ndarray]],
+    thresholds: tuple[float, ...] | list[float],
+    path: str | Path,
+    *,
+    floor: tuple[np.ndarray, np.ndarray] | None = None,
+) -> Path:
+    """Position error [m] over time since the start [s], log scale, with horizontal ``thresholds`` [m];
+    ``floor`` (t, error) is drawn grey (e.g. the track's own deviation from a rigid rod)."""
+    fig, ax = plt.subplots(figsize=(11, 5.5))
+    for label, (t, err) in curves.items():
+        ax.semilogy(t, np.maximum(err, 1e-5), lw=1.1, label=label)
+    if floor is not None:
+        label = "track: | |r2 - r1| - l2 | (rod-length error)"
+        ax.semilogy(floor[0], np.maximum(floor[1], 1e-5), ".", color="0.6", ms=2, label=label)
+    for th, ls in zip(thresholds, ("--", "-.", ":")):
+        ax.axhline(th, color="k", ls=ls, lw=0.9, label=f"{100 * th:g} cm")
+    ax.set(xlabel="t - t0 [s]", ylabel="position error [m]", title="simulated minus measured bob position")
+    ax.legend(fontsize=7, ncols=2)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, path)

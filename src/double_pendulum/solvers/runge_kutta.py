@@ -161,7 +161,6 @@ class Dop853:
         ks = list(ks)
         for i in (13, 14, 15):
             ks.append(f(t + tb.DOP853_C[i] * h, _stage_input(y, h, tb.DOP853_A[i], ks)))
-        n = len(y)
         dy = [v - u for u, v in zip(y, y_new)]
         coeffs = [
             dy,
@@ -171,14 +170,20 @@ class Dop853:
         for row in tb.DOP853_D:
             coeffs.append([h * v for v in _weighted_sum(ks, row)])
         coeffs.reverse()
+        columns = list(zip(*coeffs))  # per component: its 7 coefficients, highest first
+        n_coeffs = len(coeffs)
 
         def evaluate(theta: float) -> list[float]:
-            out = [0.0] * n
+            # y + F0 x + F1 x(1-x) + F2 x^2(1-x) + ... evaluated Horner-like, alternating x and 1-x
             one_minus = 1.0 - theta
-            for i, cf in enumerate(coeffs):
-                factor = theta if i % 2 == 0 else one_minus
-                out = [(o + v) * factor for o, v in zip(out, cf)]
-            return [o + u for o, u in zip(out, y)]
+            factors = [theta if i % 2 == 0 else one_minus for i in range(n_coeffs)]
+            out = []
+            for column, yc in zip(columns, y):
+                acc = 0.0
+                for cf, factor in zip(column, factors):
+                    acc = (acc + cf) * factor
+                out.append(acc + yc)
+            return out
 
         return evaluate
 

@@ -1,0 +1,296 @@
+"""Many FMU runs at once: parameter sweeps on all local cores or on a Dask cluster.
+
+:func:`run_sweep` runs the FMU once per *case* (a mapping of start values, as for
+:meth:`double_pendulum.runner.FmuRunner.simulate`) and returns the results in the order of the
+cases. The cases are split into contiguous chunks; each worker process extracts the FMU once
+(one :class:`~double_pendulum.runner.FmuRunner` per process, kept for later chunks) and runs its
+chunks one case after another.
+
+* Locally (default) the chunks go to a :class:`concurrent.futures.ProcessPoolExecutor` with one
+  process per core (``max_workers=None``), started by ``forkserver`` so no threads of the calling
+  process are forked; ``max_workers=1`` runs in the calling process. As with any spawned worker
+  processes, a script that calls this must guard its top level with ``if __name__ == "__main__":``.
+* With ``scheduler="tcp://host:8786"`` (or a ``distributed.Client``) they go to a Dask cluster,
+  as in FMPy's own parameter-variation example. The FMU file itself is sent to the workers once
+  (``Client.scatter(..., broadcast=True)``), so they need not share a file system; they need this
+  package and fmpy installed (``pip install double-pendulum-fmu``).
+
+Deterministic: the cases are fixed before anything is distributed (:func:`random_cases` draws
+them from a seeded generator), every run is deterministic, and results are put back in case
+order, so the same cases give bit-identical results with any number of workers, locally or on
+Dask. Long runs show a progress line on stderr (:class:`double_pendulum.progress.ProgressLine`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import itertools
+import math
+import multiprocessing
+import multiprocessing.util
+import os
+import sys
+import tempfile
+import threading
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .progress import ProgressLine
+from .runner import FmuRunError, FmuRunner
+
+CHUNKS_PER_WORKER = 4
+
+
+def default_workers() -> int:
+    """Number of cores this process may use."""
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # not on Linux
+        return max(1, os.cpu_count() or 1)
+
+
+def chunk(items: Sequence[Any], n_chunks: int) -> list[list[Any]]:
+    """Split ``items`` into at most ``n_chunks`` contiguous, nearly equal parts (order kept)."""
+    n_chunks = max(1, min(n_chunks, len(items)))
+    size, extra = divmod(len(items), n_chunks)
+    out, start = [], 0
+    for i in range(n_chunks):
+        stop = start + size + (1 if i < extra else 0)
+        out.append(list(items[start:stop]))
+        start = stop
+    return out
+
+
+# ---------------------------------------------------------------------------- generic parallel map
+def _dask_client(scheduler: Any):
+    """Return ``(client, owned)`` for a scheduler address or an existing ``distributed.Client``."""
+    try:
+        from distributed import Client
+    except ImportError as error:  # pragma: no cover - depends on the installation
+        raise ImportError("running on a Dask cluster needs 'dask[distributed]' installed") from error
+    if isinstance(scheduler, Client):
+        return scheduler, False
+    return Client(scheduler), True
+
+
+def _is_fmu_resources(entry: str) -> bool:
+    """True for the ``resources`` folder of an extracted FMU (pythonfmu puts it on ``sys.path``)."""
+    path = Path(entry)
+    return path.name == "resources" and (path.parent / "modelDescription.xml").is_file()
+
+
+@contextlib.contextmanager
+def _without_fmu_resources_on_path() -> Iterator[None]:
+    """Hide extracted FMUs' ``resources`` folders from ``sys.path`` while worker processes start.
+
+    Running a pythonfmu FMU in this process appends its ``resources`` folder (which holds a bundled
+    copy of this package) to ``sys.path`` for good; spawned workers copy ``sys.path`` and would
+    otherwise import that copy instead of the installed package.
+    """
+    saved = list(sys.path)
+    sys.path[:] = [p for p in saved if not _is_fmu_resources(p)]
+    try:
+        yield
+    finally:
+        sys.path[:] = saved
+
+
+def _call(func: Callable[..., Any], item: Any, shared: Any) -> Any:
+    return func(item) if shared is None else func(item, shared)
+
+
+def parallel_map(
+    func: Callable[..., Any],
+    items: Sequence[Any],
+    *,
+    shared: Any = None,
+    max_workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool | None = None,
+    label: str = "parallel",
+    weights: Sequence[int] | None = None,
+) -> tuple[list[Any], int]:
+    """Apply ``func`` to every item in parallel; return ``(results in item order, workers used)``.
+
+    ``func(item)``, or ``func(item, shared)`` when ``shared`` is given (sent to Dask workers once).
+    ``func`` must be importable (a module-level function). ``max_workers=None`` uses every local
+    core, ``1`` runs in this process; ``scheduler`` (address or ``distributed.Client``) uses Dask.
+    ``weights`` (default 1 each) count each item's share of the progress line.
+    """
+    weights = list(weights) if weights is not None else [1] * len(items)
+    results: list[Any] = [None] * len(items)
+    with ProgressLine(sum(weights), label, enabled=progress) as bar:
+        if scheduler is not None:
+            return _dask_map(func, items, shared, scheduler, bar, weights, results)
+        workers = min(default_workers() if max_workers is None else max_workers, max(len(items), 1))
+        if workers <= 1:
+            for i, item in enumerate(items):
+                results[i] = _call(func, item, shared)
+                bar.update(weights[i])
+            return results, 1
+        context = multiprocessing.get_context("forkserver" if os.name == "posix" else "spawn")
+        with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+            with _without_fmu_resources_on_path():  # workers start on these submits
+                futures = {pool.submit(_call, func, item, shared): i for i, item in enumerate(items)}
+            for future in as_completed(futures):
+                i = futures[future]
+                results[i] = future.result()
+                bar.update(weights[i])
+        return results, workers
+
+
+def _dask_map(func, items, shared, scheduler, bar, weights, results) -> tuple[list[Any], int]:
+    from distributed import as_completed as dask_as_completed
+
+    client, owned = _dask_client(scheduler)
+    try:
+        shared_ref = client.scatter(shared, broadcast=True) if shared is not None else None
+        futures = [client.submit(_call, func, item, shared_ref, pure=False) for item in items]
+        index = {future.key: i for i, future in enumerate(futures)}
+        for future in dask_as_completed(futures):
+            i = index[future.key]
+            results[i] = future.result()
+            bar.update(weights[i])
+        workers = len(client.scheduler_info().get("workers", {})) or 1
+    finally:
+        if owned:
+            client.close()
+    return results, workers
+
+
+# ---------------------------------------------------------------------------- FMU sweeps
+@dataclass(frozen=True)
+class FmuSource:
+    """The FMU for the workers: a path (local processes) or the file's bytes (Dask), with its hash."""
+
+    key: str
+    path: str | None = None
+    content: bytes | None = None
+
+    @classmethod
+    def from_path(cls, path: str | Path, *, embed: bool) -> FmuSource:
+        data = Path(path).read_bytes()
+        key = hashlib.sha256(data).hexdigest()[:16]
+        return cls(key, str(Path(path).resolve()), data if embed else None)
+
+
+_RUNNERS: dict[str, tuple[FmuRunner, threading.Lock]] = {}
+_RUNNERS_LOCK = threading.Lock()
+
+
+def _worker_runner(source: FmuSource) -> tuple[FmuRunner, threading.Lock]:
+    """This process's runner for ``source`` (extracted on first use, removed at process exit)."""
+    with _RUNNERS_LOCK:
+        if source.key not in _RUNNERS:
+            path = source.path
+            if source.content is not None and (path is None or not Path(path).is_file()):
+                folder = Path(tempfile.mkdtemp(prefix="dp-sweep-"))
+                path = str(folder / f"{source.key}.fmu")
+                Path(path).write_bytes(source.content)
+            runner = FmuRunner(path)
+            multiprocessing.util.Finalize(runner, runner.close, exitpriority=10)
+            _RUNNERS[source.key] = (runner, threading.Lock())
+        return _RUNNERS[source.key]
+
+
+@dataclass(frozen=True)
+class SweepChunk:
+    """A worker's share: the indices and start values of its cases and the run options."""
+
+    indices: tuple[int, ...]
+    cases: tuple[Mapping[str, Any], ...]
+    options: Mapping[str, Any]
+    reduce: Callable[[np.ndarray], Any] | None = None
+
+
+def _run_chunk(work: SweepChunk, source: FmuSource) -> list[Any]:
+    """Worker: run the chunk's cases one after another with this process's runner."""
+    runner, lock = _worker_runner(source)
+    out = []
+    for index, case in zip(work.indices, work.cases):
+        try:
+            with lock:
+                result = runner.simulate(dict(case), **work.options)
+        except FmuRunError as error:
+            raise FmuRunError(f"sweep case {index} {dict(case)}: {error}", error.partial_result) from error
+        out.append(work.reduce(result) if work.reduce is not None else result)
+    return out
+
+
+def run_sweep(
+    fmu_path: str | Path,
+    cases: Sequence[Mapping[str, Any]],
+    *,
+    stop_time: float = 10.0,
+    output_interval: float = 0.01,
+    outputs: Sequence[str] | None = None,
+    reduce: Callable[[np.ndarray], Any] | None = None,
+    max_workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool | None = None,
+) -> list[Any]:
+    """Run the FMU for every case (start values by name); results in case order.
+
+    Each result is fmpy's structured array (``time`` and ``outputs``), or ``reduce(result)`` if
+    given (computed on the worker, so only the reduced value travels back; it must be a
+    module-level function). Parallelism as in :func:`parallel_map`; a failing case raises
+    :class:`~double_pendulum.runner.FmuRunError` naming the case.
+    """
+    options: dict[str, Any] = {"stop_time": stop_time, "output_interval": output_interval}
+    if outputs is not None:
+        options["outputs"] = tuple(outputs)
+    indexed = list(enumerate(cases))
+    serial = max_workers == 1 and scheduler is None
+    parts = chunk(indexed, 1 if serial else CHUNKS_PER_WORKER * (max_workers or default_workers()))
+    work = [SweepChunk(tuple(i for i, _ in part), tuple(dict(c) for _, c in part), options, reduce) for part in parts]
+    source = FmuSource.from_path(fmu_path, embed=scheduler is not None)
+    results, _ = parallel_map(
+        _run_chunk,
+        work,
+        shared=source,
+        max_workers=max_workers,
+        scheduler=scheduler,
+        progress=progress,
+        label=f"sweep ({len(cases)} runs)",
+        weights=[len(w.indices) for w in work],
+    )
+    return list(itertools.chain.from_iterable(results))
+
+
+# ---------------------------------------------------------------------------- case generators
+def grid_cases(base: Mapping[str, Any] | None = None, **axes: Sequence[Any]) -> list[dict[str, Any]]:
+    """Full factorial cases: every combination of the ``axes`` values (last axis fastest) on ``base``."""
+    names = list(axes)
+    return [{**(base or {}), **dict(zip(names, combo))} for combo in itertools.product(*axes.values())]
+
+
+def random_cases(
+    n: int,
+    *,
+    seed: int,
+    base: Mapping[str, Any] | None = None,
+    uniform: Mapping[str, tuple[float, float]] | None = None,
+    normal: Mapping[str, tuple[float, float]] | None = None,
+) -> list[dict[str, Any]]:
+    """``n`` cases drawn from ``numpy.random.default_rng(seed)``: same seed, same cases.
+
+    ``uniform`` maps a name to ``(low, high)``, ``normal`` to ``(mean, standard deviation)``;
+    names are drawn in sorted order so the result does not depend on the mappings' order.
+    """
+    rng = np.random.default_rng(seed)
+    draws: dict[str, np.ndarray] = {}
+    for name in sorted(uniform or {}):
+        low, high = (uniform or {})[name]
+        draws[name] = rng.uniform(low, high, size=n)
+    for name in sorted(normal or {}):
+        mean, sd = (normal or {})[name]
+        if not (math.isfinite(sd) and sd >= 0):
+            raise ValueError(f"invalid standard deviation for {name}: {sd!r}")
+        draws[name] = rng.normal(mean, sd, size=n)
+    return [{**(base or {}), **{k: float(v[i]) for k, v in draws.items()}} for i in range(n)]

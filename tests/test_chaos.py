@@ -1,0 +1,217 @@
+"""Chaos: tangent dynamics, Lyapunov exponents, flipping bound, predictability, sections, scenario."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from double_pendulum import chaos
+from double_pendulum.dynamics import linearised_normal_modes
+from double_pendulum.ensemble import batch_energy, batch_potential_energy, initial_states, pendulum_field
+from double_pendulum.parameters import PendulumParameters
+from double_pendulum.results_io import read_results_csv
+
+P = PendulumParameters()
+FIELD = pendulum_field(P)
+CHAOTIC = (2.0, 0.0)  # the scenario's seed-like release: upper rod at 2 rad, lower rod hanging
+
+
+def test_complex_step_jacobian_at_rest_has_the_normal_mode_frequencies():
+    """J(0) = [[0, I], [-M0^-1 K, 0]] has eigenvalues +-i omega_k of the linearised modes."""
+    rest = np.zeros((4, 4))
+    jac = chaos.complex_step_jvp(FIELD, 0.0, rest, np.eye(4))  # column j: J e_j
+    eig = np.sort(np.abs(np.linalg.eigvals(jac).imag))
+    omegas, _ = linearised_normal_modes(P)
+    np.testing.assert_allclose(eig, np.repeat(omegas, 2), rtol=1e-12)
+    np.testing.assert_allclose(np.linalg.eigvals(jac).real, 0.0, atol=1e-12)
+
+
+def test_complex_step_and_central_differences_agree_at_chaotic_states():
+    rng = np.random.default_rng(3)
+    y = np.vstack((rng.uniform(-3, 3, (2, 20)), rng.uniform(-8, 8, (2, 20))))
+    v = rng.standard_normal((4, 20))
+    exact = chaos.complex_step_jvp(FIELD, 0.0, y, v)
+    approx = chaos.central_difference_jvp(FIELD, 0.0, y, v)
+    np.testing.assert_allclose(approx, exact, rtol=1e-6, atol=1e-6 * np.abs(exact).max())
+
+
+def test_tangent_and_two_trajectory_methods_agree_trajectory_by_trajectory():
+    """Benettin's two methods: the tangent (complex step, exact) and a companion 1e-8 away."""
+    y0 = chaos.release_ensemble(*CHAOTIC, 0.005, 6, P, seed=2)
+    integration = chaos.Integration("rk4", h=2e-3)
+    tangent = chaos.lyapunov_benettin(FIELD, y0, 6.0, renorm_interval=0.5, integration=integration)
+    _, two = chaos.lyapunov_two_trajectory(FIELD, y0, 6.0, renorm_interval=0.5, integration=integration)
+    np.testing.assert_allclose(two[-1], tangent.exponents[0], rtol=1e-3)
+    augmented = chaos.lyapunov_benettin(FIELD, y0, 6.0, renorm_interval=0.5, integration=integration, jvp="central")
+    np.testing.assert_allclose(augmented.exponents[0], tangent.exponents[0], rtol=1e-6)
+
+
+def test_lyapunov_exponent_of_a_regular_start_converges_towards_zero():
+    res = chaos.lyapunov_benettin(
+        FIELD,
+        initial_states(0.3, 0.3),
+        40.0,
+        renorm_interval=0.5,
+        integration=chaos.Integration("rk4", h=5e-3),
+    )
+    lam = res.running[:, 0, 0]
+    at = {t: lam[np.argmin(np.abs(res.times - t))] for t in (5.0, 10.0, 20.0, 40.0)}
+    # a quasi-periodic orbit separates linearly: lambda(t) ~ ln(t)/t -> 0
+    assert at[5.0] > at[10.0] > at[20.0] > at[40.0] > 0.0
+    assert at[40.0] < 0.06
+
+
+@pytest.fixture(scope="module")
+def chaotic_estimates():
+    """Largest exponent of the chaotic start, averaged over 64 starts within 5 mm (10 s each)."""
+    y0 = chaos.release_ensemble(*CHAOTIC, 0.005, 64, P, seed=11, include_nominal=True)
+    out = {}
+    for label, integration in {
+        "reference": chaos.Integration("dop853", rtol=1e-10, atol=1e-12),
+        "h": chaos.Integration("rk4", h=2e-3),
+        "h/2": chaos.Integration("rk4", h=1e-3),
+    }.items():
+        res = chaos.lyapunov_benettin(FIELD, y0, 10.0, renorm_interval=0.5, integration=integration)
+        out[label] = res.exponents[0]
+    return out
+
+
+def test_lyapunov_exponent_of_the_chaotic_start_is_positive_and_stable_under_step_halving(chaotic_estimates):
+    ref = chaotic_estimates["reference"].mean()
+    assert ref > 1.0  # 1/s: clearly chaotic (a regular start gives < 0.1 over the same time)
+    for label in ("h", "h/2"):
+        lam = chaotic_estimates[label]
+        assert np.all(lam > 0.0)
+        assert abs(lam.mean() - ref) < 0.10 * ref, label
+
+
+def test_lyapunov_spectrum_pairs_up_and_its_sum_obeys_the_phase_volume_bound():
+    t_end = 20.0
+    res = chaos.lyapunov_benettin(
+        FIELD,
+        initial_states(*CHAOTIC),
+        t_end,
+        renorm_interval=0.5,
+        n_vectors=4,
+        integration=chaos.Integration("rk4", h=2e-3),
+    )
+    lam = res.exponents[:, 0]
+    assert lam[0] > 1.0 and np.all(np.diff(lam) < 0)
+    assert abs(lam[0] + lam[3]) < 0.05 * lam[0]  # (lambda, ..., -lambda)
+    assert abs(lam[1]) < 0.1 * lam[0] and abs(lam[2]) < 0.1 * lam[0]  # the two zeros
+    # |sum| <= ln((m1+m2)/m1) / t at every renormalisation time (exact, up to integration error)
+    total = np.abs(res.running[:, :, 0].sum(axis=1))
+    assert np.all(total <= chaos.spectrum_sum_bound(P, res.times) + 1e-9)
+
+
+def test_lyapunov_exponent_falls_as_damping_drains_the_energy():
+    """Any vector field can be analysed: here joint torques Q = -c omega with c = 5e-4 N m s."""
+    c = 5e-4
+    field = pendulum_field(P, lambda t, y: (-c * y[2], -c * y[3]))
+    y0 = chaos.release_ensemble(*CHAOTIC, 0.005, 8, P, seed=1, include_nominal=True)
+    res = chaos.lyapunov_benettin(field, y0, 40.0, renorm_interval=0.5, integration=chaos.Integration("rk4", h=2e-3))
+    centres, local = chaos.local_exponents(res, 10.0)
+    energy = batch_energy(res.states[-1], P) / chaos.flip_energy_threshold(P)
+    assert np.all(energy < 1.0)  # every member has dropped below the flipping energy
+    mean = local.mean(axis=1)
+    assert centres.tolist() == [5.0, 15.0, 25.0, 35.0]
+    assert mean[0] > 1.0
+    assert mean[-1] < 0.3 and mean[-1] < 0.2 * mean[0]
+
+
+def _starts_on_energy_contour(energy: float, phi1: np.ndarray) -> np.ndarray:
+    """Release angles (phi1, phi2 >= 0) from rest with V(phi1, phi2) = energy, by bisection in phi2."""
+    lo, hi = np.zeros_like(phi1), np.full_like(phi1, math.pi)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        below = batch_potential_energy(phi1, mid, P) < energy
+        lo, hi = np.where(below, mid, lo), np.where(below, hi, mid)
+    return initial_states(phi1, 0.5 * (lo + hi))
+
+
+def test_energetic_bound_on_flipping_is_respected_by_every_trajectory():
+    bound1, bound2 = chaos.flip_energy_bounds(P)
+    assert bound1 == pytest.approx(2 * (P.m1 + P.m2) * P.g * P.l1, rel=1e-15)
+    assert bound2 == pytest.approx(2 * P.m2 * P.g * P.l2, rel=1e-15)
+    fmap = chaos.flip_time_map(32, 32, P, t_max=5.0, max_workers=1)
+    flipped = fmap.rod > 0
+    assert not np.any(flipped & (fmap.energy < bound2))  # nothing flips below the threshold
+    assert not np.any((fmap.rod == 1) & (fmap.energy < bound1))  # rod 1 needs V(pi, 0)
+    # the bound is not vacuous: starts just above it do flip, the map has both outcomes
+    near = (fmap.energy > bound2) & (fmap.energy < 1.5 * bound2)
+    assert np.any(flipped & near) and np.any(~flipped)
+    # starts just below the threshold, along the whole contour, never reach the upright position
+    target = 0.999 * bound2
+    phi1 = np.linspace(-math.pi, math.pi, 2001)
+    phi1 = phi1[batch_potential_energy(phi1, 0.0, P) < target]  # where the contour exists
+    y0 = _starts_on_energy_contour(target, np.linspace(phi1[0], phi1[-1], 40))
+    np.testing.assert_allclose(batch_energy(y0, P), target, rtol=1e-9)
+    times, rods = chaos.first_flip_times(FIELD, y0, 20.0, h=2e-3)
+    assert np.all(rods == 0) and np.all(np.isnan(times))
+
+
+def test_flip_times_are_mirror_symmetric():
+    """(phi1, phi2) -> (-phi1, -phi2) mirrors the motion: the same flip time."""
+    fmap = chaos.flip_time_map(20, 20, P, t_max=3.0, max_workers=1)
+    np.testing.assert_allclose(fmap.time, fmap.time[::-1, ::-1], rtol=1e-9, equal_nan=True)
+
+
+def test_predictability_horizon_grows_by_one_over_lambda_per_e_fold_of_precision(chaotic_estimates):
+    sigmas = np.array([1e-5, 1e-4, 1e-3])
+    groups = [chaos.release_ensemble(*CHAOTIC, s, 60, P, seed=5 + i) for i, s in enumerate(sigmas)]
+    spread = chaos.ensemble_spread(FIELD, groups, P, 6.0, h=2e-3, every=5)
+    horizon = chaos.predictability_horizon(spread.times, spread.spread, 0.01)
+    assert np.all(np.isfinite(horizon)) and np.all(np.diff(horizon) < 0)
+    # t_h ~ ln(d / sigma) / lambda: the slope against ln(sigma) is -1/lambda (finite-time scatter: x2)
+    slope = -np.polyfit(np.log(sigmas), horizon, 1)[0]
+    lam = chaotic_estimates["reference"].mean()
+    assert 0.5 / lam < slope < 2.0 / lam
+    # at release the hanging lower rod moves with the upper bob: both bobs are spread by sigma
+    np.testing.assert_allclose(spread.spread[0], sigmas, rtol=0.25)
+
+
+def test_poincare_points_lie_on_the_section_and_the_energy_surface():
+    energy = float(batch_energy(initial_states(*CHAOTIC), P)[0])
+    starts = chaos.section_starts(energy, np.linspace(-1.0, 1.0, 5), 0.0, P)
+    np.testing.assert_allclose(batch_energy(starts, P), energy, rtol=1e-14)
+    pts, owner = chaos.poincare_section(FIELD, starts, 8.0, h=1e-3)
+    assert pts.shape[0] > 10 and set(owner) <= set(range(starts.shape[1]))
+    np.testing.assert_allclose(pts[:, 0], 0.0, atol=1e-12)
+    assert np.all(pts[:, 2] > 0.0)
+    # cubic Hermite interpolation within a 1 ms RK4 step: energy error O(h^4)
+    np.testing.assert_allclose(batch_energy(pts.T, P), energy, rtol=1e-7)
+
+
+def test_chaos_scenario_writes_results_plots_and_summary(runner, tmp_path):
+    import scenarios.chaos as scenario
+
+    summary = scenario.run(runner, tmp_path, quick=True)
+    written = json.loads((tmp_path / "summary.json").read_text())
+    assert written["lyapunov_per_s"] == pytest.approx(summary["lyapunov_per_s"])
+    assert written["lyapunov_per_s"] > 0.5
+    assert written["flip_map"]["bound_violations"] == 0
+    assert written["fmu_vs_batch_dop853_max_angle_difference_rad_first_2s"] < 1e-6
+    spectrum = written["lyapunov"]["spectrum"]["exponents_per_s"]
+    assert spectrum[0] > 0 > spectrum[3]
+    for name in (
+        "release_traces",
+        "phase_portraits",
+        "ensemble_spread",
+        "ensemble_clouds",
+        "predictability",
+        "lyapunov_convergence",
+        "lyapunov_energy",
+        "lyapunov_spectrum",
+        "lyapunov_friction",
+        "flip_map",
+        "poincare_sections",
+    ):
+        assert (tmp_path / f"{name}.png").stat().st_size > 10_000, name
+    nominal = read_results_csv(tmp_path / "nominal.csv")
+    assert nominal["phi1"][0] == scenario.DEFAULT_START["phi1_0"]
+    fmap = read_results_csv(tmp_path / "flip_map.csv")
+    assert len(fmap) == 24 * 24
+    assert set(np.unique(fmap["flipped_rod"])) <= {0.0, 1.0, 2.0}

@@ -1,0 +1,110 @@
+"""Parameter sweeps of the FMU: local processes, a Dask cluster, determinism, errors, progress."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+
+from double_pendulum import chaos
+from double_pendulum.progress import ProgressLine
+from double_pendulum.runner import FmuRunError
+from double_pendulum.sweep import chunk, grid_cases, random_cases, run_sweep
+
+OPTIONS = {"stop_time": 0.5, "output_interval": 0.05}
+
+
+def _cases() -> list[dict]:
+    return random_cases(5, seed=3, base={"phi2_0": 0.0}, normal={"phi1_0": (2.0, 0.017)}, uniform={"m2": (0.2, 0.4)})
+
+
+def _assert_same(a: list[np.ndarray], b: list[np.ndarray]) -> None:
+    assert len(a) == len(b)
+    for x, y in zip(a, b):
+        assert x.dtype.names == y.dtype.names
+        for name in x.dtype.names:
+            np.testing.assert_array_equal(x[name], y[name])
+
+
+@pytest.fixture(scope="module")
+def serial_results(fmu_path):
+    return run_sweep(fmu_path, _cases(), max_workers=1, **OPTIONS)
+
+
+def test_sweep_on_local_processes_gives_the_direct_runs_in_case_order(fmu_path, runner, serial_results):
+    cases = _cases()
+    parallel = run_sweep(fmu_path, cases, max_workers=2, **OPTIONS)
+    _assert_same(parallel, serial_results)
+    _assert_same(serial_results, [runner.simulate(c, **OPTIONS) for c in cases])
+    # each case really ran with its own start values
+    assert [r["phi1"][0] for r in parallel] == [c["phi1_0"] for c in cases]
+
+
+def test_sweep_on_a_local_dask_cluster_gives_identical_results(fmu_path, serial_results):
+    pytest.importorskip("distributed", reason="dask[distributed] is not installed")
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+        on_dask = run_sweep(fmu_path, _cases(), scheduler=cluster.scheduler_address, **OPTIONS)
+    _assert_same(on_dask, serial_results)
+
+
+def test_random_cases_are_fixed_by_the_seed():
+    a = random_cases(4, seed=7, uniform={"m1": (0.2, 0.4), "l2": (0.1, 0.3)})
+    b = random_cases(4, seed=7, uniform={"l2": (0.1, 0.3), "m1": (0.2, 0.4)})  # order of names irrelevant
+    c = random_cases(4, seed=8, uniform={"m1": (0.2, 0.4), "l2": (0.1, 0.3)})
+    assert a == b and a != c
+    assert all(0.2 <= case["m1"] <= 0.4 and 0.1 <= case["l2"] <= 0.3 for case in a)
+    with pytest.raises(ValueError, match="standard deviation"):
+        random_cases(2, seed=1, normal={"g": (9.81, -1.0)})
+
+
+def test_grid_cases_and_chunks_keep_the_order():
+    cases = grid_cases({"phi2_0": 0.0}, phi1_0=[1.0, 2.0], m2=[0.1, 0.2, 0.3])
+    assert [(c["phi1_0"], c["m2"]) for c in cases] == [
+        (1.0, 0.1),
+        (1.0, 0.2),
+        (1.0, 0.3),
+        (2.0, 0.1),
+        (2.0, 0.2),
+        (2.0, 0.3),
+    ]
+    parts = chunk(list(range(10)), 4)
+    assert [len(p) for p in parts] == [3, 3, 2, 2] and sum(parts, []) == list(range(10))
+
+
+def test_a_failing_case_is_reported_with_its_index_and_the_fmu_message(fmu_path):
+    cases = [{"phi1_0": 1.0}, {"l1": -1.0}]
+    with pytest.raises(FmuRunError, match=r"sweep case 1 .*l1"):
+        run_sweep(fmu_path, cases, max_workers=1, **OPTIONS)
+
+
+def _final_phi2(result: np.ndarray) -> float:
+    return float(result["phi2"][-1])
+
+
+def test_reduce_returns_only_what_is_asked_for(fmu_path, serial_results):
+    reduced = run_sweep(fmu_path, _cases(), max_workers=1, reduce=_final_phi2, **OPTIONS)
+    assert reduced == [float(r["phi2"][-1]) for r in serial_results]
+
+
+def test_batch_work_split_over_processes_is_identical_to_one_batch():
+    serial = chaos.flip_time_map(16, 16, t_max=1.5, max_workers=1)
+    parallel = chaos.flip_time_map(16, 16, t_max=1.5, max_workers=2)
+    assert parallel.workers == 2
+    np.testing.assert_array_equal(parallel.time, serial.time)
+    np.testing.assert_array_equal(parallel.rod, serial.rod)
+
+
+def test_progress_line_counts_and_estimates():
+    stream = io.StringIO()
+    with ProgressLine(4, "sweep", enabled=True, stream=stream, min_interval=0.0) as bar:
+        bar.update(1)
+        assert "sweep: 1/4 (25 %)" in stream.getvalue() and "ETA" in stream.getvalue()
+        bar.update(3)
+    assert stream.getvalue().endswith("\n") and "4/4 (100 %)" in stream.getvalue()
+    quiet = io.StringIO()
+    with ProgressLine(4, "sweep", stream=quiet) as bar:  # not a terminal: silent by default
+        bar.update(4)
+    assert quiet.getvalue() == ""
