@@ -56,7 +56,10 @@ def test_fmu_bundles_the_package_and_lists_runtime_requirements(fmu_path):
         assert "resources/double_pendulum/dynamics.py" in names
         assert "resources/DoublePendulum.py" in names
         assert "pythonfmu" in z.read("resources/requirements.txt").decode()
-        assert not any("__pycache__" in n for n in names)
+        # bytecode only for the FMU's own sources (nothing copied from a local __pycache__)
+        for name in (n for n in names if "__pycache__" in n):
+            folder, cached = name.split("/__pycache__/")
+            assert f"{folder}/{cached.split('.')[0]}.py" in names, name
 
 
 def test_fmu_runs_without_the_project_installed(fmu_path, tmp_path):
@@ -210,3 +213,24 @@ def test_numerical_blow_up_is_reported_not_returned(runner):
         )
     partial = info.value.partial_result
     assert partial is not None and np.all(np.isfinite(partial["E_total"]))
+
+
+def test_repeated_plain_fmpy_runs_with_fresh_extractions_work(fmu_path):
+    """fmpy extracts the FMU anew for every call and deletes it afterwards; the bundled package
+    stays imported from the first extraction, so nothing may be imported lazily from it later."""
+    from fmpy import simulate_fmu
+
+    for solver in ("dop853", "rodas4", "gauss4", "rk4"):
+        r = simulate_fmu(str(fmu_path), stop_time=0.2, start_values={"solver": solver, "fixed_step": 1e-3})
+        assert r["time"][-1] == pytest.approx(0.2)
+
+
+def test_fmu_ships_hash_checked_bytecode(fmu_path):
+    import importlib.util
+
+    with zipfile.ZipFile(fmu_path) as z:
+        names = set(z.namelist())
+        cached = importlib.util.cache_from_source("resources/double_pendulum/dynamics.py")
+        assert cached in names
+        flags = int.from_bytes(z.read(cached)[4:8], "little")
+        assert flags == 0b11  # PEP 552: hash-based, checked against the source

@@ -103,8 +103,32 @@ def complete_model_description(xml_text: bytes) -> bytes:
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
+def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
+    """Return the ``__pycache__`` path and hash-checked bytecode of one Python source in the FMU.
+
+    Hosts extract FMUs without restoring file times, so the bytecode is checked against a hash
+    of the source (PEP 552) rather than its time stamp; a Python of another minor version simply
+    ignores it (other cache tag) and compiles the source as usual.
+    """
+    import importlib.util
+    import py_compile
+
+    with tempfile.TemporaryDirectory() as tmp:
+        src = Path(tmp) / "module.py"
+        src.write_bytes(source)
+        cfile = Path(tmp) / "module.pyc"
+        py_compile.compile(str(src), cfile=str(cfile), dfile=arcname, doraise=True,
+                           invalidation_mode=py_compile.PycInvalidationMode.CHECKED_HASH)
+        cached = importlib.util.cache_from_source(arcname)
+        return cached, cfile.read_bytes()
+
+
 def _rewrite_fmu(fmu: Path) -> None:
-    """Rewrite the zip with the completed modelDescription and requirements.txt."""
+    """Rewrite the zip with the completed modelDescription, bytecode and requirements.txt.
+
+    Precompiled bytecode spares every fresh extraction (fmpy extracts the FMU anew for each
+    ``simulate_fmu`` call) the compilation of the bundled sources at start-up.
+    """
     tmp = fmu.with_suffix(".fmu.tmp")
     with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
         for item in src.infolist():
@@ -112,6 +136,9 @@ def _rewrite_fmu(fmu: Path) -> None:
             if item.filename == "modelDescription.xml":
                 data = complete_model_description(data)
             dst.writestr(item, data, compress_type=zipfile.ZIP_DEFLATED)
+            if item.filename.startswith("resources/") and item.filename.endswith(".py"):
+                cached, code = compiled_bytecode(data, item.filename)
+                dst.writestr(cached, code, compress_type=zipfile.ZIP_DEFLATED)
         dst.writestr("resources/requirements.txt", "\n".join(RUNTIME_REQUIREMENTS) + "\n")
     tmp.replace(fmu)
 

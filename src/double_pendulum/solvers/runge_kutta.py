@@ -28,34 +28,38 @@ import math
 from collections.abc import Callable, Sequence
 
 from . import tableaus as tb
+from .combinations import sparse, step_combination, weighted_sum
 
 VectorField = Callable[[float, list[float]], list[float]]
 SparseRows = Sequence[Sequence[tuple[int, float]]]
 
 
-def _stage_input(
-    y: list[float], h: float, row: Sequence[tuple[int, float]], ks: list[list[float]]
-) -> list[float]:
-    """Return ``y + h * sum_j a_ij k_j`` for one sparse tableau row."""
-    out = list(y)
-    n = len(y)
-    for j, a in row:
-        ha = h * a
-        kj = ks[j]
-        for c in range(n):
-            out[c] += ha * kj[c]
-    return out
+_CONSTANT_KERNELS: dict[tuple[int, int, bool], Callable] = {}
+
+
+def _constant_kernel(row: Sequence, n: int, *, dense_weights: bool = False) -> Callable:
+    """Compiled combination for a *module-level constant* ``row``, cached by its identity (fast).
+
+    Sparse rows ``((j, a_j), ...)`` give ``g(y, h, ks) = y + h sum_j a_j k_j``; dense weights
+    (``dense_weights=True``) give ``g(ks) = sum_j w_j k_j``. Only for rows that live as long as
+    the module (tableau constants), so an identity is never reused for other coefficients.
+    """
+    key = (id(row), n, dense_weights)
+    kernel = _CONSTANT_KERNELS.get(key)
+    if kernel is None:
+        kernel = weighted_sum(sparse(row), n) if dense_weights else step_combination(tuple(row), n)
+        _CONSTANT_KERNELS[key] = kernel
+    return kernel
+
+
+def _stage_input(y: list[float], h: float, row: Sequence[tuple[int, float]], ks: list[list[float]]) -> list[float]:
+    """Return ``y + h * sum_j a_ij k_j`` for one sparse tableau row (any row; cached by content)."""
+    return step_combination(row if isinstance(row, tuple) else tuple(row), len(y))(y, h, ks)
 
 
 def _weighted_sum(ks: list[list[float]], weights: Sequence[float]) -> list[float]:
-    """Return ``sum_j w_j k_j`` over the non-zero weights."""
-    n = len(ks[0])
-    out = [0.0] * n
-    for w, k in zip(weights, ks):
-        if w != 0.0:
-            for c in range(n):
-                out[c] += w * k[c]
-    return out
+    """Return ``sum_j w_j k_j`` over the non-zero weights (any weights; cached by content)."""
+    return weighted_sum(sparse(weights), len(ks[0]))(ks)
 
 
 def _run_stages(
@@ -69,10 +73,23 @@ def _run_stages(
     n_stages: int,
 ) -> list[list[float]]:
     """Evaluate the first ``n_stages`` stage derivatives ``k_0 = fy, k_1, ...``."""
+    stages = _stage_kernels(a, len(y))  # a is a module-level tableau
     ks = [fy]
     for i in range(1, n_stages):
-        ks.append(f(t + c[i] * h, _stage_input(y, h, a[i], ks)))
+        ks.append(f(t + c[i] * h, stages[i](y, h, ks)))
     return ks
+
+
+_KERNELS: dict[tuple[int, int], list] = {}
+
+
+def _stage_kernels(a: SparseRows, n: int) -> list:
+    """Compiled ``y + h sum_j a_ij k_j`` for every row of tableau ``a`` and state size ``n`` (cached)."""
+    key = (id(a), n)
+    kernels = _KERNELS.get(key)
+    if kernels is None:
+        kernels = _KERNELS[key] = [step_combination(tuple(row), n) for row in a]
+    return kernels
 
 
 def _as_row(weights: Sequence[float]) -> tuple[tuple[int, float], ...]:
@@ -83,6 +100,7 @@ def _as_row(weights: Sequence[float]) -> tuple[tuple[int, float], ...]:
 _DOPRI5_B_ROW = _as_row(tb.DOPRI5_B)
 _DOP853_B_ROW = _as_row(tb.DOP853_B)
 _RK4_B_ROW = _as_row(tb.RK4_B)
+_DOPRI5_P_COLUMNS = tuple(tuple(row[k] for row in tb.DOPRI5_P) for k in range(len(tb.DOPRI5_P[0])))
 
 
 def scaled_rms(err: list[float], y: list[float], y_new: list[float], rtol: float, atol: float) -> float:
@@ -107,18 +125,18 @@ class Dopri5:
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
         ks = _run_stages(f, t, y, fy, h, tb.DOPRI5_A, tb.DOPRI5_C, 6)
-        y_new = _stage_input(y, h, _DOPRI5_B_ROW, ks)
+        y_new = _constant_kernel(_DOPRI5_B_ROW, len(y))(y, h, ks)
         f_new = f(t + h, y_new)
         ks.append(f_new)
         return y_new, f_new, ks
 
     def error_norm(self, y, y_new, ks, h, rtol, atol) -> float:
-        err = _weighted_sum(ks, tb.DOPRI5_E)
+        err = _constant_kernel(tb.DOPRI5_E, len(y), dense_weights=True)(ks)
         return scaled_rms([h * e for e in err], y, y_new, rtol, atol)
 
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):
         # y(t + theta h) = y + h * sum_k Q[:, k] theta^(k+1), Q = K^T P
-        q = [_weighted_sum(ks, [row[k] for row in tb.DOPRI5_P]) for k in range(4)]
+        q = [_constant_kernel(column, len(y), dense_weights=True)(ks) for column in _DOPRI5_P_COLUMNS]
 
         def evaluate(theta: float) -> list[float]:
             p1, p2, p3, p4 = theta, theta**2, theta**3, theta**4
@@ -140,14 +158,14 @@ class Dop853:
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
         ks = _run_stages(f, t, y, fy, h, tb.DOP853_A, tb.DOP853_C, 12)
-        y_new = _stage_input(y, h, _DOP853_B_ROW, ks)
+        y_new = _constant_kernel(_DOP853_B_ROW, len(y))(y, h, ks)
         f_new = f(t + h, y_new)
         ks.append(f_new)
         return y_new, f_new, ks
 
     def error_norm(self, y, y_new, ks, h, rtol, atol) -> float:
-        err5 = _weighted_sum(ks, tb.DOP853_E5)
-        err3 = _weighted_sum(ks, tb.DOP853_E3)
+        err5 = _constant_kernel(tb.DOP853_E5, len(y), dense_weights=True)(ks)
+        err3 = _constant_kernel(tb.DOP853_E3, len(y), dense_weights=True)(ks)
         n5 = n3 = 0.0
         for e5, e3, u, v in zip(err5, err3, y, y_new):
             s = atol + rtol * max(abs(u), abs(v))
@@ -160,7 +178,7 @@ class Dop853:
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):
         ks = list(ks)
         for i in (13, 14, 15):
-            ks.append(f(t + tb.DOP853_C[i] * h, _stage_input(y, h, tb.DOP853_A[i], ks)))
+            ks.append(f(t + tb.DOP853_C[i] * h, _constant_kernel(tb.DOP853_A[i], len(y))(y, h, ks)))
         dy = [v - u for u, v in zip(y, y_new)]
         coeffs = [
             dy,
@@ -168,7 +186,7 @@ class Dop853:
             [2.0 * d - h * (a + b) for d, a, b in zip(dy, fy, f_new)],
         ]
         for row in tb.DOP853_D:
-            coeffs.append([h * v for v in _weighted_sum(ks, row)])
+            coeffs.append([h * v for v in _constant_kernel(row, len(y), dense_weights=True)(ks)])
         coeffs.reverse()
         columns = list(zip(*coeffs))  # per component: its 7 coefficients, highest first
         n_coeffs = len(coeffs)
@@ -201,7 +219,7 @@ class ClassicRK4:
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
         ks = _run_stages(f, t, y, fy, h, tb.RK4_A, tb.RK4_C, 4)
-        y_new = _stage_input(y, h, _RK4_B_ROW, ks)
+        y_new = _constant_kernel(_RK4_B_ROW, len(y))(y, h, ks)
         return y_new, f(t + h, y_new), ks
 
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):
