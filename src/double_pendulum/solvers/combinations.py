@@ -15,7 +15,7 @@ is safe to ``exec``.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from functools import lru_cache
+from functools import cache
 
 SparseRow = tuple[tuple[int, float], ...]
 
@@ -32,7 +32,7 @@ def _compile(name: str, args: str, row: SparseRow, body: str) -> Callable:
     return namespace[name]
 
 
-@lru_cache(maxsize=None)
+@cache
 def step_combination(row: SparseRow, n: int) -> Callable[[list[float], float, Sequence[list[float]]], list[float]]:
     """Return ``g(y, h, ks) -> [y_c + sum_j (h a_j) ks[j][c] for c in range(n)]``.
 
@@ -50,7 +50,7 @@ def step_combination(row: SparseRow, n: int) -> Callable[[list[float], float, Se
     return namespace["stage"]
 
 
-@lru_cache(maxsize=None)
+@cache
 def weighted_sum(row: SparseRow, n: int) -> Callable[[Sequence[list[float]]], list[float]]:
     """Return ``g(ks) -> [sum_j w_j ks[j][c] for c in range(n)]``."""
     body = ", ".join(_terms(row, c) for c in range(n))
