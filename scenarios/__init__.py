@@ -9,6 +9,8 @@ SCENARIOS: tuple[str, ...] = (
     "free_swing",
     "friction_budget",
     "energy_decay",
+    "suspension_transfer",
+    "measured_vs_sim",
     "work_precision",
     "stability",
     "chaos",

@@ -448,8 +448,8 @@ def plot_decay_rate_map(
 
     Each panel maps ``k``, ``c`` (1-D) and ``b`` (shape (len(k), len(c))), optionally a finer
     prediction ``k_fine``, ``c_fine``, ``b_fine`` drawn as dotted contours. ``levels`` label the
-    solid/dashed iso-b contours; ``points`` mark (k, c) pairs; ``slope_through`` draws c ~ k^2
-    through a point (the stiff-suspension law).
+    solid/dashed iso-b contours; ``points`` mark (k, c) pairs and ``slope_through`` draws c ~ k^2
+    through a point (the stiff-suspension law), both on the first panel only.
     """
     n = len(panels)
     fig, axes = plt.subplots(1, n, figsize=(6.2 * n, 5.2), squeeze=False)
@@ -468,16 +468,17 @@ def plot_decay_rate_map(
                 ax.contour(p["k_fine"], p["c_fine"], b_fine, levels=[level], colors="r", linestyles=":")
         if "b_fine" in p:
             ax.plot([], [], "r:", label="linear response (fixed-pivot force spectrum)")
-        if slope_through is not None:
+        first = ax is axes[0, 0]
+        if slope_through is not None and first:
             k0, c0 = slope_through
             ks = np.asarray(p["k"], dtype=float)
             ax.plot(ks, c0 * (ks / k0) ** 2, color="orange", lw=1.0, label="c ~ k^2 (stiff limit)")
-        for (label, (k, c)), marker in zip((points or {}).items(), "o^sDv"):
+        for (label, (k, c)), marker in zip((points or {}).items() if first else (), "o^sDv"):
             ax.plot([k], [c], marker, color="r", mec="k", ms=7, label=label)
         ax.set(xscale="log", yscale="log", xlabel="k [N/m]", ylabel="c [N s/m]", title=title)
         ax.set_xlim(np.min(p["k"]) / 1.2, np.max(p["k"]) * 1.2)
         ax.set_ylim(np.min(p["c"]) / 1.5, np.max(p["c"]) * 1.5)
-        ax.legend(loc="lower right", fontsize=7)
+        ax.legend(loc="upper right", fontsize=6)
         fig.colorbar(mesh, ax=ax, label="b [1/s] of E_pendulum")
     return _save(fig, path)
 
@@ -537,27 +538,27 @@ def plot_force_spectrum(
 def plot_energy_flow(
     runs: Mapping[str, np.ndarray], path: str | Path, *, smooth_s: float = 1.0, zoom_s: float = 0.5
 ) -> Path:
-    """How the pendulum's energy reaches the suspension: P_to_suspension [W] (raw and averaged over
-    ``smooth_s``), a zoom on the first ``zoom_s`` seconds, E_suspension [J], and the cumulative
-    budget: pendulum energy lost, W_suspension, W_air, W_bearing and E_suspension + W_suspension [J]."""
+    """How the pendulum's energy reaches the suspension: P_to_suspension [W] averaged over ``smooth_s``
+    and unaveraged over the first ``zoom_s`` seconds, E_suspension [J], and the cumulative budget:
+    pendulum energy lost, W_suspension, W_air + W_bearing and E_suspension + W_suspension [J]."""
     fig, axes = plt.subplots(4, 1, figsize=(11, 13))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for (label, r), col in zip(runs.items(), colours):
         t = r["time"]
         dt = float(t[1] - t[0])
         p = r["P_to_suspension"]
-        axes[0].plot(t, p, color=col, lw=0.3, alpha=0.35)
         mean = _running_mean(p, round(smooth_s / dt))
         axes[0].plot(t, mean, color=col, lw=1.5, label=f"{label} ({smooth_s:g} s mean)")
         z = t <= t[0] + zoom_s
         axes[1].plot(t[z], p[z], color=col, lw=1.0, label=label)
-        axes[2].semilogy(t, np.maximum(r["E_suspension"], 1e-12), color=col, lw=0.5, label=label)
+        e_s = np.asarray(r["E_suspension"])
+        axes[2].semilogy(t, np.maximum(e_s, 1e-4 * e_s.max()), color=col, lw=0.5, label=label)
         axes[3].plot(t, r["E_pendulum"][0] - r["E_pendulum"], color=col, lw=1.5, label=f"{label}: pendulum energy lost")
         axes[3].plot(t, r["W_suspension"], color=col, ls="--", label=f"{label}: W_suspension")
         axes[3].plot(t, r["W_air"] + r["W_bearing"], color=col, ls=":", label=f"{label}: W_air + W_bearing")
         axes[3].plot(t, r["E_suspension"] + r["W_suspension"], color=col, lw=0.6, alpha=0.6)
-    axes[0].set(ylabel="P_to_suspension [W]", title="power from the pendulum into the suspension")
-    axes[1].set(ylabel="P_to_suspension [W]", title=f"first {zoom_s:g} s: exchange at the suspension's frequency")
+    axes[0].set(ylabel="P_to_suspension [W]", title=f"power from the pendulum into the suspension, {smooth_s:g} s mean")
+    axes[1].set(ylabel="P_to_suspension [W]", title=f"first {zoom_s:g} s, unaveraged: energy pumped in and taken back")
     axes[2].set(ylabel="E_suspension [J]", title="energy stored in the suspension")
     axes[3].set(xlabel="t [s]", ylabel="energy [J]", title="cumulative: lost by the pendulum, dissipated "
                 "(thin: E_suspension + W_suspension = integral of P_to_suspension)")

@@ -1,0 +1,99 @@
+"""The suspension scenario: identification reproduces the measured decay, the map obeys the physics."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from double_pendulum.decay_fit import calibrate_error_model, fit_model
+from double_pendulum.measurement import FRAME_INTERVAL, load_track, reconstruct
+from double_pendulum.results_io import read_results_csv
+from double_pendulum.suspension_response import pivot_force_spectrum
+from scenarios import suspension_transfer as st
+from scenarios.friction_budget import SEED_RELEASE
+
+
+@pytest.fixture(scope="module")
+def identified(runner):
+    """The quick identification (first seconds of the track), shared by the tests of this module."""
+    return st.identify_suspension(runner, quick=True)
+
+
+def _measured_b(window_s: float) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, int]:
+    """b of the camera energy after the release over ``window_s`` s, straight from measurement + decay_fit."""
+    rec = reconstruct(load_track())
+    i0 = rec.release_frame
+    idx = np.flatnonzero(rec.free_motion & (rec.t <= rec.t[i0] + window_s))
+    t, e = rec.t[idx], rec.energy[idx]
+    sigma = calibrate_error_model(t, e, rec.sigma_energy[idx], rec.momentum[idx]).sigma
+    return fit_model("exponential", t, e, sigma).value("b"), t, sigma, idx - i0, i0
+
+
+def test_identified_suspension_reproduces_the_measured_decay_rate(runner, identified):
+    b_meas, t, sigma, offsets, i0 = _measured_b(st.QUICK.window_s)
+    assert identified.measured.b == pytest.approx(b_meas, rel=1e-9)
+    t0 = float(t[0])
+    run = runner.simulate(
+        {**st.FIT_SETTINGS, **identified.values},
+        start_time=t0,
+        stop_time=t0 + offsets[-1] * FRAME_INTERVAL,
+        output_interval=FRAME_INTERVAL,
+        outputs=("E_pendulum",),
+    )
+    b_sim = fit_model("exponential", t, run["E_pendulum"][offsets], sigma).value("b")
+    assert b_sim == pytest.approx(b_meas, rel=0.05)
+    # the suspension carries the loss: without it the same start decays at less than a third of the rate
+    no_suspension = {k: v for k, v in identified.values.items() if k != "suspension"}
+    run0 = runner.simulate(
+        {**st.FIT_SETTINGS, **no_suspension},
+        start_time=t0,
+        stop_time=t0 + offsets[-1] * FRAME_INTERVAL,
+        output_interval=FRAME_INTERVAL,
+        outputs=("E_pendulum",),
+    )
+    assert abs(fit_model("exponential", t, run0["E_pendulum"][offsets], sigma).value("b")) < abs(b_meas) / 3
+    ident = identified.identification
+    assert 0.0 < ident.c_stderr < ident.c
+    assert 0.7 < ident.chi2_red < 1.5  # the calibrated errors describe the scatter about the FMU's energy
+
+
+def test_stiff_suspension_loss_scales_as_c_over_k_squared_and_follows_linear_response(runner):
+    n = 151  # 5 s of frames from the seed's release, suspension the only loss
+    frames = st.FitFrames(0.0, np.arange(n), np.arange(n) * FRAME_INTERVAL, None)
+    base = dict(SEED_RELEASE)
+    points = [(1e5, 30.0), (1e5, 90.0), (1e5, 270.0), (2e5, 270.0)]
+    cases = [{**st.MAP_SETTINGS, "suspension": False}]
+    cases += [{**st.MAP_SETTINGS, **st.suspension_values(k, c, 2.0)} for k, c in points]
+    rates = [r["b_E_pendulum"] for r in st.decay_rate_sweep(runner.fmu_path, base, frames, cases, max_workers=1)]
+    assert abs(rates[0]) < 1e-5  # no loss mechanism, no decay
+    b = dict(zip(points, rates[1:]))
+    assert b[(1e5, 30.0)] > b[(1e5, 90.0)] > b[(1e5, 270.0)]  # more damping, faster decay (stiff range)
+    assert b[(1e5, 90.0)] / b[(1e5, 30.0)] == pytest.approx(3.0, rel=0.15)  # ~ c
+    assert b[(1e5, 270.0)] / b[(1e5, 90.0)] == pytest.approx(3.0, rel=0.15)
+    assert b[(1e5, 270.0)] / b[(2e5, 270.0)] == pytest.approx(4.0, rel=0.15)  # ~ 1/k^2
+    spectrum = pivot_force_spectrum(runner, base, 0.0, frames.duration, 0.301 + 0.297, 9.81)
+    for (k, c), rate in b.items():
+        assert rate == pytest.approx(spectrum.linear_response_rate(k, c, 2.0), rel=0.1)
+
+
+def test_quick_run_writes_its_files_and_closes_the_energy_budget(runner, tmp_path):
+    summary = st.run(runner, tmp_path, quick=True)
+    assert json.loads((tmp_path / "summary.json").read_text())["identified"]["c_N_s_per_m"] == pytest.approx(
+        summary["identified"]["c_N_s_per_m"]
+    )
+    table = read_results_csv(tmp_path / "decay_rate_map.csv")
+    assert len(table) == len(st.QUICK.k_grid) * len(st.QUICK.c_grid)
+    assert np.all(table["b_suspension"] < 0)  # a damper only takes energy
+    frames = read_results_csv(tmp_path / "frames.csv")
+    assert np.all(np.diff(frames["E_total_identified"]) <= 1e-8)  # no input: the total energy never rises
+    flow = summary["energy_flow"]["identified"]
+    shares = ("share_W_suspension", "share_W_air", "share_W_bearing", "share_still_in_suspension")
+    assert sum(flow[k] for k in shares) == pytest.approx(1.0, abs=1e-6)
+    assert flow["integral_P_dt_J"] == pytest.approx(flow["E_suspension_gain_plus_W_suspension_J"], rel=0.01)
+    for name in ("decay_rate_map", "decay_rate_cuts", "force_spectrum", "energy_flow", "energy_fit"):
+        assert (tmp_path / f"{name}.png").stat().st_size > 10_000
+    for name in ("identified", "fixed_pivot_force"):
+        assert len(read_results_csv(tmp_path / f"{name}.csv")) > 100
+    assert "curve, not a point" in (tmp_path / "report.md").read_text()
