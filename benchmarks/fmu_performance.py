@@ -10,7 +10,8 @@ Usage: ``python benchmarks/fmu_performance.py [--fmu build/DoublePendulum.fmu] [
 3. FMU start-up (instantiate + initialise, first instance in a fresh process, so including the
    import of the bundled package) versus the empty FMU. Target <= 2.
 4. The stiff suspension (k = 1e7 N/m, M_s = 0.05 kg, 2 s) with the FMU's stiff solver (rodas4)
-   versus SciPy's LSODA called directly, both at rtol = 1e-6 (errors printed). Target <= 1.
+   versus SciPy's LSODA called directly, each at the loosest tolerance whose largest error over
+   the run is <= 1e-5. Target <= 1.
 
 CPU times (``time.process_time``, median of the repeats, spread in brackets). Compare the ratios,
 not the absolute seconds: the machine is shared and noisy.
@@ -37,7 +38,7 @@ from double_pendulum.runner import FmuRunner, ensure_fmu
 CHAOTIC = {"phi1_0": 2.0, "phi2_0": 2.0}
 STIFF = {"phi1_0": 1.0, "phi2_0": 1.0, "suspension": True, "M_s": 0.05, "k_x": 1e7, "k_y": 1e7,
          "c_x": 200.0, "c_y": 200.0}
-RTOLS = (1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 3e-10, 1e-10, 3e-11, 1e-11, 3e-12, 1e-12)
+RTOLS = (1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 3e-10, 1e-10, 3e-11, 1e-11, 3e-12, 1e-12)
 
 EMPTY_SLAVE = '''
 from pythonfmu import Fmi2Causality, Fmi2Slave, Real
@@ -179,16 +180,26 @@ def bench_startup(runner: FmuRunner, empty: FmuRunner, repeats: int) -> float:
 
 def bench_stiff(runner: FmuRunner, repeats: int) -> float:
     ref = reference_solution(STIFF, 2.0, 0.01)
-    start = {**STIFF, "solver": "rodas4", "rtol": 1e-6, "atol": 1e-9}
-    t_fmu, s_fmu, r = timed(lambda: runner.simulate(start, stop_time=2.0, output_interval=0.01,
-                                                    outputs=list(STATE_OUTPUTS)), repeats)
-    err_fmu = max(float(np.max(np.abs(r[n] - ref.states[n]))) for n in STATE_OUTPUTS)
-    t_sp, s_sp, sol = timed(lambda: scipy_run(STIFF, 2.0, "LSODA", 1e-6, 1e-9), repeats)
-    err_sp = max(float(np.max(np.abs(sol.y[i] - ref.states[n]))) for i, n in enumerate(STATE_OUTPUTS))
+
+    def fmu_max_error(rtol: float) -> float:
+        r = runner.simulate({**STIFF, "solver": "rodas4", "rtol": rtol, "atol": rtol * 1e-3}, stop_time=2.0,
+                            output_interval=0.01, outputs=list(STATE_OUTPUTS))
+        return max(float(np.max(np.abs(r[n] - ref.states[n]))) for n in STATE_OUTPUTS)
+
+    def lsoda_max_error(rtol: float) -> float:
+        sol = scipy_run(STIFF, 2.0, "LSODA", rtol, rtol * 1e-3)
+        return max(float(np.max(np.abs(sol.y[i] - ref.states[n]))) for i, n in enumerate(STATE_OUTPUTS))
+
+    target = 1e-5
+    fmu_rtol, err_fmu = loosest(fmu_max_error, target)
+    sp_rtol, err_sp = loosest(lsoda_max_error, target)
+    start = {**STIFF, "solver": "rodas4", "rtol": fmu_rtol, "atol": fmu_rtol * 1e-3}
+    t_fmu, s_fmu, _ = timed(lambda: runner.simulate(start, stop_time=2.0, output_interval=0.01), repeats)
+    t_sp, s_sp, _ = timed(lambda: scipy_run(STIFF, 2.0, "LSODA", sp_rtol, sp_rtol * 1e-3), repeats)
     ratio = t_fmu / t_sp
-    print("4. stiff suspension k = 1e7 N/m, M_s = 0.05 kg, 2 s, rtol 1e-6")
-    print(f"   FMU rodas4 via fmpy: {t_fmu:.3f} s CPU ({s_fmu:.0%}), max error {err_fmu:.1e}")
-    print(f"   scipy LSODA direct:  {t_sp:.3f} s CPU ({s_sp:.0%}), max error {err_sp:.1e}")
+    print(f"4. stiff suspension k = 1e7 N/m, M_s = 0.05 kg, 2 s, max error over the run <= {target:g}")
+    print(f"   FMU rodas4 via fmpy: rtol {fmu_rtol:g}, error {err_fmu:.1e}, {t_fmu:.3f} s CPU ({s_fmu:.0%})")
+    print(f"   scipy LSODA direct:  rtol {sp_rtol:g}, error {err_sp:.1e}, {t_sp:.3f} s CPU ({s_sp:.0%})")
     print(f"   ratio FMU / LSODA = {ratio:.2f}  (target <= 1: {'met' if ratio <= 1 else 'NOT met'})")
     return ratio
 

@@ -74,7 +74,12 @@ class LazyOutputs(Mapping[str, float]):
         self._values: dict[str, float] = {**solver_stats, **(values or {})}
         self._done: set[int] = set() if values is None else set(range(len(OUTPUT_GROUPS)))
 
+    _STATE_INDEX = {"phi1": 0, "phi2": 1, "omega1": 2, "omega2": 3}
+
     def __getitem__(self, name: str) -> float:
+        index = self._STATE_INDEX.get(name)
+        if index is not None and self._y is not None:
+            return self._y[index]
         if name not in self._values:
             group = GROUP_OF[name]  # KeyError for unknown names, as a dict would
             if group not in self._done:

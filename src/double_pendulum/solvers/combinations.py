@@ -60,3 +60,28 @@ def weighted_sum(row: SparseRow, n: int) -> Callable[[Sequence[list[float]]], li
 def sparse(weights: Sequence[float]) -> SparseRow:
     """Turn dense weights into a sparse row ``((j, w_j), ...)`` of the non-zero ones."""
     return tuple((j, float(w)) for j, w in enumerate(weights) if w != 0.0)
+
+
+@cache
+def alternating_horner(n: int, m: int) -> Callable[[float, Sequence[Sequence[float]], Sequence[float]], list[float]]:
+    """Return ``g(x, columns, y)`` evaluating DOP853's dense-output polynomial for ``n`` components.
+
+    For each component with coefficients ``(c_0, ..., c_{m-1})`` (highest first) it computes
+    ``((((c_0 x + c_1)(1-x) + c_2) x + c_3)(1-x) ...) + y`` -- factors alternating ``x`` and
+    ``1 - x`` starting with ``x`` -- in the same order as the equivalent loop.
+    """
+    lines = ["def horner(x, columns, y):", "    u = 1.0 - x"]
+    results = []
+    for c in range(n):
+        names = [f"a{c}_{i}" for i in range(m)]
+        lines.append(f"    {', '.join(names)}{',' if m == 1 else ''} = columns[{c}]")
+        expr = names[0]
+        for i in range(m):
+            if i > 0:
+                expr = f"({expr} + {names[i]})"
+            expr = f"{expr} * {'x' if i % 2 == 0 else 'u'}"
+        results.append(f"{expr} + y[{c}]")
+    lines.append(f"    return [{', '.join(results)}]")
+    namespace: dict = {}
+    exec(compile("\n".join(lines) + "\n", "<horner>", "exec"), namespace)  # noqa: S102 - names only
+    return namespace["horner"]

@@ -28,7 +28,7 @@ import math
 from collections.abc import Callable, Sequence
 
 from . import tableaus as tb
-from .combinations import sparse, step_combination, weighted_sum
+from .combinations import alternating_horner, sparse, step_combination, weighted_sum
 
 VectorField = Callable[[float, list[float]], list[float]]
 SparseRows = Sequence[Sequence[tuple[int, float]]]
@@ -189,19 +189,11 @@ class Dop853:
             coeffs.append([h * v for v in _constant_kernel(row, len(y), dense_weights=True)(ks)])
         coeffs.reverse()
         columns = list(zip(*coeffs))  # per component: its 7 coefficients, highest first
-        n_coeffs = len(coeffs)
+        horner = alternating_horner(len(y), len(coeffs))
 
         def evaluate(theta: float) -> list[float]:
-            # y + F0 x + F1 x(1-x) + F2 x^2(1-x) + ... evaluated Horner-like, alternating x and 1-x
-            one_minus = 1.0 - theta
-            factors = [theta if i % 2 == 0 else one_minus for i in range(n_coeffs)]
-            out = []
-            for column, yc in zip(columns, y):
-                acc = 0.0
-                for cf, factor in zip(column, factors):
-                    acc = (acc + cf) * factor
-                out.append(acc + yc)
-            return out
+            # y + F0 x + F1 x(1-x) + F2 x^2(1-x) + ..., Horner-like with factors alternating x and 1-x
+            return horner(theta, columns, y)
 
         return evaluate
 
