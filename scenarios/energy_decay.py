@@ -24,6 +24,7 @@ import numpy as np
 
 from double_pendulum import plotting
 from double_pendulum.decay_fit import (
+    AUTOCORRELATION_LAG_S,
     MODELS,
     FitResult,
     calibrate_error_model,
@@ -54,8 +55,6 @@ SEED_FIT = {"a_J": 0.813, "a_rel_err": 0.0126, "b_per_s": -0.024, "b_rel_err": 0
 """The seed's exponential fit (section 4.2.5) and its relative errors, for comparison."""
 SEED_TOTAL_MASS_KG = 0.7
 """The seed's total moving mass including the acrylic rods (section 4.2.3) [kg]."""
-AUTOCORRELATION_LAG_S = 1.5
-"""Lag window [s] for the residual autocorrelation: about one slow swing (period 1.31 s)."""
 GAIN_CHECK_OMEGA = (10.0, 20.0, 25.0)
 """Angular frequencies [rad/s] at which the derivative filters' gains are reported."""
 

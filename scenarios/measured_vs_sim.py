@@ -11,7 +11,7 @@ the same through the FMU and goes further:
   :data:`FIT_FRAMES` frames (:func:`double_pendulum.start_state.fit_start_state`), run with the
   identified losses: air drag and bearing friction at the defaults, the suspension's c identified
   from the measured energy decay at the default k and M_s
-  (:func:`scenarios.suspension_transfer.identify_suspension`).
+  (:func:`double_pendulum.suspension_identification.identify_suspension`).
 
 The FMU's positions are relative to the pivot's rest position; the track's are relative to its own
 origin. Both are compared relative to the pivot fitted by the measurement (circle fit of the upper
@@ -54,8 +54,8 @@ from double_pendulum.start_state import (
     state_start_values,
     track_window,
 )
+from double_pendulum.suspension_identification import START_FIT_FRAMES, IdentifiedModel, identify_suspension
 from scenarios.energy_decay import SEED_TOTAL_MASS_KG
-from scenarios.suspension_transfer import START_FIT_FRAMES, IdentifiedModel, identify_suspension
 
 DESCRIPTION = "FMU prediction of the measured track from t0 = 0.8 s: the seed's start and a least-squares start"
 

@@ -31,6 +31,10 @@ Outputs in ``results/suspension_transfer/``: ``decay_rate_map.csv`` (the sweep),
 of the identified suspension and of a resonant one on the same iso-b curve),
 ``fixed_pivot_force.csv``; plots ``decay_rate_map.png``, ``decay_rate_cuts.png``,
 ``force_spectrum.png``, ``energy_flow.png``, ``energy_fit.png``; ``summary.json``; ``report.md``.
+
+The analysis lives in the package: :mod:`double_pendulum.suspension_identification` (measured decay,
+identification of c, its valley, decay shape) and :mod:`double_pendulum.decay_map` (the sweep over
+(k, c, M_s) and its checks against the physics).
 """
 
 from __future__ import annotations
@@ -45,37 +49,44 @@ from typing import Any
 import numpy as np
 
 from double_pendulum import plotting
-from double_pendulum.decay_fit import MODELS, FitResult, calibrate_error_model, effective_sample_factor, fit_model
-from double_pendulum.measurement import FPS, FRAME_INTERVAL, Reconstruction, load_track, reconstruct
-from double_pendulum.parameters import SuspensionParameters
+from double_pendulum.decay_map import (
+    MAP_SETTINGS,
+    MAP_UNITS,
+    DecayMap,
+    crossing,
+    decay_map,
+    linear_response_grid,
+    map_summary,
+    trace_valley,
+)
+from double_pendulum.measurement import FRAME_INTERVAL, load_track, reconstruct
 from double_pendulum.results_io import write_json, write_results_csv, write_text
 from double_pendulum.runner import FmuRunner
-from double_pendulum.start_state import StartStateFit, fit_start_state, track_window
-from double_pendulum.suspension_response import ForceSpectrum, pivot_force_spectrum
-from double_pendulum.sweep import run_sweep
-from scenarios.energy_decay import AUTOCORRELATION_LAG_S, SEED_FIT
+from double_pendulum.suspension_identification import (
+    DEFAULT_SUSPENSION,
+    FIT_SETTINGS,
+    LOSSES,
+    QUICK_WINDOW_S,
+    FitFrames,
+    Identification,
+    MeasuredDecay,
+    decay_shape,
+    identify_suspension,
+    pendulum_values,
+    point_summary,
+    simulate_frames_from,
+    simulated_decay_rate,
+    suspension_values,
+    valley_fisher,
+    window_check,
+)
+from double_pendulum.suspension_response import ForceSpectrum
+from scenarios.energy_decay import SEED_FIT
 
 DESCRIPTION = "decay rate b over suspension stiffness and damping; suspension identified from the measured decay"
 
-LOSSES: dict[str, bool] = {"air_drag": True, "rod_drag": True, "bearing_friction": True}
-"""Air drag on bobs and rods and bearing friction, at their default (the seed's) coefficients."""
-MAP_SETTINGS: dict[str, Any] = {"solver": "dop853", "rtol": 1e-6, "atol": 1e-8}
-"""Sweep tolerances: b is stable to about 1e-6 relative at these (checked against rtol 1e-8)."""
-FIT_SETTINGS: dict[str, Any] = {"solver": "dop853", "rtol": 1e-8, "atol": 1e-10}
-"""Tolerances of the least-squares runs: integration errors (~1e-8 J) far below the energy change of a
-finite-difference step (~1 mJ)."""
-C_DIFF_STEP = 0.01
-"""Finite-difference step in ln c of the damping fit (1 % in c)."""
-C_XTOL = 0.01
-"""Change of ln c [-] at which the damping fit stops (1 % in c, a tenth of its error)."""
 SEED_B = SEED_FIT["b_per_s"]
 """The seed's measured decay rate [1/s]."""
-DEFAULT_SUSPENSION = SuspensionParameters()
-START_FIT_FRAMES = 10
-"""Frames after the release fitted for the start state (1/3 s: long enough for the rates, short
-enough that model error does not yet dominate; see ``measured_vs_sim``)."""
-JACOBIAN_STEP = 0.02
-"""Step in ln k, ln c, ln M_s for the valley's Jacobian columns (2 %)."""
 ENERGY_FLOW_INTERVAL = 0.005
 """Output interval [s] of the energy-flow runs (P_to_suspension oscillates at omega_n)."""
 ENERGY_FLOW_OUTPUTS: tuple[str, ...] = (
@@ -90,18 +101,6 @@ ENERGY_FLOW_OUTPUTS: tuple[str, ...] = (
     "ys",
     "energy_residual",
 )
-MAP_UNITS: dict[str, str] = {
-    "M_s": "kg",
-    "k": "N/m",
-    "c": "N.s/m",
-    "omega_n_x": "rad/s",
-    "omega_n_y": "rad/s",
-    "b_E_pendulum": "1/s",
-    "b_E_total": "1/s",
-    "b_suspension": "1/s",
-    "b_linear_response": "1/s",
-    "b_quasi_static": "1/s",
-}
 
 
 @dataclass(frozen=True)
@@ -141,548 +140,11 @@ QUICK = Plan(
     m_s_main=DEFAULT_SUSPENSION.M_s,
     m_s_extra=(),
     extra_stride=1,
-    window_s=8.0,
+    window_s=QUICK_WINDOW_S,
     valley_k_factors=(),
     window_checks_s=(),
     max_workers=1,
 )
-
-
-# --- measured decay and the frames everything is compared on -------------------------------------
-
-
-@dataclass(frozen=True, eq=False)
-class FitFrames:
-    """Frames on which a decay rate is fitted: ``t0`` [s] of the start frame, ``offsets`` (frames
-    after it), their times ``t`` [s] and energy errors ``sigma`` [J] (None: equal weights)."""
-
-    t0: float
-    offsets: np.ndarray
-    t: np.ndarray
-    sigma: np.ndarray | None
-
-    @property
-    def n_frames(self) -> int:
-        """Frames to simulate (start frame up to the last fitted one)."""
-        return int(self.offsets[-1]) + 1
-
-    @property
-    def duration(self) -> float:
-        """Simulated time [s] from t0 to the last fitted frame."""
-        return (self.n_frames - 1) * FRAME_INTERVAL
-
-
-@dataclass(frozen=True, eq=False)
-class MeasuredDecay:
-    """The measured energy after the release with calibrated errors and its exponential fit.
-
-    ``factor`` is the residual-correlation variance factor of :func:`effective_sample_factor`;
-    ``b_err`` is the fit error of b inflated by sqrt(factor).
-    """
-
-    rec: Reconstruction
-    i0: int
-    frames: FitFrames
-    energy: np.ndarray
-    fit: FitResult
-    factor: float
-
-    @property
-    def b(self) -> float:
-        return self.fit.value("b")
-
-    @property
-    def b_err(self) -> float:
-        return self.fit.error("b") * math.sqrt(self.factor)
-
-
-def measured_decay(rec: Reconstruction, window_s: float | None = None) -> MeasuredDecay:
-    """Exponential fit of the measured energy after the release (as ``energy_decay``), optionally
-    only the first ``window_s`` seconds [s] after it; errors from
-    :func:`~double_pendulum.decay_fit.calibrate_error_model`."""
-    i0 = rec.release_frame
-    mask = rec.free_motion.copy()
-    if window_s is not None:
-        mask &= rec.t <= rec.t[i0] + window_s
-    idx = np.flatnonzero(mask)
-    t, e = rec.t[idx], rec.energy[idx]
-    errors = calibrate_error_model(t, e, rec.sigma_energy[idx], rec.momentum[idx])
-    fit = fit_model("exponential", t, e, errors.sigma)
-    resid = (e - MODELS["exponential"].func(t, *fit.params)) / errors.sigma
-    factor = effective_sample_factor(resid, round(AUTOCORRELATION_LAG_S * FPS))
-    frames = FitFrames(float(rec.t[i0]), idx - i0, t, errors.sigma)
-    return MeasuredDecay(rec, int(i0), frames, e, fit, factor)
-
-
-def simulated_decay_rate(result: np.ndarray, frames: FitFrames, output: str = "E_pendulum") -> float:
-    """b [1/s] of ``E = a exp(b t)`` fitted to a run's ``output`` on ``frames`` (rows = frames after t0)."""
-    energy = np.asarray(result[output])[frames.offsets]
-    return fit_model("exponential", frames.t, energy, frames.sigma).value("b")
-
-
-# --- model values --------------------------------------------------------------------------------
-
-
-def suspension_values(k: float, c: float, m_s: float) -> dict[str, Any]:
-    """FMU start values of an isotropic suspension: k_x = k_y = k [N/m], c_x = c_y = c [N s/m], M_s [kg]."""
-    return {"suspension": True, "k_x": k, "k_y": k, "c_x": c, "c_y": c, "M_s": m_s}
-
-
-def pendulum_values(rec: Reconstruction) -> dict[str, float]:
-    """The measured rod lengths (the masses are the defaults, as in the reconstruction)."""
-    return {"l1": rec.params.l1, "l2": rec.params.l2}
-
-
-def fit_release_state(runner: FmuRunner, rec: Reconstruction, model_values: Mapping[str, Any]) -> StartStateFit:
-    """Least-squares start state at the end of the hand release over :data:`START_FIT_FRAMES` frames."""
-    window = track_window(rec, rec.release_frame, START_FIT_FRAMES)
-    return fit_start_state(
-        runner, window.t0, window.offsets, window.positions, window.sigma_positions, window.guess, model_values
-    )
-
-
-def simulate_frames_from(
-    runner: FmuRunner,
-    values: Mapping[str, Any],
-    frames: FitFrames,
-    settings: Mapping[str, Any] = FIT_SETTINGS,
-    outputs: Sequence[str] = ("E_pendulum", "E_total"),
-    interval: float = FRAME_INTERVAL,
-) -> np.ndarray:
-    """Run the FMU from ``frames.t0`` to the last fitted frame (rows on ``t0 + n interval``)."""
-    return runner.simulate(
-        {**settings, **values},
-        start_time=frames.t0,
-        stop_time=frames.t0 + frames.duration,
-        output_interval=interval,
-        outputs=outputs,
-    )
-
-
-# --- the sweep -----------------------------------------------------------------------------------
-
-
-def sweep_cases(k_grid: Sequence[float], c_grid: Sequence[float], m_s: float) -> list[dict]:
-    """One case per (k, c) (c fastest) at suspension mass ``m_s`` [kg], with the sweep tolerances."""
-    return [{**MAP_SETTINGS, **suspension_values(k, c, m_s)} for k in k_grid for c in c_grid]
-
-
-def decay_rate_sweep(
-    fmu_path: str | Path,
-    base: Mapping[str, Any],
-    frames: FitFrames,
-    cases: Sequence[Mapping[str, Any]],
-    max_workers: int | None = None,
-) -> list[dict[str, float]]:
-    """b of E_pendulum and E_total for every case, run in parallel by :func:`double_pendulum.sweep.run_sweep`.
-
-    run_sweep starts each run at t = 0; the model is autonomous (no explicit time dependence), so
-    this is the run from ``frames.t0`` shifted in time, and row n is frame ``t0 + n / FPS``.
-    """
-    results = run_sweep(
-        fmu_path,
-        [{**base, **case} for case in cases],
-        stop_time=frames.duration,
-        output_interval=FRAME_INTERVAL,
-        outputs=("E_pendulum", "E_total"),
-        max_workers=max_workers,
-    )
-    return [
-        {
-            "b_E_pendulum": simulated_decay_rate(r, frames, "E_pendulum"),
-            "b_E_total": simulated_decay_rate(r, frames, "E_total"),
-        }
-        for r in results
-    ]
-
-
-# --- identification ------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, eq=False)
-class Identification:
-    """Damping c [N s/m] fitted at fixed k [N/m] and M_s [kg] to the measured energy per frame.
-
-    ``c_stderr`` is the Jacobian error inflated by sqrt(``factor``) (residual correlation),
-    ``c_stderr_fit`` the plain one; ``residuals`` are normalised, ``jac_c`` is d r / d c [s m/N].
-    """
-
-    k: float
-    m_s: float
-    c: float
-    c_stderr: float
-    c_stderr_fit: float
-    chi2: float
-    n: int
-    factor: float
-    residuals: np.ndarray
-    jac_c: np.ndarray
-    n_fmu_runs: int
-
-    @property
-    def chi2_red(self) -> float:
-        return self.chi2 / (self.n - 1)
-
-    def values(self) -> dict[str, Any]:
-        """The identified suspension as FMU start values."""
-        return suspension_values(self.k, self.c, self.m_s)
-
-    def as_dict(self) -> dict[str, Any]:
-        return {
-            "k_N_per_m": self.k,
-            "M_s_kg": self.m_s,
-            "c_N_s_per_m": self.c,
-            "c_stderr": self.c_stderr,
-            "c_stderr_uncorrelated": self.c_stderr_fit,
-            "autocorrelation_factor": self.factor,
-            "chi2": self.chi2,
-            "chi2_red": self.chi2_red,
-            "n_frames": self.n,
-            "n_fmu_runs": self.n_fmu_runs,
-        }
-
-
-def energy_residuals(
-    runner: FmuRunner, md: MeasuredDecay, base: Mapping[str, Any], suspension: Mapping[str, Any]
-) -> np.ndarray:
-    """(E_pendulum simulated - E measured) / sigma on the fitted frames."""
-    result = simulate_frames_from(runner, {**base, **suspension}, md.frames, outputs=("E_pendulum",))
-    return (np.asarray(result["E_pendulum"])[md.frames.offsets] - md.energy) / md.frames.sigma
-
-
-@dataclass(frozen=True, eq=False)
-class LeastSquares1D:
-    """Result of :func:`least_squares_1d`: parameter, residuals and Jacobian column there, runs used."""
-
-    x: float
-    residuals: np.ndarray
-    jac: np.ndarray
-    n_runs: int
-
-
-def least_squares_1d(
-    residuals: Any, x0: float, *, rel_step: float, rel_tol: float, bounds: tuple[float, float], max_iterations: int = 12
-) -> LeastSquares1D:
-    r"""Minimise :math:`|r(x)|^2` over one positive parameter x by Gauss-Newton in u = ln x.
-
-    Each iteration evaluates r and the forward difference :math:`J_u = (r(x e^h) - r(x))/h`,
-    h = ``rel_step`` (two FMU runs), steps :math:`\Delta u = -J_u\cdot r / J_u\cdot J_u`, halved
-    while :math:`|r|^2` grows, within ``bounds`` (on x); stops when :math:`|\Delta u| <` ``rel_tol``.
-    Returns x, r(x) and :math:`J = dr/dx = J_u / x` at the last evaluated point.
-    """
-    runs = 0
-
-    def r(u: float) -> np.ndarray:
-        nonlocal runs
-        runs += 1
-        return residuals(math.exp(u))
-
-    lo, hi = math.log(bounds[0]), math.log(bounds[1])
-    u, r0 = math.log(x0), r(math.log(x0))
-    for _ in range(max_iterations):
-        jac = (r(u + rel_step) - r0) / rel_step
-        du = -float(jac @ r0) / float(jac @ jac)
-        if abs(du) < rel_tol:
-            break
-        for _ in range(5):
-            u_new = min(max(u + du, lo), hi)
-            r_new = r(u_new)
-            if r_new @ r_new <= r0 @ r0:
-                break
-            du *= 0.5
-        else:
-            break
-        u, r0 = u_new, r_new
-    return LeastSquares1D(math.exp(u), r0, jac / math.exp(u), runs)
-
-
-C_BOUNDS = (0.1, 1e4)
-"""Range of c [N s/m] the damping fit may search."""
-
-
-def identify_damping(
-    runner: FmuRunner, md: MeasuredDecay, base: Mapping[str, Any], k: float, m_s: float, c_guess: float
-) -> Identification:
-    r"""Least squares of E_pendulum against the measured energy over c (k, M_s fixed).
-
-    :math:`\chi^2(c) = \sum_i (E^{FMU}_i(c) - E_i)^2/\sigma_i^2` with the calibrated errors,
-    minimised by :func:`least_squares_1d`;
-    :math:`\sigma_c^2 = F / (J^T J)` with J = d r / d c at the optimum and F the
-    residual-correlation factor (:func:`~double_pendulum.decay_fit.effective_sample_factor`).
-    """
-
-    def residuals(c: float) -> np.ndarray:
-        return energy_residuals(runner, md, base, suspension_values(k, c, m_s))
-
-    gn = least_squares_1d(residuals, c_guess, rel_step=C_DIFF_STEP, rel_tol=C_XTOL, bounds=C_BOUNDS)
-    factor = effective_sample_factor(gn.residuals, round(AUTOCORRELATION_LAG_S * FPS))
-    s_c = 1.0 / math.sqrt(float(gn.jac @ gn.jac))
-    return Identification(
-        k=k,
-        m_s=m_s,
-        c=gn.x,
-        c_stderr=s_c * math.sqrt(factor),
-        c_stderr_fit=s_c,
-        chi2=float(gn.residuals @ gn.residuals),
-        n=len(gn.residuals),
-        factor=factor,
-        residuals=gn.residuals,
-        jac_c=gn.jac,
-        n_fmu_runs=gn.n_runs,
-    )
-
-
-def guess_damping(spectrum: ForceSpectrum, b_target_susp: float, k: float, m_s: float) -> float:
-    """c [N s/m] at which the linear response gives the suspension share ``b_target_susp`` [1/s].
-
-    Searched on a logarithmic grid of c on the rising (under-damped) side; the default c if none fits.
-    """
-    cs = np.geomspace(0.1, 1e4, 200)
-    rates = np.array([spectrum.linear_response_rate(k, c, m_s) for c in cs])
-    below = np.flatnonzero(rates <= b_target_susp)
-    if len(below) == 0 or below[0] == 0:
-        return DEFAULT_SUSPENSION.c_x
-    i = below[0]
-    x = np.interp(b_target_susp, [rates[i], rates[i - 1]], [math.log(cs[i]), math.log(cs[i - 1])])
-    return float(math.exp(x))
-
-
-@dataclass(frozen=True)
-class IdentifiedModel:
-    """Everything another scenario needs to run the identified pendulum (lengths, losses, suspension)."""
-
-    values: dict[str, Any]
-    start: StartStateFit
-    identification: Identification
-    measured: MeasuredDecay
-    spectrum: ForceSpectrum
-
-
-def identify_suspension(
-    runner: FmuRunner,
-    rec: Reconstruction | None = None,
-    *,
-    quick: bool = False,
-    k: float = DEFAULT_SUSPENSION.k_x,
-    m_s: float = DEFAULT_SUSPENSION.M_s,
-) -> IdentifiedModel:
-    """Fit the release state and the damping c at fixed k, M_s (defaults: the parameter defaults).
-
-    The cheap path other scenarios use: no sweep; the start of the c iteration comes from the linear
-    response. ``quick`` fits only the first :data:`QUICK` window seconds.
-    """
-    rec = reconstruct(load_track()) if rec is None else rec
-    md = measured_decay(rec, QUICK.window_s if quick else FULL.window_s)
-    model = {**pendulum_values(rec), **LOSSES}
-    start = fit_release_state(runner, rec, {**model, "suspension": True})
-    base = {**model, **start.start_values()}
-    m12 = rec.params.m1 + rec.params.m2
-    spectrum = pivot_force_spectrum(runner, base, md.frames.t0, md.frames.duration, m12, rec.params.g)
-    base_rate = simulated_decay_rate(simulate_frames_from(runner, base, md.frames), md.frames)
-    c_guess = guess_damping(spectrum, md.b - base_rate, k, m_s)
-    ident = identify_damping(runner, md, base, k, m_s, c_guess)
-    return IdentifiedModel({**base, **ident.values()}, start, ident, md, spectrum)
-
-
-# --- the map -------------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True, eq=False)
-class DecayMap:
-    """Simulated decay rates on a (k, c) grid at one suspension mass, with the linear-response ones.
-
-    Arrays have shape (len(k), len(c)); ``b_base`` [1/s] is the rate without suspension.
-    """
-
-    m_s: float
-    k: np.ndarray
-    c: np.ndarray
-    b: np.ndarray
-    b_total: np.ndarray
-    b_linear: np.ndarray
-    b_quasi_static: np.ndarray
-    b_base: float
-
-    @property
-    def b_suspension(self) -> np.ndarray:
-        """The suspension's share b - b_base [1/s]."""
-        return self.b - self.b_base
-
-    def rows(self, m12: float) -> list[dict[str, float]]:
-        """One row per grid point for the CSV table (:data:`MAP_UNITS`)."""
-        out = []
-        for i, k in enumerate(self.k):
-            for j, c in enumerate(self.c):
-                out.append(
-                    {
-                        "M_s": self.m_s,
-                        "k": k,
-                        "c": c,
-                        "omega_n_x": math.sqrt(k / self.m_s),
-                        "omega_n_y": math.sqrt(k / (self.m_s + m12)),
-                        "b_E_pendulum": self.b[i, j],
-                        "b_E_total": self.b_total[i, j],
-                        "b_suspension": self.b_suspension[i, j],
-                        "b_linear_response": self.b_base + self.b_linear[i, j],
-                        "b_quasi_static": self.b_base + self.b_quasi_static[i, j],
-                    }
-                )
-        return out
-
-
-def decay_map(
-    fmu_path: str | Path,
-    base: Mapping[str, Any],
-    frames: FitFrames,
-    spectrum: ForceSpectrum,
-    k_grid: Sequence[float],
-    c_grid: Sequence[float],
-    m_s: float,
-    max_workers: int | None = None,
-) -> DecayMap:
-    """Sweep (k, c) at ``m_s`` through the FMU (plus one run without suspension) and predict each point."""
-    cases = [{**MAP_SETTINGS, "suspension": False}] + sweep_cases(k_grid, c_grid, m_s)
-    rates = decay_rate_sweep(fmu_path, base, frames, cases, max_workers)
-    shape = (len(k_grid), len(c_grid))
-    k_arr, c_arr = np.asarray(k_grid, dtype=float), np.asarray(c_grid, dtype=float)
-    return DecayMap(
-        m_s=m_s,
-        k=k_arr,
-        c=c_arr,
-        b=np.array([r["b_E_pendulum"] for r in rates[1:]]).reshape(shape),
-        b_total=np.array([r["b_E_total"] for r in rates[1:]]).reshape(shape),
-        b_linear=np.array([[spectrum.linear_response_rate(k, c, m_s) for c in c_arr] for k in k_arr]),
-        b_quasi_static=np.array([[spectrum.quasi_static_rate(k, c) for c in c_arr] for k in k_arr]),
-        b_base=rates[0]["b_E_pendulum"],
-    )
-
-
-def linear_response_grid(
-    spectrum: ForceSpectrum,
-    b_base: float,
-    k_range: tuple[float, float],
-    c_range: tuple[float, float],
-    m_s: float,
-    n: int,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """b_base + linear-response share on an n x n logarithmic grid (for smooth predicted contours)."""
-    ks = np.geomspace(*k_range, n)
-    cs = np.geomspace(*c_range, n)
-    return ks, cs, b_base + np.array([[spectrum.linear_response_rate(k, c, m_s) for c in cs] for k in ks])
-
-
-def crossing(x: np.ndarray, y: np.ndarray, level: float) -> float | None:
-    """First x (log-interpolated) where y crosses ``level`` going along x, or None."""
-    d = y - level
-    for i in range(len(x) - 1):
-        if d[i] == 0.0:
-            return float(x[i])
-        if d[i] * d[i + 1] < 0.0:
-            f = d[i] / (d[i] - d[i + 1])
-            return float(math.exp(math.log(x[i]) + f * (math.log(x[i + 1]) - math.log(x[i]))))
-    return None
-
-
-def row_crossings(c: np.ndarray, b: np.ndarray, level: float) -> list[tuple[float, str]]:
-    """Every c where b(c) at fixed k crosses ``level``, with the branch: "rising" where the loss grows
-    with c through the crossing (under-damped side), "falling" where it shrinks (overdamped side)."""
-    d = b - level
-    return [
-        (crossing(c[j : j + 2], b[j : j + 2], level), "rising" if d[j] > 0 else "falling")
-        for j in range(len(c) - 1)
-        if d[j] * d[j + 1] < 0.0
-    ]
-
-
-def contour_points(dmap: DecayMap, level: float) -> list[dict[str, Any]]:
-    """Along each row (fixed k) of the map, the c values where b crosses ``level``: the iso-b curve."""
-    return [
-        {"k": float(k), "c": c, "branch": branch}
-        for k, row in zip(dmap.k, dmap.b)
-        for c, branch in row_crossings(dmap.c, row, level)
-    ]
-
-
-def monotonic_rows(dmap: DecayMap) -> dict[str, Any]:
-    """Where b falls (grows in magnitude) monotonically with c: per k, the range of c before |b| peaks."""
-    out = {}
-    for i, k in enumerate(dmap.k):
-        j_peak = int(np.argmin(dmap.b[i]))
-        rising = bool(np.all(np.diff(dmap.b[i, : j_peak + 1]) < 0.0))
-        out[f"{k:.0f}"] = {"c_at_largest_loss": float(dmap.c[j_peak]), "monotonic_below_it": rising}
-    return out
-
-
-# --- the valley of the identification ------------------------------------------------------------
-
-
-def valley_fisher(
-    runner: FmuRunner, md: MeasuredDecay, base: Mapping[str, Any], ident: Identification
-) -> dict[str, Any]:
-    r"""Jacobian of the energy residuals in (ln k, ln c, ln M_s) at the identified point and what it says.
-
-    Columns by forward differences of :data:`JACOBIAN_STEP` (ln c: the fit's own, times c). The
-    Fisher matrix :math:`F = J^T J`; the covariance of (ln k, ln c) with k free too is
-    :math:`f\,(F_{kc})^{-1}` (f the correlation factor). Along the valley the residuals do not change
-    to first order: :math:`d\ln c/d\ln k = -J_k\cdot J_c / J_c\cdot J_c` (the stiff limit b ~ c/k^2
-    would give 2).
-    """
-    r0 = ident.residuals
-    cols = {"ln_c": ident.jac_c * ident.c}
-    for name, k, m_s in (
-        ("ln_k", ident.k * math.exp(JACOBIAN_STEP), ident.m_s),
-        ("ln_M_s", ident.k, ident.m_s * math.exp(JACOBIAN_STEP)),
-    ):
-        cols[name] = (energy_residuals(runner, md, base, suspension_values(k, ident.c, m_s)) - r0) / JACOBIAN_STEP
-    names = ("ln_k", "ln_c", "ln_M_s")
-    jac = np.column_stack([cols[n] for n in names])
-    fisher = jac.T @ jac
-    cov_kc = ident.factor * np.linalg.inv(fisher[:2, :2])
-    eigval, eigvec = np.linalg.eigh(fisher)
-    jk, jc = cols["ln_k"], cols["ln_c"]
-    return {
-        "parameters": list(names),
-        "fisher": fisher.tolist(),
-        "eigenvalues": eigval.tolist(),
-        "weakest_direction": dict(zip(names, eigvec[:, 0].tolist())),
-        "cov_ln_k_ln_c_with_k_free": cov_kc.tolist(),
-        "stderr_ln_k_with_k_free": math.sqrt(cov_kc[0, 0]),
-        "stderr_ln_c_with_k_free": math.sqrt(cov_kc[1, 1]),
-        "correlation_ln_k_ln_c": cov_kc[0, 1] / math.sqrt(cov_kc[0, 0] * cov_kc[1, 1]),
-        "valley_slope_dlnc_dlnk": -float(jk @ jc) / float(jc @ jc),
-        "stiff_limit_slope": 2.0,
-        "sensitivity_ratio_M_s_to_c": math.sqrt(fisher[2, 2] / fisher[1, 1]),
-        "cos_angle_ln_k_ln_M_s": fisher[0, 2] / math.sqrt(fisher[0, 0] * fisher[2, 2]),
-    }
-
-
-def trace_valley(
-    runner: FmuRunner,
-    md: MeasuredDecay,
-    base: Mapping[str, Any],
-    ident: Identification,
-    dmap: DecayMap,
-    factors: Sequence[float],
-) -> list[Identification]:
-    """Fit c again at k = factor * k_identified (same M_s): how chi2 runs along the iso-b valley.
-
-    Each fit starts from the map's iso-b crossing on that row (interpolated in ln k), else from the
-    identified c.
-    """
-    out = []
-    for factor in factors:
-        k = ident.k * factor
-        rising = [c for c, branch in contour_points_at(dmap, k, md.b) if branch == "rising"]
-        out.append(identify_damping(runner, md, base, k, ident.m_s, rising[0] if rising else ident.c))
-    return out
-
-
-def contour_points_at(dmap: DecayMap, k: float, level: float) -> list[tuple[float, str]]:
-    """Iso-b crossings (c, branch) at stiffness ``k`` [N/m], the map's rows interpolated in ln k."""
-    lk = np.log(dmap.k)
-    i = int(np.clip(np.searchsorted(lk, math.log(k)) - 1, 0, len(lk) - 2))
-    f = (math.log(k) - lk[i]) / (lk[i + 1] - lk[i])
-    return row_crossings(dmap.c, (1.0 - f) * dmap.b[i] + f * dmap.b[i + 1], level)
 
 
 # --- energy flow ---------------------------------------------------------------------------------
@@ -735,92 +197,6 @@ def energy_flow_summary(result: np.ndarray) -> dict[str, float]:
     }
 
 
-# --- checks of the map against the physics -------------------------------------------------------
-
-
-def law_agreement(
-    share: np.ndarray,
-    predicted: np.ndarray,
-    k: np.ndarray,
-    c: np.ndarray,
-    tol: float,
-    region: np.ndarray | None = None,
-) -> dict:
-    """Cells (within ``region``, a mask; default all) where the FMU's suspension share is within ``tol``
-    (relative) of a prediction: the ratio table, how many, their k and c ranges, the largest share there."""
-    region = np.ones(share.shape, dtype=bool) if region is None else region
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = share / predicted
-    ok = (np.abs(ratio - 1.0) <= tol) & region
-    ki, ci = np.nonzero(ok)
-    return {
-        "ratio_fmu_to_prediction": ratio.tolist(),
-        "tolerance": tol,
-        "n_cells_within": int(ok.sum()),
-        "n_cells": int(region.sum()),
-        "k_range_within_N_per_m": [float(k[ki].min()), float(k[ki].max())] if ok.any() else None,
-        "c_range_within_N_s_per_m": [float(c[ci].min()), float(c[ci].max())] if ok.any() else None,
-        "largest_share_within_per_s": float(np.max(-share[ok])) if ok.any() else None,
-        "rows_within": {f"{kk:.0f}": [float(cc) for cc, o in zip(c, row) if o] for kk, row in zip(k, ok)},
-    }
-
-
-def reach(dmap: DecayMap, level: float) -> dict[str, Any]:
-    """Largest loss (most negative b) per k over the c grid, and the stiffest k whose best c reaches ``level``."""
-    best = dmap.b.min(axis=1)
-    reached = dmap.k[best <= level]
-    return {
-        "most_negative_b_per_k": {f"{k:.0f}": float(b) for k, b in zip(dmap.k, best)},
-        "c_of_most_negative_b": {f"{k:.0f}": float(dmap.c[j]) for k, j in zip(dmap.k, dmap.b.argmin(axis=1))},
-        "stiffest_k_reaching_N_per_m": float(reached.max()) if reached.size else None,
-    }
-
-
-STIFF_RATIO = 3.0
-"""Stiff region: natural frequencies at least this many times the force's rms frequency, and the
-spring force at least this many times the damper force at that frequency."""
-
-
-def stiff_region(dmap: DecayMap, spectrum: ForceSpectrum) -> np.ndarray:
-    r"""Mask of the cells where the suspension is "much stiffer than the pendulum".
-
-    With the force's rms frequency :math:`\omega_F = \sqrt{\langle|\dot F|^2\rangle/\langle F^2\rangle}`:
-    :math:`\sqrt{k/M_y} \ge` :data:`STIFF_RATIO` :math:`\omega_F` (M_y the larger mass) and
-    :math:`k \ge` :data:`STIFF_RATIO` :math:`c\,\omega_F`.
-    """
-    var_x, var_y = spectrum.force_variances()
-    w_f = math.sqrt(spectrum.fdot_squared / (var_x + var_y))
-    m_y = spectrum.masses(dmap.m_s)[1]
-    k, c = np.meshgrid(dmap.k, dmap.c, indexing="ij")
-    return (np.sqrt(k / m_y) >= STIFF_RATIO * w_f) & (k >= STIFF_RATIO * c * w_f)
-
-
-def map_summary(dmap: DecayMap, spectrum: ForceSpectrum, md: MeasuredDecay) -> dict[str, Any]:
-    """The map, its iso-b curves (measured and seed b), reach, monotonicity and the law checks.
-
-    The stiff-limit law is checked in the stiff region only (:func:`stiff_region`).
-    """
-    stiff = stiff_region(dmap, spectrum)
-    return {
-        "M_s_kg": dmap.m_s,
-        "k_N_per_m": dmap.k.tolist(),
-        "c_N_s_per_m": dmap.c.tolist(),
-        "b_base_no_suspension_per_s": dmap.b_base,
-        "b_E_pendulum": dmap.b.tolist(),
-        "max_abs_b_E_pendulum_minus_b_E_total": float(np.max(np.abs(dmap.b - dmap.b_total))),
-        "iso_b_measured": contour_points(dmap, md.b),
-        "iso_b_seed": contour_points(dmap, SEED_B),
-        "reach_measured_b": reach(dmap, md.b),
-        "monotonic_in_c": monotonic_rows(dmap),
-        "linear_response": law_agreement(dmap.b_suspension, dmap.b_linear, dmap.k, dmap.c, 0.25),
-        "stiff_region": {"natural_frequency_over_force_frequency": STIFF_RATIO, "k_over_c_omega_F": STIFF_RATIO,
-                         "n_cells": int(stiff.sum())},
-        "quasi_static_c_over_k2": law_agreement(
-            dmap.b_suspension, dmap.b_quasi_static, dmap.k, dmap.c, 0.2, stiff
-        ),
-    }
-
-
 def spectrum_summary(spectrum: ForceSpectrum, ident: Identification) -> dict[str, Any]:
     """Force statistics, the identified suspension's natural frequencies and the three limits there."""
     var_x, var_y = spectrum.force_variances()
@@ -845,9 +221,7 @@ def spectrum_summary(spectrum: ForceSpectrum, ident: Identification) -> dict[str
 def _table(rows: Sequence[Mapping[str, float]]) -> np.ndarray:
     """Rows of equal keys as a structured array (for :func:`write_results_csv`)."""
     names = list(rows[0])
-    return np.rec.fromarrays([np.array([r[n] for r in rows], dtype=float) for n in names], names=names).view(
-        np.ndarray
-    )
+    return np.rec.fromarrays([np.array([r[n] for r in rows], dtype=float) for n in names], names=names).view(np.ndarray)
 
 
 FRAME_UNITS = {
@@ -940,7 +314,13 @@ def _plots(
     sigma = np.full(len(full_t), np.nan)
     sigma[used] = md.frames.sigma
     plotting.plot_energy_decay(
-        full_t, md.rec.energy, sigma, curves, t_curve, out_dir / "energy_fit.png", used=used,
+        full_t,
+        md.rec.energy,
+        sigma,
+        curves,
+        t_curve,
+        out_dir / "energy_fit.png",
+        used=used,
         residual_curve="FMU, identified",
     )
 
@@ -952,36 +332,6 @@ def _resonant_point(main: DecayMap, level: float) -> tuple[float, float] | None:
     """(k, c) where the lightest-damped column of the map crosses ``level``: the resonant end of the curve."""
     k = crossing(main.k, main.b[:, 0], level)
     return None if k is None else (k, float(main.c[0]))
-
-
-def decay_shape(t: np.ndarray, energy: np.ndarray, sigma: np.ndarray | None, factor: float = 1.0) -> dict[str, float]:
-    """Exponent p of dE/dt = -k E^p fitted to E(t) [J] (``decay_fit`` model ``power``), error x sqrt(factor)."""
-    fit = fit_model("power", t, energy, sigma)
-    return {"p": fit.value("p"), "p_stderr": fit.error("p") * math.sqrt(factor)}
-
-
-def _point_summary(md: MeasuredDecay, fit: Identification, reference_chi2: float) -> dict[str, Any]:
-    """A fitted (k, c) with its chi2 difference to the reference, b and p of its simulated energy."""
-    energy = md.energy + fit.residuals * md.frames.sigma  # the simulated E_pendulum on the frames
-    b = fit_model("exponential", md.frames.t, energy, md.frames.sigma).value("b")
-    return {
-        **fit.as_dict(),
-        "delta_chi2": fit.chi2 - reference_chi2,
-        "delta_chi2_over_factor": (fit.chi2 - reference_chi2) / fit.factor,
-        "b_per_s": b,
-        "b_relative_to_measured": (b - md.b) / md.b,
-        "p": decay_shape(md.frames.t, energy, md.frames.sigma)["p"],
-    }
-
-
-def window_check(
-    runner: FmuRunner, rec: Reconstruction, base: Mapping[str, Any], ident: Identification, window_s: float
-) -> dict[str, Any]:
-    """The damping fitted to the first ``window_s`` seconds only: one c should describe every window."""
-    md = measured_decay(rec, window_s)
-    fit = identify_damping(runner, md, base, ident.k, ident.m_s, ident.c)
-    return {"window_s": window_s, "measured_b_per_s": md.b, "measured_b_stderr": md.b_err,
-            **_point_summary(md, fit, fit.chi2)}
 
 
 def _measured_summary(md: MeasuredDecay) -> dict[str, Any]:
@@ -1036,8 +386,7 @@ def _sweep_maps(
 ) -> list[DecayMap]:
     """The main (k, c) map at plan.m_s_main and coarser ones (every extra_stride-th value) at the other masses."""
     maps = [
-        decay_map(runner.fmu_path, base, md.frames, spectrum, plan.k_grid, plan.c_grid, plan.m_s_main,
-                  plan.max_workers)
+        decay_map(runner.fmu_path, base, md.frames, spectrum, plan.k_grid, plan.c_grid, plan.m_s_main, plan.max_workers)
     ]
     k_grid, c_grid = plan.k_grid[:: plan.extra_stride], plan.c_grid[:: plan.extra_stride]
     for m_s in plan.m_s_extra:
@@ -1096,16 +445,16 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "settings": {"map": MAP_SETTINGS, "fits": FIT_SETTINGS, "losses": LOSSES},
         "measured": _measured_summary(md),
         "start_state": model.start.as_dict(),
-        "identified": {**_point_summary(md, ident, ident.chi2), "fixed": {"k": ident.k, "M_s": ident.m_s}},
+        "identified": {**point_summary(md, ident, ident.chi2), "fixed": {"k": ident.k, "M_s": ident.m_s}},
         "refit": {label: _run_summary(md, r, ident.chi2) for label, r in runs.items()},
         "valley": {
             "fisher": valley_fisher(runner, md, base, ident),
-            "trace": [_point_summary(md, f, ident.chi2) for f in trace],
+            "trace": [point_summary(md, f, ident.chi2) for f in trace],
             "resonant_end": None if resonant is None else _resonant_summary(resonant, plan.m_s_main, spectrum),
         },
         "window_checks": [window_check(runner, rec, base, ident, w) for w in plan.window_checks_s],
         "spectrum": spectrum_summary(spectrum, ident),
-        "maps": [map_summary(d, spectrum, md) for d in maps],
+        "maps": [map_summary(d, spectrum, md, SEED_B) for d in maps],
         "energy_flow": {label: energy_flow_summary(f) for label, f in flows.items()},
         "map_runs": int(sum(d.b.size + 1 for d in maps)),
         "map_wall_time_s": map_wall,
@@ -1241,8 +590,10 @@ def _branches_text(s: Mapping[str, Any]) -> str:
         f"No c on the grid reaches the measured b above k = {_g(stiffest, '.3g')} N/m: at fixed k the loss peaks at "
         f"c ~ k/omega (c of the largest loss per k: {c_best}) and that peak falls with k. The stiffest k that still "
         f"reaches it per suspension mass: "
-        + ", ".join(f"{m['M_s_kg']:g} kg: {_g(m['reach_measured_b']['stiffest_k_reaching_N_per_m'], '.3g')} N/m"
-                    for m in s["maps"])
+        + ", ".join(
+            f"{m['M_s_kg']:g} kg: {_g(m['reach_measured_b']['stiffest_k_reaching_N_per_m'], '.3g')} N/m"
+            for m in s["maps"]
+        )
         + " (a heavier suspension has lower natural frequencies at the same k)."
     )
     return " ".join(out)
@@ -1264,11 +615,15 @@ def _identification_section(s: Mapping[str, Any]) -> str:
         for t in trace
     )
     res = v["resonant_end"]
-    res_text = "" if res is None else (
-        f"The resonant end of the curve (k = {res['k_N_per_m']:.3g} N/m, c = {res['c_N_s_per_m']:g} N s/m) fits "
-        f"worse: chi2 = {s['refit']['resonant']['chi2']:.0f} "
-        f"({s['refit']['resonant']['delta_chi2']:+.0f}); its loss depends even more steeply on the amplitude "
-        f"(p = {s['refit']['resonant']['p']:.2f})."
+    res_text = (
+        ""
+        if res is None
+        else (
+            f"The resonant end of the curve (k = {res['k_N_per_m']:.3g} N/m, c = {res['c_N_s_per_m']:g} N s/m) fits "
+            f"worse: chi2 = {s['refit']['resonant']['chi2']:.0f} "
+            f"({s['refit']['resonant']['delta_chi2']:+.0f}); its loss depends even more steeply on the amplitude "
+            f"(p = {s['refit']['resonant']['p']:.2f})."
+        )
     )
     return f"""## Identification
 
@@ -1329,8 +684,10 @@ def _refit_section(s: Mapping[str, Any]) -> str:
         for w in s["window_checks"]
     )
     i = s["identified"]
-    whole = (f"| whole record | {m['b_per_s']:.5f} +- {m['b_per_s_stderr_autocorr']:.5f} | {i['c_N_s_per_m']:.1f} +- "
-             f"{i['c_stderr']:.1f} | {i['b_per_s']:.5f} | {100 * i['b_relative_to_measured']:+.1f} % |")
+    whole = (
+        f"| whole record | {m['b_per_s']:.5f} +- {m['b_per_s_stderr_autocorr']:.5f} | {i['c_N_s_per_m']:.1f} +- "
+        f"{i['c_stderr']:.1f} | {i['b_per_s']:.5f} | {100 * i['b_relative_to_measured']:+.1f} % |"
+    )
     return f"""## Refit: does the identified suspension reproduce b?
 
 The identified parameters run again through the FMU and b fitted on the same frames with the same

@@ -8,8 +8,10 @@ import numpy as np
 import pytest
 
 from double_pendulum.decay_fit import calibrate_error_model, fit_model
+from double_pendulum.decay_map import MAP_SETTINGS, decay_rate_sweep
 from double_pendulum.measurement import FRAME_INTERVAL, load_track, reconstruct
 from double_pendulum.results_io import read_results_csv
+from double_pendulum.suspension_identification import FIT_SETTINGS, FitFrames, identify_suspension, suspension_values
 from double_pendulum.suspension_response import pivot_force_spectrum
 from scenarios import suspension_transfer as st
 from scenarios.friction_budget import SEED_RELEASE
@@ -18,7 +20,7 @@ from scenarios.friction_budget import SEED_RELEASE
 @pytest.fixture(scope="module")
 def identified(runner):
     """The quick identification (first seconds of the track), shared by the tests of this module."""
-    return st.identify_suspension(runner, quick=True)
+    return identify_suspension(runner, quick=True)
 
 
 def _measured_b(window_s: float) -> tuple[float, np.ndarray, np.ndarray, np.ndarray, int]:
@@ -36,7 +38,7 @@ def test_identified_suspension_reproduces_the_measured_decay_rate(runner, identi
     assert identified.measured.b == pytest.approx(b_meas, rel=1e-9)
     t0 = float(t[0])
     run = runner.simulate(
-        {**st.FIT_SETTINGS, **identified.values},
+        {**FIT_SETTINGS, **identified.values},
         start_time=t0,
         stop_time=t0 + offsets[-1] * FRAME_INTERVAL,
         output_interval=FRAME_INTERVAL,
@@ -47,7 +49,7 @@ def test_identified_suspension_reproduces_the_measured_decay_rate(runner, identi
     # the suspension carries the loss: without it the same start decays at less than a third of the rate
     no_suspension = {k: v for k, v in identified.values.items() if k != "suspension"}
     run0 = runner.simulate(
-        {**st.FIT_SETTINGS, **no_suspension},
+        {**FIT_SETTINGS, **no_suspension},
         start_time=t0,
         stop_time=t0 + offsets[-1] * FRAME_INTERVAL,
         output_interval=FRAME_INTERVAL,
@@ -61,12 +63,12 @@ def test_identified_suspension_reproduces_the_measured_decay_rate(runner, identi
 
 def test_stiff_suspension_loss_scales_as_c_over_k_squared_and_follows_linear_response(runner):
     n = 151  # 5 s of frames from the seed's release, suspension the only loss
-    frames = st.FitFrames(0.0, np.arange(n), np.arange(n) * FRAME_INTERVAL, None)
+    frames = FitFrames(0.0, np.arange(n), np.arange(n) * FRAME_INTERVAL, None)
     base = dict(SEED_RELEASE)
     points = [(1e5, 30.0), (1e5, 90.0), (1e5, 270.0), (2e5, 270.0)]
-    cases = [{**st.MAP_SETTINGS, "suspension": False}]
-    cases += [{**st.MAP_SETTINGS, **st.suspension_values(k, c, 2.0)} for k, c in points]
-    rates = [r["b_E_pendulum"] for r in st.decay_rate_sweep(runner.fmu_path, base, frames, cases, max_workers=1)]
+    cases = [{**MAP_SETTINGS, "suspension": False}]
+    cases += [{**MAP_SETTINGS, **suspension_values(k, c, 2.0)} for k, c in points]
+    rates = [r["b_E_pendulum"] for r in decay_rate_sweep(runner.fmu_path, base, frames, cases, max_workers=1)]
     assert abs(rates[0]) < 1e-5  # no loss mechanism, no decay
     b = dict(zip(points, rates[1:]))
     assert b[(1e5, 30.0)] > b[(1e5, 90.0)] > b[(1e5, 270.0)]  # more damping, faster decay (stiff range)

@@ -38,6 +38,9 @@ from scipy.optimize import curve_fit, minimize
 
 P_ONE_TOLERANCE = 1e-9
 """|1 - p| below which the power model is evaluated as its exponential limit."""
+AUTOCORRELATION_LAG_S = 1.5
+"""Lag window [s] for the residual autocorrelation of the measured energy (the ``max_lag`` of
+:func:`effective_sample_factor` times the frame rate): about one slow swing (period 1.31 s)."""
 
 
 @dataclass(frozen=True)
