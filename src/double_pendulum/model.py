@@ -260,11 +260,16 @@ def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
     return evaluate
 
 
-def build_vector_field(config: ModelConfig) -> Callable[[float, list[float]], list[float]]:
-    """Return ``f(t, y) -> dy/dt`` for the states of :func:`state_layout` (only enabled terms)."""
+def build_vector_field(
+    config: ModelConfig, evaluate: Callable[[list[float]], Evaluation] | None = None
+) -> Callable[[float, list[float]], list[float]]:
+    """Return ``f(t, y) -> dy/dt`` for the states of :func:`state_layout` (only enabled terms).
+
+    ``evaluate`` is the scene's evaluator if already built (see :func:`build_model`).
+    """
     if is_core(config):
         return fixed_pivot_vector_field(config.pendulum)
-    evaluate = build_evaluator(config)
+    evaluate = evaluate or build_evaluator(config)
 
     def vector_field(t: float, y: list[float]) -> list[float]:
         return evaluate(y).dydt
@@ -311,4 +316,5 @@ class Model:
 
 def build_model(config: ModelConfig) -> Model:
     """Build the scene ``config``: only the enabled mechanisms are integrated and evaluated."""
-    return Model(config, state_layout(config), build_vector_field(config), build_evaluator(config))
+    evaluate = build_evaluator(config)
+    return Model(config, state_layout(config), build_vector_field(config, evaluate), evaluate)

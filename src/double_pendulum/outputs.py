@@ -127,11 +127,3 @@ GROUP_OF: dict[str, int] = {
     )
     for name in names
 }
-
-
-def output_values(model: Model, y: list[float], initial_energy: float | None = None) -> tuple[float, ...]:
-    """Return the model outputs, in :data:`MODEL_OUTPUT_NAMES` order, at state ``y``."""
-    values: dict[str, float] = {}
-    for group in OUTPUT_GROUPS:
-        values.update(group(model, y, initial_energy))
-    return tuple(values[name] for name in MODEL_OUTPUT_NAMES)

@@ -57,8 +57,9 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
+from .combinations import sparse
 from .integrator import SolverError
-from .runge_kutta import VectorField, _as_row, _stage_input, hermite_interpolant
+from .runge_kutta import VectorField, _stage_input, hermite_interpolant
 
 MAX_ITERATIONS = 100
 ROUNDING_LEVEL = 1e-13  # largest relative increment still taken as rounding noise
@@ -103,8 +104,8 @@ class GaussLegendre:
     B: tuple[float, ...] = ()
 
     def __init__(self) -> None:
-        self._a_rows = tuple(_as_row(row) for row in self.A)
-        self._b_row = _as_row(self.B)
+        self._a_rows = tuple(sparse(row) for row in self.A)
+        self._b_row = sparse(self.B)
 
     def _solve_stages(
         self, f: VectorField, t: float, y: list[float], fy: list[float], h: float

@@ -92,14 +92,9 @@ def _stage_kernels(a: SparseRows, n: int) -> list:
     return kernels
 
 
-def _as_row(weights: Sequence[float]) -> tuple[tuple[int, float], ...]:
-    """Turn dense weights into a sparse tableau row ``((j, w_j), ...)``."""
-    return tuple((j, w) for j, w in enumerate(weights) if w != 0.0)
-
-
-_DOPRI5_B_ROW = _as_row(tb.DOPRI5_B)
-_DOP853_B_ROW = _as_row(tb.DOP853_B)
-_RK4_B_ROW = _as_row(tb.RK4_B)
+_DOPRI5_B_ROW = sparse(tb.DOPRI5_B)
+_DOP853_B_ROW = sparse(tb.DOP853_B)
+_RK4_B_ROW = sparse(tb.RK4_B)
 _DOPRI5_P_COLUMNS = tuple(tuple(row[k] for row in tb.DOPRI5_P) for k in range(len(tb.DOPRI5_P[0])))
 
 
