@@ -4,10 +4,10 @@ Usage: ``python benchmarks/batch_vs_c.py [--batch 10000] [--steps 500] [--repeat
 
 Both integrate the same batch (seeded random release angles in (-pi, pi)^2 from rest, the seed
 pendulum, h = 1 ms) with the classic RK4 in the same stage order: the batch integrator
-(:func:`double_pendulum.ensemble.rk4_step` on :func:`double_pendulum.ensemble.pendulum_field`,
+(:func:`double_pendulum.analysis.ensemble.rk4_step` on :func:`double_pendulum.analysis.ensemble.pendulum_field`,
 vectorised over the batch) and a plain C loop over trajectories and steps, compiled at run time
 with the system ``cc -O2`` into a temporary folder and called through ctypes. The C source
-restates the equations of :mod:`double_pendulum.dynamics` only for this comparison; the script
+restates the equations of :mod:`double_pendulum.model.dynamics` only for this comparison; the script
 checks that both end in the same states. Figures are CPU times (``time.process_time``), the
 median of ``--repeats`` runs, printed side by side with their ratio (the issue's target: within
 3 times for batches of 10,000). ``--flip-map N`` also times an N x N flip-time map over 10 s on
@@ -27,14 +27,14 @@ from pathlib import Path
 
 import numpy as np
 
-from double_pendulum.chaos import flip_time_map
-from double_pendulum.ensemble import initial_states, pendulum_field, rk4_step
-from double_pendulum.parameters import PendulumParameters
+from double_pendulum.analysis.chaos import flip_time_map
+from double_pendulum.analysis.ensemble import initial_states, pendulum_field, rk4_step
+from double_pendulum.model.parameters import PendulumParameters
 
 C_SOURCE = r"""
 #include <math.h>
 
-/* dy/dt of the double pendulum, the closed-form 2x2 solve of double_pendulum.dynamics */
+/* dy/dt of the double pendulum, the closed-form 2x2 solve of double_pendulum.model.dynamics */
 static void field(const double *y, double *d, double m1, double m2, double l1, double l2, double g) {
     double delta = y[0] - y[1], s_d = sin(delta), c_d = cos(delta), m12 = m1 + m2;
     double a11 = m12 * l1 * l1, a12 = m2 * l1 * l2 * c_d, a22 = m2 * l2 * l2;

@@ -24,8 +24,8 @@ from collections.abc import Callable
 
 from scipy.integrate import solve_ivp
 
-from double_pendulum.model import ModelConfig, build_model, energies
-from double_pendulum.parameters import BearingParameters, SuspensionParameters
+from double_pendulum.model.parameters import BearingParameters, SuspensionParameters
+from double_pendulum.model.vector_field import ModelConfig, build_model, energies
 from double_pendulum.solvers import make_integrator
 
 RTOL, ATOL, T_END = 1e-6, 1e-9, 2.0

@@ -1,9 +1,9 @@
-"""pythonfmu adapter: maps FMI 2.0 co-simulation calls onto ``double_pendulum.cosimulation``.
+"""pythonfmu adapter: maps FMI 2.0 co-simulation calls onto ``double_pendulum.component.cosimulation``.
 
-All physics, numerics and validation live in the ``double_pendulum`` package, which the build
-bundles into the FMU's resources next to this file. The bundled copy is loaded under a private
-module name so the FMU always runs its own code, whatever ``double_pendulum`` the host process
-may have imported.
+All physics, numerics and validation live in the ``double_pendulum`` package, whose runtime part
+(model, solvers, component) the build bundles into the FMU's resources next to this file. The
+bundled copy is loaded under a private module name so the FMU always runs its own code, whatever
+``double_pendulum`` the host process may have imported.
 """
 
 from __future__ import annotations
@@ -54,8 +54,8 @@ def _load_package():
 
 
 _package = _load_package()
-_cosim = importlib.import_module(_package.__name__ + ".cosimulation")
-_interface = importlib.import_module(_package.__name__ + ".fmu_interface")
+_cosim = importlib.import_module(_package.__name__ + ".component.cosimulation")
+_interface = importlib.import_module(_package.__name__ + ".component.variables")
 _FMI_TYPES = {"Real": Real, "Boolean": Boolean, "String": String}
 
 

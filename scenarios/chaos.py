@@ -9,12 +9,12 @@ enough for the chaotic traces of its figs. 4-6) with the lower rod hanging (phi2
 Outputs in ``results/chaos/``:
 
 * three releases drawn with the 5 mm uncertainty and the nominal one, through the FMU (run in
-  parallel by :mod:`double_pendulum.sweep`): CSVs, the lower bob's traces with the point where
+  parallel by :mod:`double_pendulum.analysis.sweep`): CSVs, the lower bob's traces with the point where
   they part, phase portraits at a regular and the chaotic energy;
-* ensembles (:mod:`double_pendulum.ensemble`): the spread of the lower bob over time for start
+* ensembles (:mod:`double_pendulum.analysis.ensemble`): the spread of the lower bob over time for start
   uncertainties from 0.01 to 10 mm, clouds of the 5 mm ensemble, the predictability horizon
   (spread above 1 cm and 10 cm) against the uncertainty;
-* Lyapunov exponents (:mod:`double_pendulum.chaos`): the largest exponent of the default start
+* Lyapunov exponents (:mod:`double_pendulum.analysis.chaos`): the largest exponent of the default start
   with its convergence for DOP853 (rtol 1e-10, the high-accuracy estimate) and RK4 at h and h/2,
   the two-trajectory cross-check, the full spectrum (pairing lambda, 0, 0, -lambda), the exponent
   against the release angle phi1 = phi2 = theta0 from 0.5 to 3 rad;
@@ -32,8 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-from double_pendulum import chaos, plotting
-from double_pendulum.ensemble import (
+from double_pendulum import plots
+from double_pendulum.analysis import chaos
+from double_pendulum.analysis.ensemble import (
     batch_energy,
     batch_potential_energy,
     dop853_trajectory,
@@ -41,11 +42,11 @@ from double_pendulum.ensemble import (
     model_field,
     pendulum_field,
 )
-from double_pendulum.model import ModelConfig
-from double_pendulum.parameters import AirDragParameters, BearingParameters, PendulumParameters
+from double_pendulum.analysis.sweep import run_sweep
+from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.model.parameters import AirDragParameters, BearingParameters, PendulumParameters
+from double_pendulum.model.vector_field import ModelConfig
 from double_pendulum.results_io import write_json, write_results_csv
-from double_pendulum.runner import FmuRunner
-from double_pendulum.sweep import run_sweep
 
 DESCRIPTION = "sensitivity to the start (seed 4.1): ensembles, predictability, Lyapunov exponents, flip map"
 
@@ -167,14 +168,14 @@ def fmu_runs(runner: FmuRunner, out_dir: Path, plan: Plan, params: PendulumParam
         f"{label} (phi1_0 = {releases[label]['phi1_0']:.4f} rad)": (r["x2"][window], r["y2"][window])
         for label, r in zip(list(releases)[1:], drawn)
     }
-    plotting.plot_lower_mass_traces(
+    plots.plot_lower_mass_traces(
         traces,
         out_dir / "release_traces.png",
         diverge=where,
         title=f"three releases drawn with sigma = 5 mm: traces until {t_show:.1f} s; arrow: 1 cm apart",
     )
     portraits = {"regular (phi1 = phi2 = 0.5 rad)": results[4], "chaotic (default start)": results[0]}
-    plotting.plot_phase_portraits(portraits, out_dir / "phase_portraits.png")
+    plots.plot_phase_portraits(portraits, out_dir / "phase_portraits.png")
     return {
         "releases": releases,
         "settings": FMU_SETTINGS,
@@ -232,18 +233,18 @@ def ensembles(out_dir: Path, plan: Plan, params: PendulumParameters, lyapunov: f
         _table(sigma=sigmas, horizon_1cm=horizons[0.01], horizon_10cm=horizons[0.10]),
         {"sigma": "m", "horizon_1cm": "s", "horizon_10cm": "s"},
     )
-    plotting.plot_ensemble_spread(
+    plots.plot_ensemble_spread(
         spread.times,
         {f"sigma = {_mm(s)}": spread.spread[:, j] for j, s in enumerate(sigmas)},
         THRESHOLDS,
         out_dir / "ensemble_spread.png",
     )
-    plotting.plot_ensemble_clouds(
+    plots.plot_ensemble_clouds(
         spread.snapshots,
         out_dir / "ensemble_clouds.png",
         title=f"{plan.members} releases, upper bob uncertain by sigma = {_mm(START_UNCERTAINTY)}: lower bob",
     )
-    plotting.plot_predictability(
+    plots.plot_predictability(
         sigmas,
         {f"spread > {d * 100:g} cm": horizons[d] for d in THRESHOLDS},
         lyapunov,
@@ -318,7 +319,7 @@ def lyapunov(out_dir: Path, plan: Plan, params: PendulumParameters) -> dict:
             for n, v in cloud_running.items()
         }
     )
-    plotting.plot_lyapunov_convergence(
+    plots.plot_lyapunov_convergence(
         curves, out_dir / "lyapunov_convergence.png", title="largest exponent, default start"
     )
     n = starts.shape[1]
@@ -375,7 +376,7 @@ def spectrum(out_dir: Path, plan: Plan, params: PendulumParameters, field) -> di
         ),
         {**{f"lambda{i + 1}": "1/s" for i in range(4)}, "sum": "1/s", "sum_bound": "1/s"},
     )
-    plotting.plot_lyapunov_spectrum(res.times, run, bound, out_dir / "lyapunov_spectrum.png")
+    plots.plot_lyapunov_spectrum(res.times, run, bound, out_dir / "lyapunov_spectrum.png")
     lam = run[-1]
     return {
         "exponents_per_s": lam,
@@ -404,7 +405,7 @@ def energy_scan(out_dir: Path, plan: Plan, params: PendulumParameters, field) ->
         _table(theta0=theta, E_0=energy, E_over_E_flip=ratio, lambda_max=lam),
         {"theta0": "rad", "E_0": "J", "lambda_max": "1/s"},
     )
-    plotting.plot_lyapunov_vs_energy(theta, ratio, lam, out_dir / "lyapunov_energy.png")
+    plots.plot_lyapunov_vs_energy(theta, ratio, lam, out_dir / "lyapunov_energy.png")
     return {
         "theta0_rad": theta,
         "lambda_per_s": lam,
@@ -417,8 +418,8 @@ def energy_scan(out_dir: Path, plan: Plan, params: PendulumParameters, field) ->
 def with_friction(out_dir: Path, plan: Plan, params: PendulumParameters) -> dict:
     """The largest exponent in time windows while the seed's air drag and bearing friction drain the energy.
 
-    The model with friction (:mod:`double_pendulum.model`, the seed's drag and bearing numbers) runs
-    column by column (:func:`double_pendulum.ensemble.model_field`); its tangent uses central
+    The model with friction (:mod:`double_pendulum.model.vector_field`, the seed's drag and bearing numbers) runs
+    column by column (:func:`double_pendulum.analysis.ensemble.model_field`); its tangent uses central
     differences (the friction terms are evaluated with ``math``), DOP853 rtol 1e-8.
     """
     config = ModelConfig(
@@ -445,7 +446,7 @@ def with_friction(out_dir: Path, plan: Plan, params: PendulumParameters) -> dict
         _table(time=centres, lambda_window=local[:, 0], E_over_E_flip=at_centres),
         {"lambda_window": "1/s"},
     )
-    plotting.plot_lyapunov_with_friction(
+    plots.plot_lyapunov_with_friction(
         centres,
         local[:, 0],
         res.times,
@@ -473,7 +474,7 @@ def flip_map(out_dir: Path, plan: Plan, params: PendulumParameters) -> dict:
         _table(phi1_0=g1, phi2_0=g2, E_0=fmap.energy, flip_time=fmap.time, flipped_rod=fmap.rod),
         {"phi1_0": "rad", "phi2_0": "rad", "E_0": "J", "flip_time": "s"},
     )
-    plotting.plot_flip_map(
+    plots.plot_flip_map(
         fmap.phi1,
         fmap.phi2,
         fmap.time,
@@ -525,7 +526,7 @@ def poincare(out_dir: Path, plan: Plan, params: PendulumParameters) -> dict:
             "points": int(pts.shape[0]),
             "start_energy_relative_error": float(np.max(np.abs(batch_energy(starts, params) - energy)) / energy),
         }
-    plotting.plot_poincare_sections(sections, out_dir / "poincare_sections.png")
+    plots.plot_poincare_sections(sections, out_dir / "poincare_sections.png")
     return out
 
 

@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from double_pendulum import plotting
-from double_pendulum.decay_fit import (
+from double_pendulum import plots
+from double_pendulum.analysis.decay_fit import (
     AUTOCORRELATION_LAG_S,
     MODELS,
     FitResult,
@@ -33,7 +33,7 @@ from double_pendulum.decay_fit import (
     fit_all,
     fit_model,
 )
-from double_pendulum.measurement import (
+from double_pendulum.analysis.measurement import (
     FPS,
     SEED_VELOCITY_ERROR,
     SG_POLYORDER,
@@ -242,11 +242,11 @@ def _plots(
     full_sigma = np.full(len(rec.t), np.nan)
     full_sigma[m] = sigma
     path = out_dir / "energy_decay.png"
-    plotting.plot_energy_decay(
+    plots.plot_energy_decay(
         rec.t, rec.energy, full_sigma, curves, t_curve, path, used=m, residual_curve=exp_label
     )
     g = rec.geometry
-    plotting.plot_circle_fit(
+    plots.plot_circle_fit(
         rec.x1, rec.y1, rec.x2, rec.y2, rec.t, g.l1, g.l2, out_dir / "circle_fit.png", valid=rec.track.valid
     )
 
@@ -363,7 +363,7 @@ def _energy_section(s: dict[str, Any]) -> str:
     cd = s["derivative_filters"]["central_difference"]["gain"]
     return f"""## Energy and its errors
 
-The energy is `double_pendulum.energy.total_energy` for point masses m1 = {s["masses_kg"]["m1"]} kg,
+The energy is `double_pendulum.model.energy.total_energy` for point masses m1 = {s["masses_kg"]["m1"]} kg,
 m2 = {s["masses_kg"]["m2"]} kg on the measured rods (potential zero with both bobs at rest below the
 fitted pivot). The angular velocities come from a Savitzky-Golay derivative ({SG_WINDOW} frames, order
 {SG_POLYORDER}): on a harmonic motion at 10 / 20 / 25 rad/s it returns {sg["10_rad_s"]:.3f} /

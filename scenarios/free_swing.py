@@ -12,9 +12,9 @@ from pathlib import Path
 
 import numpy as np
 
-from double_pendulum import plotting
+from double_pendulum import plots
+from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv
-from double_pendulum.runner import FmuRunner
 
 DESCRIPTION = "frictionless swing from a regular (small-angle) and a chaotic (2 rad) start"
 
@@ -60,9 +60,9 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
             "flips_rod2": _count_flips(result["phi2"]),
             "max_abs_omega2_rad_s": float(np.max(np.abs(result["omega2"]))),
         }
-    plotting.plot_angles(runs, out_dir / "angles.png")
-    plotting.plot_traces(runs, out_dir / "traces.png")
-    plotting.plot_energy(runs, out_dir / "energy.png")
-    plotting.plot_phase_portraits(runs, out_dir / "phase_portraits.png")
+    plots.plot_angles(runs, out_dir / "angles.png")
+    plots.plot_traces(runs, out_dir / "traces.png")
+    plots.plot_energy(runs, out_dir / "energy.png")
+    plots.plot_phase_portraits(runs, out_dir / "phase_portraits.png")
     write_json(out_dir / "summary.json", summary)
     return summary

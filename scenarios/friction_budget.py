@@ -18,10 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
-from double_pendulum import plotting
-from double_pendulum.decay_fit import fit_model
+from double_pendulum import plots
+from double_pendulum.analysis.decay_fit import fit_model
+from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv
-from double_pendulum.runner import FmuRunner
 
 DESCRIPTION = "energy budget of air drag, bearing friction and suspension, alone and together (60 s)"
 
@@ -100,7 +100,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     }
     summary["seed_measured_b_per_s"] = -0.024
 
-    plotting.plot_energy_per_mechanism(results, out_dir / "energy_per_mechanism.png")
-    plotting.plot_energy_budget_stacked(results["all"], out_dir / "energy_budget_stacked.png")
+    plots.plot_energy_per_mechanism(results, out_dir / "energy_per_mechanism.png")
+    plots.plot_energy_budget_stacked(results["all"], out_dir / "energy_budget_stacked.png")
     write_json(out_dir / "summary.json", summary)
     return summary

@@ -5,13 +5,13 @@ coordinates agreeing with the camera track until about 2 s (its figs. 11-14). Th
 the same through the FMU and goes further:
 
 - **seed start**: angles and rates of the frame nearest t0 from the measurement reconstruction
-  (:func:`double_pendulum.measurement.reconstruct`: angles from the positions, rates from the
+  (:func:`double_pendulum.analysis.measurement.reconstruct`: angles from the positions, rates from the
   Savitzky-Golay derivative), run frictionless as in the seed and with the identified losses;
 - **least-squares start**: (phi1, phi2, omega1, omega2) at t0 fitted to the positions of the first
-  :data:`FIT_FRAMES` frames (:func:`double_pendulum.start_state.fit_start_state`), run with the
+  :data:`FIT_FRAMES` frames (:func:`double_pendulum.analysis.start_state.fit_start_state`), run with the
   identified losses: air drag and bearing friction at the defaults, the suspension's c identified
   from the measured energy decay at the default k and M_s
-  (:func:`double_pendulum.suspension_identification.identify_suspension`).
+  (:func:`double_pendulum.analysis.suspension_identification.identify_suspension`).
 
 The FMU's positions are relative to the pivot's rest position; the track's are relative to its own
 origin. Both are compared relative to the pivot fitted by the measurement (circle fit of the upper
@@ -38,12 +38,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from double_pendulum.scenarios.energy_decay import SEED_TOTAL_MASS_KG
 
-from double_pendulum import plotting
-from double_pendulum.measurement import FRAME_INTERVAL, Reconstruction, load_track, reconstruct
-from double_pendulum.results_io import write_json, write_results_csv, write_text
-from double_pendulum.runner import FmuRunner
-from double_pendulum.start_state import (
+from double_pendulum import plots
+from double_pendulum.analysis.measurement import FRAME_INTERVAL, Reconstruction, load_track, reconstruct
+from double_pendulum.analysis.start_state import (
     FIT_SETTINGS,
     POSITION_OUTPUTS,
     STATE_NAMES,
@@ -54,8 +53,9 @@ from double_pendulum.start_state import (
     state_start_values,
     track_window,
 )
-from double_pendulum.suspension_identification import START_FIT_FRAMES, IdentifiedModel, identify_suspension
-from scenarios.energy_decay import SEED_TOTAL_MASS_KG
+from double_pendulum.analysis.suspension_identification import START_FIT_FRAMES, IdentifiedModel, identify_suspension
+from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.results_io import write_json, write_results_csv, write_text
 
 DESCRIPTION = "FMU prediction of the measured track from t0 = 0.8 s: the seed's start and a least-squares start"
 
@@ -256,13 +256,13 @@ def _plots(
         p.label: (np.asarray(p.result["time"]), {n: np.asarray(p.result[n]) + shift[n] for n in shift})
         for p in predictions
     }
-    plotting.plot_track_comparison(
+    plots.plot_track_comparison(
         rec.t[v], measured, runs, out_dir / "coordinates.png", starts={"t0": float(rec.t[i0])}
     )
     curves = {f"{p.label}: lower bob": (p.t, p.e2) for p in predictions}
     curves.update({f"{p.label}: both (larger)": (p.t, p.e_both) for p in predictions[-1:]})
     curves["chaos: spread of runs from the fitted start's uncertainty (median)"] = spread
-    plotting.plot_prediction_errors(
+    plots.plot_prediction_errors(
         curves, list(THRESHOLDS_M), out_dir / "prediction_error.png", floor=rod_length_floor(rec, i0, n_frames)
     )
 

@@ -25,10 +25,10 @@ from typing import Any
 
 import numpy as np
 
-from double_pendulum import plotting
-from double_pendulum.parameters import PendulumParameters
+from double_pendulum import plots
+from double_pendulum.fmu.runner import FmuRunError, FmuRunner
+from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.results_io import write_json, write_results_csv, write_table_csv, write_text
-from double_pendulum.runner import FmuRunError, FmuRunner
 
 DESCRIPTION = "stiff and extreme cases through the FMU with pass criteria (table, report, worst-case plots)"
 
@@ -209,7 +209,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     worst = sorted(passing, key=lambda r: r["max_rel_energy_residual"], reverse=True)[:3]
     for i, r in enumerate(worst):
         write_results_csv(out_dir / f"worst_{i + 1}.csv", results[r["case"]], runner.units)
-    plotting.plot_residuals({r["case"]: results[r["case"]] for r in worst}, out_dir / "worst_residuals.png")
+    plots.plot_residuals({r["case"]: results[r["case"]] for r in worst}, out_dir / "worst_residuals.png")
     summary = {
         "scenario": "stability",
         "quick": quick,

@@ -6,17 +6,17 @@ bearing friction at the seed's estimates (the parameter defaults) give only abou
 This scenario asks how much a pivot on a damped suspension (mass M_s, springs k = k_x = k_y,
 dampers c = c_x = c_y) adds, and which suspensions reproduce the measurement. Every run goes
 through the FMU, from the state the pendulum was measured in after the hand release (fitted to the
-first frames by :func:`double_pendulum.start_state.fit_start_state`), with air drag (bobs and rods)
+first frames by :func:`double_pendulum.analysis.start_state.fit_start_state`), with air drag (bobs and rods)
 and bearing friction on.
 
 Decay rate. b is fitted to the **pendulum's** energy E_pendulum (the two bobs, output of the FMU)
 on the measured frames with the measured fit's calibrated errors
-(:func:`double_pendulum.decay_fit.fit_model`, ``exponential``), so a simulated b and the measured b
+(:func:`double_pendulum.analysis.decay_fit.fit_model`, ``exponential``), so a simulated b and the measured b
 are the same statistic of the same frames. The camera sees the bobs only, so E_pendulum is the
 measured quantity; E_total = E_pendulum + E_suspension differs by the energy stored in the
 suspension (the map records b of both; the summary gives the largest difference).
 
-Physics of the map. :mod:`double_pendulum.suspension_response` predicts the suspension's share of b
+Physics of the map. :mod:`double_pendulum.analysis.suspension_response` predicts the suspension's share of b
 from the spectrum of the force the pendulum exerts on a fixed pivot (linear response, one FMU run):
 a stiff suspension gives b - b0 ~ -c <|dF/dt|^2> / (k^2 E) (iso-b curves c ~ k^2), a lightly damped
 one whose natural frequency sqrt(k/M) lies inside the force spectrum takes pi S_F(omega_n) / (2 M)
@@ -32,8 +32,8 @@ of the identified suspension and of a resonant one on the same iso-b curve),
 ``fixed_pivot_force.csv``; plots ``decay_rate_map.png``, ``decay_rate_cuts.png``,
 ``force_spectrum.png``, ``energy_flow.png``, ``energy_fit.png``; ``summary.json``; ``report.md``.
 
-The analysis lives in the package: :mod:`double_pendulum.suspension_identification` (measured decay,
-identification of c, its valley, decay shape) and :mod:`double_pendulum.decay_map` (the sweep over
+The analysis lives in the package: :mod:`double_pendulum.analysis.suspension_identification` (measured decay,
+identification of c, its valley, decay shape) and :mod:`double_pendulum.analysis.decay_map` (the sweep over
 (k, c, M_s) and its checks against the physics).
 """
 
@@ -47,9 +47,10 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from double_pendulum.scenarios.energy_decay import SEED_FIT
 
-from double_pendulum import plotting
-from double_pendulum.decay_map import (
+from double_pendulum import plots
+from double_pendulum.analysis.decay_map import (
     MAP_SETTINGS,
     MAP_UNITS,
     DecayMap,
@@ -59,10 +60,8 @@ from double_pendulum.decay_map import (
     map_summary,
     trace_valley,
 )
-from double_pendulum.measurement import FRAME_INTERVAL, load_track, reconstruct
-from double_pendulum.results_io import write_json, write_results_csv, write_text
-from double_pendulum.runner import FmuRunner
-from double_pendulum.suspension_identification import (
+from double_pendulum.analysis.measurement import FRAME_INTERVAL, load_track, reconstruct
+from double_pendulum.analysis.suspension_identification import (
     DEFAULT_SUSPENSION,
     FIT_SETTINGS,
     LOSSES,
@@ -80,8 +79,9 @@ from double_pendulum.suspension_identification import (
     valley_fisher,
     window_check,
 )
-from double_pendulum.suspension_response import ForceSpectrum
-from scenarios.energy_decay import SEED_FIT
+from double_pendulum.analysis.suspension_response import ForceSpectrum
+from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.results_io import write_json, write_results_csv, write_text
 
 DESCRIPTION = "decay rate b over suspension stiffness and damping; suspension identified from the measured decay"
 
@@ -280,7 +280,7 @@ def _plots(
 ) -> None:
     main = maps[0]
     levels = {"measured (this project)": md.b, "seed": SEED_B}
-    plotting.plot_decay_rate_map(
+    plots.plot_decay_rate_map(
         _map_panels(maps, spectrum, n_fine),
         levels,
         out_dir / "decay_rate_map.png",
@@ -290,7 +290,7 @@ def _plots(
     c_fine = np.geomspace(main.c[0], main.c[-1], 80)
     lr = np.array([[spectrum.linear_response_rate(k, c, main.m_s) for c in c_fine] for k in main.k])
     qs = np.array([[spectrum.quasi_static_rate(k, c) for c in c_fine] for k in main.k])
-    plotting.plot_decay_rate_cuts(
+    plots.plot_decay_rate_cuts(
         main.k, main.c, main.b_suspension, c_fine, lr, qs, md.b - main.b_base, out_dir / "decay_rate_cuts.png"
     )
     w_x, w_y = math.sqrt(ident.k / ident.m_s), math.sqrt(ident.k / (ident.m_s + spectrum.m12))
@@ -299,13 +299,13 @@ def _plots(
         f"identified omega_n,y = sqrt(k/(M_s+m1+m2)) = {w_y:.0f} rad/s": w_y,
     }
     shown = spectrum.omega >= 1.0  # below, the Welch window's leakage of the decaying mean
-    plotting.plot_force_spectrum(
+    plots.plot_force_spectrum(
         spectrum.omega[shown],
         {"F_x": spectrum.s_x[shown], "F_y": spectrum.s_y[shown]},
         marks,
         out_dir / "force_spectrum.png",
     )
-    plotting.plot_energy_flow(flows, out_dir / "energy_flow.png")
+    plots.plot_energy_flow(flows, out_dir / "energy_flow.png")
     t_curve = md.frames.t0 + np.arange(md.frames.n_frames) * FRAME_INTERVAL
     curves = {f"FMU, {label}": np.asarray(r["E_pendulum"]) for label, r in runs.items()}
     full_t = md.rec.t
@@ -313,7 +313,7 @@ def _plots(
     used[md.i0 + md.frames.offsets] = True
     sigma = np.full(len(full_t), np.nan)
     sigma[used] = md.frames.sigma
-    plotting.plot_energy_decay(
+    plots.plot_energy_decay(
         full_t,
         md.rec.energy,
         sigma,
@@ -479,7 +479,7 @@ def _measured_section(s: Mapping[str, Any]) -> str:
     shape = m["decay_shape"]
     return f"""## Measured decay and start
 
-The camera energy (``double_pendulum.measurement``, calibrated errors, {m["n_frames"]} frames from the end of
+The camera energy (``double_pendulum.analysis.measurement``, calibrated errors, {m["n_frames"]} frames from the end of
 the hand release at t = {m["window_s"][0]:.2f} s to t = {m["window_s"][1]:.2f} s): E = a exp(b t) with
 a = {m["a_J"]:.4f} J, **b = {m["b_per_s"]:.5f} +- {m["b_per_s_stderr_autocorr"]:.5f} 1/s** (error inflated by the
 residual correlation, factor {m["autocorrelation_factor"]:.2f}); the seed printed b = {m["seed_b_per_s"]} 1/s.
@@ -529,7 +529,7 @@ def _map_section(s: Mapping[str, Any]) -> str:
 
 {s["map_runs"]} FMU runs (``decay_rate_map.csv``, ``decay_rate_map.png``), k = k_x = k_y from
 {main["k_N_per_m"][0]:.3g} to {main["k_N_per_m"][-1]:.3g} N/m, c = c_x = c_y from {main["c_N_s_per_m"][0]:.3g} to
-{main["c_N_s_per_m"][-1]:.3g} N s/m, swept in {s["map_wall_time_s"]:.0f} s by ``double_pendulum.sweep.run_sweep``.
+{main["c_N_s_per_m"][-1]:.3g} N s/m, swept in {s["map_wall_time_s"]:.0f} s by ``analysis.sweep.run_sweep``.
 b of E_pendulum and of E_total differ by at most {main["max_abs_b_E_pendulum_minus_b_E_total"]:.1e} 1/s.
 
 | M_s [kg] | grid | b without suspension [1/s] | stiffest k reaching the measured b [N/m] | iso-b points (measured b) |
@@ -547,7 +547,7 @@ per k at c = {_rows(qs["rows_within"])}; elsewhere in that region the c-independ
 still adds (small c). The largest suspension share where the law holds is {qs_share} 1/s, against the
 {-needed:.4f} 1/s needed{verdict}. Along the measured curve the local slope of the valley is
 d ln c / d ln k = {fisher["valley_slope_dlnc_dlnk"]:.1f} (c ~ k^2 would be 2). The full linear response
-(``double_pendulum.suspension_response``, from one fixed-pivot run's force spectrum; dotted in the map)
+(``double_pendulum.analysis.suspension_response``, from one fixed-pivot run's force spectrum; dotted in the map)
 agrees with the FMU within
 {100 * lr["tolerance"]:.0f} % in {lr["n_cells_within"]} of {lr["n_cells"]} cells, per k at c =
 {_rows(lr["rows_within"])}: it

@@ -5,7 +5,7 @@ diverges --, and a stiff light suspension over 2 s) and each solver, a sweep of 
 (adaptive methods) or step sizes (fixed-step methods) runs **through fmpy** at a 10 ms
 communication step, and one mid setting per solver also at 1 ms and 100 ms. Recorded per run:
 final-horizon error and maximum error over the horizon (max over phi1, phi2, omega1, omega2
-against the cached reference, :mod:`double_pendulum.reference`), energy drift (frictionless: max
+against the cached reference, :mod:`double_pendulum.analysis.reference`), energy drift (frictionless: max
 |E_total - E0| / E0; with dissipation: max |energy_residual| / E0), RHS evaluations and steps
 (FMU outputs), CPU time (median of the repeats, with the spread). Failed or unstable
 configurations are kept in the table with their status and message.
@@ -24,10 +24,10 @@ from typing import Any
 
 import numpy as np
 
-from double_pendulum import plotting
-from double_pendulum.reference import STATE_OUTPUTS, reference_solution
+from double_pendulum import plots
+from double_pendulum.analysis.reference import STATE_OUTPUTS, reference_solution
+from double_pendulum.fmu.runner import FmuRunError, FmuRunner
 from double_pendulum.results_io import write_json, write_table_csv, write_text
-from double_pendulum.runner import FmuRunError, FmuRunner
 from double_pendulum.solvers import METHODS, make_method
 
 DESCRIPTION = "error against CPU time for every solver, tolerance and communication step (through fmpy)"
@@ -181,7 +181,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
                 for comm in COMM_STEPS:
                     if comm != BASE_COMM_STEP:
                         rows.append(run_config(runner, case, ref, solver, mid, comm, horizon, repeats))
-        plotting.plot_work_precision(
+        plots.plot_work_precision(
             [r for r in rows if r["case"] == case.name and r["comm_step_s"] == BASE_COMM_STEP],
             out_dir / f"work_precision_{case.name}.png", title=f"{case.name} (horizon {horizon:g} s)",
         )

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from double_pendulum.fmu_build import build_fmu
-from double_pendulum.runner import FmuRunner
+from double_pendulum.fmu.build import build_fmu
+from double_pendulum.fmu.runner import FmuRunner
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"

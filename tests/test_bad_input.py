@@ -10,8 +10,8 @@ from dataclasses import fields
 
 import pytest
 
-from double_pendulum.cosimulation import PARAMETER_GROUPS
-from double_pendulum.runner import FmuRunError
+from double_pendulum.component.cosimulation import PARAMETER_GROUPS
+from double_pendulum.fmu.runner import FmuRunError
 
 INVALID_VALUES = {
     "positive": [-1.0, 0.0, math.nan, math.inf, -math.inf],

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum import chaos
-from double_pendulum.dynamics import linearised_normal_modes
-from double_pendulum.ensemble import batch_energy, batch_potential_energy, initial_states, pendulum_field
-from double_pendulum.parameters import PendulumParameters
+from double_pendulum.analysis import chaos
+from double_pendulum.analysis.ensemble import batch_energy, batch_potential_energy, initial_states, pendulum_field
+from double_pendulum.model.dynamics import linearised_normal_modes
+from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.results_io import read_results_csv
 
 P = PendulumParameters()
@@ -186,7 +186,7 @@ def test_poincare_points_lie_on_the_section_and_the_energy_surface():
 
 
 def test_chaos_scenario_writes_results_plots_and_summary(runner, tmp_path):
-    import scenarios.chaos as scenario
+    import double_pendulum.scenarios.chaos as scenario
 
     summary = scenario.run(runner, tmp_path, quick=True)
     written = json.loads((tmp_path / "summary.json").read_text())

@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum import decay_fit as df
-from double_pendulum.energy import total_energy
-from double_pendulum.measurement import load_track, reconstruct
+from double_pendulum.analysis import decay_fit as df
+from double_pendulum.analysis.measurement import load_track, reconstruct
+from double_pendulum.model.energy import total_energy
 from double_pendulum.results_io import read_results_csv
 
 T = np.arange(630) / 29.97  # the seed's frames [s]
@@ -134,7 +134,7 @@ def test_effective_sample_factor_detects_correlated_residuals():
 
 @pytest.fixture(scope="module")
 def scenario(tmp_path_factory):
-    from scenarios import energy_decay
+    from double_pendulum.scenarios import energy_decay
 
     out = tmp_path_factory.mktemp("energy_decay")
     return out, energy_decay.run(None, out)

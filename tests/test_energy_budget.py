@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from double_pendulum.outputs import OUTPUT_NAMES
-from double_pendulum.parameters import PendulumParameters
+from double_pendulum.model.outputs import OUTPUT_NAMES
+from double_pendulum.model.parameters import PendulumParameters
 
 START = {"phi1_0": 1.5, "phi2_0": 1.0, "rtol": 1e-10, "atol": 1e-12}
 MECHANISMS = {

@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 from conftest import DATA
 
-from double_pendulum.dynamics import fixed_pivot_vector_field
-from double_pendulum.ensemble import (
+from double_pendulum.analysis.ensemble import (
     batch_energy,
     columnwise_field,
     dop853_trajectory,
@@ -17,8 +16,9 @@ from double_pendulum.ensemble import (
     pendulum_field,
     rk4_trajectory,
 )
-from double_pendulum.model import ModelConfig
-from double_pendulum.parameters import AirDragParameters, PendulumParameters
+from double_pendulum.model.dynamics import fixed_pivot_vector_field
+from double_pendulum.model.parameters import AirDragParameters, PendulumParameters
+from double_pendulum.model.vector_field import ModelConfig
 from double_pendulum.results_io import read_results_csv
 from double_pendulum.solvers import make_integrator
 

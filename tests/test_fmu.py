@@ -15,12 +15,12 @@ import pytest
 from conftest import DATA
 from scipy.special import ellipk
 
-from double_pendulum.dynamics import linearised_normal_modes
-from double_pendulum.outputs import OUTPUT_NAMES
-from double_pendulum.parameters import PendulumParameters
+from double_pendulum.fmu.runner import FmuRunError
+from double_pendulum.fmu.simulate import simulate
+from double_pendulum.model.dynamics import linearised_normal_modes
+from double_pendulum.model.outputs import OUTPUT_NAMES
+from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.results_io import read_results_csv
-from double_pendulum.runner import FmuRunError
-from double_pendulum.simulate import simulate
 
 
 def _model_description(fmu_path) -> ET.Element:
@@ -234,3 +234,16 @@ def test_fmu_ships_hash_checked_bytecode(fmu_path):
         assert cached in names
         flags = int.from_bytes(z.read(cached)[4:8], "little")
         assert flags == 0b11  # PEP 552: hash-based, checked against the source
+
+
+def test_fmu_bundles_only_the_runtime(fmu_path):
+    """resources/ holds the adapter, pythonfmu and the runtime subpackages: no analysis, plots or CLI."""
+    import zipfile
+
+    from double_pendulum.fmu.build import RUNTIME_SUBPACKAGES
+
+    with zipfile.ZipFile(fmu_path) as fmu:
+        sources = [n for n in fmu.namelist() if n.startswith("resources/double_pendulum/") and n.endswith(".py")]
+    parts = {n.split("/")[2] for n in sources}
+    assert parts == {"__init__.py", *RUNTIME_SUBPACKAGES}
+    assert not any(word in n for n in sources for word in ("analysis", "plots", "cli", "scenarios", "fmu/"))

@@ -8,10 +8,10 @@ import random
 import pytest
 from scipy.integrate import quad
 
-from double_pendulum.dynamics import fixed_pivot_vector_field
-from double_pendulum.forces import bearing_torque, quadratic_drag, rod_drag_integrals
-from double_pendulum.model import ModelConfig, build_model, energies, state_layout
-from double_pendulum.parameters import AirDragParameters, BearingParameters, SuspensionParameters
+from double_pendulum.model.dynamics import fixed_pivot_vector_field
+from double_pendulum.model.forces import bearing_torque, quadratic_drag, rod_drag_integrals
+from double_pendulum.model.parameters import AirDragParameters, BearingParameters, SuspensionParameters
+from double_pendulum.model.vector_field import ModelConfig, build_model, energies, state_layout
 
 ALL_ON = ModelConfig(
     air=AirDragParameters(air_drag=True, rod_drag=True),

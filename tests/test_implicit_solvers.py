@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum.dynamics import fixed_pivot_vector_field
-from double_pendulum.model import ModelConfig, build_model, energies
-from double_pendulum.parameters import PendulumParameters, SuspensionParameters
+from double_pendulum.model.dynamics import fixed_pivot_vector_field
+from double_pendulum.model.parameters import PendulumParameters, SuspensionParameters
+from double_pendulum.model.vector_field import ModelConfig, build_model, energies
 from double_pendulum.solvers import METHODS, Integrator, SolverError, make_integrator, make_method
 from double_pendulum.solvers.linalg import SingularMatrixError, lu_factor, lu_solve
 
@@ -162,7 +162,7 @@ def test_registry_names():
 @pytest.mark.parametrize("solver", ["rodas4", "gauss4"])
 def test_cosimulation_state_round_trip_with_the_implicit_solvers(solver):
     """The FMU's get/set state (serialised as JSON) continues bit-identically with the new methods."""
-    from double_pendulum.cosimulation import DoublePendulumCoSimulation
+    from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 
     def start() -> DoublePendulumCoSimulation:
         sim = DoublePendulumCoSimulation()

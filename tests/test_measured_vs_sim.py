@@ -6,10 +6,10 @@ import json
 
 import numpy as np
 import pytest
+from double_pendulum.scenarios import measured_vs_sim as mv
 
-from double_pendulum.measurement import load_track, reconstruct
-from double_pendulum.results_io import read_results_csv
-from double_pendulum.start_state import (
+from double_pendulum.analysis.measurement import load_track, reconstruct
+from double_pendulum.analysis.start_state import (
     ANGLE_OUTPUTS,
     FIT_SETTINGS,
     fit_start_state,
@@ -17,7 +17,7 @@ from double_pendulum.start_state import (
     simulate_frames,
     state_start_values,
 )
-from scenarios import measured_vs_sim as mv
+from double_pendulum.results_io import read_results_csv
 
 MODEL = {"air_drag": True, "rod_drag": True, "bearing_friction": True, "suspension": True}
 TRUE_STATE = np.array([-0.2, 0.7, 2.0, -4.0])  # rad, rad, rad/s, rad/s

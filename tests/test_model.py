@@ -8,10 +8,10 @@ import random
 import numpy as np
 import pytest
 
-from double_pendulum.dynamics import angular_accelerations, fixed_pivot_vector_field, linearised_normal_modes
-from double_pendulum.energy import kinetic_energy, potential_energy, total_energy
-from double_pendulum.kinematics import positions, velocities
-from double_pendulum.parameters import PendulumParameters
+from double_pendulum.model.dynamics import angular_accelerations, fixed_pivot_vector_field, linearised_normal_modes
+from double_pendulum.model.energy import kinetic_energy, potential_energy, total_energy
+from double_pendulum.model.kinematics import positions, velocities
+from double_pendulum.model.parameters import PendulumParameters
 
 P = PendulumParameters()
 

@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 from conftest import DATA
 
-from double_pendulum.parameters import InitialState, ParameterError, PendulumParameters, SolverSettings
+from double_pendulum.component.settings import SolverSettings
+from double_pendulum.model.parameters import InitialState, ParameterError, PendulumParameters
 from double_pendulum.solvers import UnknownSolverError
 
 

@@ -6,7 +6,7 @@ import re
 
 from conftest import REPO
 
-from double_pendulum.fmu_interface import fmu_variables
+from double_pendulum.component.variables import fmu_variables
 
 README = (REPO / "README.md").read_text()
 

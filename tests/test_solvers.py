@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum.dynamics import fixed_pivot_vector_field
-from double_pendulum.parameters import PendulumParameters
+from double_pendulum.model.dynamics import fixed_pivot_vector_field
+from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.solvers import METHODS, Integrator, SolverError, make_integrator, make_method
 from double_pendulum.solvers import tableaus as tb
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import json
 
-from scenarios import stability
+from double_pendulum.scenarios import stability
 
 
 def test_every_stability_case_meets_its_criterion(runner, tmp_path):

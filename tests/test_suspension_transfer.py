@@ -6,15 +6,20 @@ import json
 
 import numpy as np
 import pytest
+from double_pendulum.scenarios import suspension_transfer as st
+from double_pendulum.scenarios.friction_budget import SEED_RELEASE
 
-from double_pendulum.decay_fit import calibrate_error_model, fit_model
-from double_pendulum.decay_map import MAP_SETTINGS, decay_rate_sweep
-from double_pendulum.measurement import FRAME_INTERVAL, load_track, reconstruct
+from double_pendulum.analysis.decay_fit import calibrate_error_model, fit_model
+from double_pendulum.analysis.decay_map import MAP_SETTINGS, decay_rate_sweep
+from double_pendulum.analysis.measurement import FRAME_INTERVAL, load_track, reconstruct
+from double_pendulum.analysis.suspension_identification import (
+    FIT_SETTINGS,
+    FitFrames,
+    identify_suspension,
+    suspension_values,
+)
+from double_pendulum.analysis.suspension_response import pivot_force_spectrum
 from double_pendulum.results_io import read_results_csv
-from double_pendulum.suspension_identification import FIT_SETTINGS, FitFrames, identify_suspension, suspension_values
-from double_pendulum.suspension_response import pivot_force_spectrum
-from scenarios import suspension_transfer as st
-from scenarios.friction_budget import SEED_RELEASE
 
 
 @pytest.fixture(scope="module")

@@ -2,15 +2,12 @@
 
 from __future__ import annotations
 
-import io
-
 import numpy as np
 import pytest
 
-from double_pendulum import chaos
-from double_pendulum.progress import ProgressLine
-from double_pendulum.runner import FmuRunError
-from double_pendulum.sweep import chunk, grid_cases, random_cases, run_sweep
+from double_pendulum.analysis import chaos
+from double_pendulum.analysis.sweep import chunk, grid_cases, parallel_map, random_cases, run_sweep
+from double_pendulum.fmu.runner import FmuRunError
 
 OPTIONS = {"stop_time": 0.5, "output_interval": 0.05}
 
@@ -97,14 +94,10 @@ def test_batch_work_split_over_processes_is_identical_to_one_batch():
     np.testing.assert_array_equal(parallel.rod, serial.rod)
 
 
-def test_progress_line_counts_and_estimates():
-    stream = io.StringIO()
-    with ProgressLine(4, "sweep", enabled=True, stream=stream, min_interval=0.0) as bar:
-        bar.update(1)
-        assert "sweep: 1/4 (25 %)" in stream.getvalue() and "ETA" in stream.getvalue()
-        bar.update(3)
-    assert stream.getvalue().endswith("\n") and "4/4 (100 %)" in stream.getvalue()
-    quiet = io.StringIO()
-    with ProgressLine(4, "sweep", stream=quiet) as bar:  # not a terminal: silent by default
-        bar.update(4)
-    assert quiet.getvalue() == ""
+def test_progress_bar_counts_and_estimates(capsys):
+    results, _ = parallel_map(abs, [-1, -2, -3, -4], max_workers=1, progress=True, label="sweep")
+    assert results == [1, 2, 3, 4]
+    shown = capsys.readouterr().err
+    assert "sweep" in shown and "4/4" in shown and "100%" in shown and "run/s" in shown
+    parallel_map(abs, [-1, -2], max_workers=1, label="sweep")  # stderr is not a terminal: silent by default
+    assert capsys.readouterr().err == ""

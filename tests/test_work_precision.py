@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import math
 
-from scenarios import work_precision
+from double_pendulum.scenarios import work_precision
 
 
 def test_work_precision_report_on_a_tiny_configuration(runner, tmp_path):

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 HERE = Path(__file__).resolve().parent
-# The seed pendulum (double_pendulum.parameters defaults), written out so this script stands alone.
+# The seed pendulum (double_pendulum.model.parameters defaults), written out so this script stands alone.
 M1, M2, L1, L2, G = 0.301, 0.297, 0.2964, 0.1971, 9.81
 CASES = {
     "regular": {"y0": (0.3, 0.3, 0.0, 0.0), "stop_time": 10.0},

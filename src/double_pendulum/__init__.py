@@ -1,12 +1,20 @@
 """double-pendulum-fmu: a planar double pendulum as an FMI 2.0 co-simulation FMU.
 
-Modules: :mod:`.parameters` (units, defaults, checks), :mod:`.dynamics` (equations of motion),
-:mod:`.kinematics`, :mod:`.energy`, :mod:`.outputs`, :mod:`.solvers` (integrators),
-:mod:`.cosimulation` (the slave the FMU runs), :mod:`.simulate` (the same in-process),
-:mod:`.fmu_build` (build the FMU), :mod:`.runner` (run it through fmpy), :mod:`.results_io`
-(CSV/JSON), :mod:`.plotting` and :mod:`.cli`.
+The runtime, which the FMU bundles and runs (pure Python, standard library only):
 
-Importing the package is cheap (no NumPy, SciPy or Matplotlib): the FMU loads it at start-up.
+* :mod:`.model` -- parameters, kinematics, equations of motion, forces, energies, the assembled
+  vector field and the outputs;
+* :mod:`.solvers` -- the integrators, separate from the vector field;
+* :mod:`.component` -- the co-simulation component the FMU adapter drives, and its variables.
+
+What studies it (NumPy, SciPy, Matplotlib, fmpy; never bundled):
+
+* :mod:`.fmu` -- build the FMU, run it through fmpy or libcosim, or in-process;
+* :mod:`.analysis` -- measured track, decay fits, identification, chaos, ensembles, sweeps;
+* :mod:`.plots`, :mod:`.results_io`, :mod:`.scenarios` and :mod:`.cli`.
+
+Imports point one way, from the studies to the runtime (``.importlinter``, checked in CI).
+Importing the package is cheap: the FMU loads it at start-up.
 """
 
 __version__ = "0.1.0"

@@ -8,11 +8,11 @@ import sys
 import time
 from pathlib import Path
 
-from .fmu_build import DEFAULT_FMU_PATH, build_fmu
+from .fmu.build import DEFAULT_FMU_PATH, build_fmu
 
 
 def _scenario_names() -> tuple[str, ...]:
-    from scenarios import SCENARIOS
+    from .scenarios import SCENARIOS
 
     return SCENARIOS
 
@@ -20,7 +20,7 @@ def _scenario_names() -> tuple[str, ...]:
 def _load_scenario(name: str):
     if name not in _scenario_names():
         raise SystemExit(f"unknown scenario {name!r}; available: {', '.join(_scenario_names())}")
-    return importlib.import_module(f"scenarios.{name}")
+    return importlib.import_module(f"double_pendulum.scenarios.{name}")
 
 
 def cmd_build(args: argparse.Namespace) -> int:
@@ -37,7 +37,7 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 def cmd_variables(args: argparse.Namespace) -> int:
     """Print the FMU's variables as the Markdown table used in the README."""
-    from .fmu_interface import fmu_variables
+    from .component.variables import fmu_variables
 
     print("| name | causality | type | unit | start | description |")
     print("|---|---|---|---|---|---|")
@@ -49,7 +49,7 @@ def cmd_variables(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .runner import FmuRunner, ensure_fmu
+    from .fmu.runner import FmuRunner, ensure_fmu
 
     names = _scenario_names() if args.scenario == "all" else (args.scenario,)
     modules = [_load_scenario(n) for n in names]

@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from .fmu_build import DEFAULT_FMU_PATH, build_fmu, fmu_is_current
-from .outputs import OUTPUT_NAMES
+from ..model.outputs import OUTPUT_NAMES
+from .build import DEFAULT_FMU_PATH, build_fmu, fmu_is_current
 
 
 class FmuRunError(RuntimeError):

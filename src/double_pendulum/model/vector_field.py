@@ -3,7 +3,7 @@ r"""The assembled model: which states exist, the vector field, and every output 
 A scene switches mechanisms on or off (:class:`ModelConfig`); :func:`build_model` then builds a
 state vector with only the states the scene needs and a vector field with only the enabled terms.
 With every mechanism off the vector field *is* the frictionless core
-(:func:`double_pendulum.dynamics.fixed_pivot_vector_field`), so results are bit-identical.
+(:func:`double_pendulum.model.dynamics.fixed_pivot_vector_field`), so results are bit-identical.
 
 State vector: ``[phi1, phi2, omega1, omega2]``, then ``[xs, vxs]`` if the suspension moves
 horizontally, ``[ys, vys]`` if it moves vertically, then the dissipated work ``W_air``,
@@ -26,7 +26,7 @@ Equations with the suspension (pivot displaced by ``(xs, ys)`` from its static e
 
 with :math:`A_{1x} = (m_1+m_2) l_1 \cos\varphi_1`, :math:`A_{1y} = (m_1+m_2) l_1 \sin\varphi_1`,
 :math:`A_{2x} = m_2 l_2 \cos\varphi_2`, :math:`A_{2y} = m_2 l_2 \sin\varphi_2`, and :math:`M_{ij}, b_i` as in
-:mod:`double_pendulum.dynamics` (including the generalised forces :math:`Q_1, Q_2`). The pivot rows
+:mod:`double_pendulum.model.dynamics` (including the generalised forces :math:`Q_1, Q_2`). The pivot rows
 are eliminated (Schur complement) and the remaining 2x2 system solved in closed form.
 
 Bearing friction torques depend on the joint reaction forces, which depend on the accelerations:
@@ -287,7 +287,7 @@ def energies(config: ModelConfig, y: list[float], layout: StateLayout | None = N
     """Return ``(E_kin, E_pot, E_suspension)`` [J] of state ``y``.
 
     ``E_kin``: both bobs, absolute velocities; ``E_pot``: pendulum potential relative to the pivot,
-    zero hanging at rest; ``E_suspension``: see :func:`double_pendulum.energy.suspension_energy`.
+    zero hanging at rest; ``E_suspension``: see :func:`double_pendulum.model.energy.suspension_energy`.
     """
     layout = layout or state_layout(config)
     ix, iy = layout.index("xs"), layout.index("ys")

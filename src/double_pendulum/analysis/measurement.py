@@ -18,7 +18,7 @@ quantities the friction analysis needs:
 
    (unwrapped), their rates by central differences (the seed's method, 4.2.1) and by a
    Savitzky-Golay derivative filter (:data:`SG_WINDOW`, :data:`SG_POLYORDER`), the energy per frame
-   with :func:`double_pendulum.energy.total_energy` and two uncertainties of that energy: the
+   with :func:`double_pendulum.model.energy.total_energy` and two uncertainties of that energy: the
    seed's eq. 25 and the propagated position noise (:func:`sigma_energy_propagated`).
 
 Lengths in m, times in s, angles in rad, energies in J.
@@ -39,15 +39,16 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import savgol_coeffs
 
-from .energy import kinetic_energy, potential_energy, total_energy
-from .kinematics import velocities
-from .parameters import PendulumParameters
+from ..data import data_path
+from ..model.energy import kinetic_energy, potential_energy, total_energy
+from ..model.kinematics import velocities
+from ..model.parameters import PendulumParameters
 
 FPS = 29.97
 """Frame rate of the seed's video [1/s]."""
 FRAME_INTERVAL = 1.0 / FPS
 """Time between frames [s]."""
-DEFAULT_TRACK_PATH = Path(__file__).resolve().parents[2] / "data" / "seed_table1.csv"
+DEFAULT_TRACK_PATH = data_path("seed_table1.csv")
 """The repository's copy of the seed's Table 1 (``src/double_pendulum`` -> ``../../data``)."""
 TRACK_COLUMNS = ("frame", "t_s", "x1_m", "y1_m", "x2_m", "y2_m")
 
@@ -331,7 +332,7 @@ def angles(x1: np.ndarray, y1: np.ndarray, x2: np.ndarray, y2: np.ndarray) -> tu
     """Unwrapped rod angles from the downward vertical [rad] (pivot at the origin, y up).
 
     ``phi1 = atan2(x1, -y1)``, ``phi2 = atan2(x2 - x1, -(y2 - y1))``: the inverse of
-    :func:`double_pendulum.kinematics.positions`.
+    :func:`double_pendulum.model.kinematics.positions`.
     """
     phi1 = np.unwrap(np.arctan2(x1, -y1))
     phi2 = np.unwrap(np.arctan2(x2 - x1, -(y2 - y1)))
@@ -399,7 +400,7 @@ def savgol_derivative(
 def bob_speeds(
     phi1: np.ndarray, phi2: np.ndarray, omega1: np.ndarray, omega2: np.ndarray, params: PendulumParameters
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Speeds |v1|, |v2| [m/s] of the bobs (:func:`double_pendulum.kinematics.velocities`)."""
+    """Speeds |v1|, |v2| [m/s] of the bobs (:func:`double_pendulum.model.kinematics.velocities`)."""
     vx1, vy1, vx2, vy2 = velocities(phi1, phi2, omega1, omega2, params.l1, params.l2, np.sin, np.cos)
     return np.hypot(vx1, vy1), np.hypot(vx2, vy2)
 
@@ -417,7 +418,7 @@ def energy_gradient(
     params: PendulumParameters,
     step: float = 1e-6,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Partial derivatives of :func:`~double_pendulum.energy.total_energy` by (phi1, phi2, omega1, omega2).
+    """Partial derivatives of :func:`~double_pendulum.model.energy.total_energy` by (phi1, phi2, omega1, omega2).
 
     Central differences of the package's own energy function (no second energy formula); exact
     up to round-off in omega (E is quadratic there), error O(step^2) in phi.

@@ -7,12 +7,12 @@ dampers c = c_x = c_y) to it through the FMU, with air drag (bobs and rods) and 
 on (:data:`LOSSES`).
 
 Measured decay (:func:`measured_decay`). The camera energy after the hand release with the
-calibrated errors of :func:`~double_pendulum.decay_fit.calibrate_error_model`, fitted with
+calibrated errors of :func:`~double_pendulum.analysis.decay_fit.calibrate_error_model`, fitted with
 E = a exp(b t) (``decay_fit`` model ``exponential``); the error of b is inflated by
 sqrt(F), F the residual-correlation factor of
-:func:`~double_pendulum.decay_fit.effective_sample_factor`. Every FMU run starts from the state the
+:func:`~double_pendulum.analysis.decay_fit.effective_sample_factor`. Every FMU run starts from the state the
 pendulum was measured in after the release (fitted to the first :data:`START_FIT_FRAMES` frames by
-:func:`double_pendulum.start_state.fit_start_state`).
+:func:`double_pendulum.analysis.start_state.fit_start_state`).
 
 Decay rate. b is fitted to the **pendulum's** energy E_pendulum (the two bobs, output of the FMU)
 on the measured frames with the measured fit's calibrated errors (:func:`simulated_decay_rate`), so
@@ -27,13 +27,13 @@ Identification (:func:`identify_damping`). At fixed k and M_s,
     \chi^2(c) = \sum_i \frac{(E^{FMU}_i(c) - E_i)^2}{\sigma_i^2}
 
 is minimised by Gauss-Newton in ln c (:func:`least_squares_1d`), started from the c at which the
-linear response of :mod:`double_pendulum.suspension_response` gives the missing share of b
+linear response of :mod:`double_pendulum.analysis.suspension_response` gives the missing share of b
 (:func:`guess_damping`); :math:`\sigma_c^2 = F / (J^T J)` with J = dr/dc at the optimum.
 
 The valley (:func:`valley_fisher`). The energy fixes one combination of (k, c, M_s): the Jacobian of
 the residuals in (ln k, ln c, ln M_s) gives the Fisher matrix :math:`J^T J`, its weakest direction
 and the slope of the valley :math:`d\ln c/d\ln k = -J_k\cdot J_c / J_c\cdot J_c` (the stiff limit
-b ~ c/k^2 would give 2). :func:`double_pendulum.decay_map.trace_valley` follows it.
+b ~ c/k^2 would give 2). :func:`double_pendulum.analysis.decay_map.trace_valley` follows it.
 
 Decay shape (:func:`decay_shape`). Besides b, the power law dE/dt = -k E^p (``decay_fit`` model
 ``power``) is fitted to the measured and the simulated energies: p tells how the loss depends on the
@@ -51,6 +51,8 @@ from typing import Any
 
 import numpy as np
 
+from ..fmu.runner import FmuRunner
+from ..model.parameters import SuspensionParameters
 from .decay_fit import (
     AUTOCORRELATION_LAG_S,
     MODELS,
@@ -60,8 +62,6 @@ from .decay_fit import (
     fit_model,
 )
 from .measurement import FPS, FRAME_INTERVAL, Reconstruction, load_track, reconstruct
-from .parameters import SuspensionParameters
-from .runner import FmuRunner
 from .start_state import StartStateFit, fit_start_state, track_window
 from .suspension_response import ForceSpectrum, pivot_force_spectrum
 
@@ -135,7 +135,7 @@ class MeasuredDecay:
 def measured_decay(rec: Reconstruction, window_s: float | None = None) -> MeasuredDecay:
     """Exponential fit of the measured energy after the release (as ``energy_decay``), optionally
     only the first ``window_s`` seconds [s] after it; errors from
-    :func:`~double_pendulum.decay_fit.calibrate_error_model`."""
+    :func:`~double_pendulum.analysis.decay_fit.calibrate_error_model`."""
     i0 = rec.release_frame
     mask = rec.free_motion.copy()
     if window_s is not None:
@@ -307,7 +307,7 @@ def identify_damping(
     :math:`\chi^2(c) = \sum_i (E^{FMU}_i(c) - E_i)^2/\sigma_i^2` with the calibrated errors,
     minimised by :func:`least_squares_1d`;
     :math:`\sigma_c^2 = F / (J^T J)` with J = d r / d c at the optimum and F the
-    residual-correlation factor (:func:`~double_pendulum.decay_fit.effective_sample_factor`).
+    residual-correlation factor (:func:`~double_pendulum.analysis.decay_fit.effective_sample_factor`).
     """
 
     def residuals(c: float) -> np.ndarray:

@@ -1,13 +1,13 @@
 r"""Chaos of the double pendulum: Lyapunov exponents, flip times, predictability, Poincare sections.
 
-Everything here runs on batches (:mod:`double_pendulum.ensemble`) and uses the model's own
+Everything here runs on batches (:mod:`double_pendulum.analysis.ensemble`) and uses the model's own
 vector field; nothing re-derives the equations of motion.
 
 **Lyapunov exponents** (Benettin et al., Meccanica 15 (1980) 9-20). A tangent vector
 :math:`v` obeys the variational equation :math:`\dot v = J(y)\,v` with :math:`J = \partial f/\partial y`.
 :math:`J v` is obtained from the vector field itself by the *complex step*
 :math:`J v = \operatorname{Im} f(y + i\varepsilon v)/\varepsilon` (:math:`\varepsilon = 10^{-20}`):
-:func:`double_pendulum.dynamics.angular_accelerations` is analytic (sums, products, quotients,
+:func:`double_pendulum.model.dynamics.angular_accelerations` is analytic (sums, products, quotients,
 sine, cosine), so this is exact to rounding, with no cancellation, and needs no hand-written
 Jacobian. A central difference is available for vector fields that are not analytic (e.g. with
 Coulomb friction). The tangent vectors are integrated together with the trajectory and
@@ -34,7 +34,7 @@ of one term per angle, each smallest at 0, so on the set where rod 1 is upright
 :math:`V \ge V(\pi, 0) = 2 (m_1+m_2) g l_1`, and where rod 2 is upright :math:`V \ge V(0, \pi) = 2 m_2 g l_2`.
 Hence rod 1 can flip only if :math:`E \ge V(\pi, 0)`, rod 2 only if :math:`E \ge V(0, \pi)`, and no
 rod can flip if :math:`E < \min(V(\pi,0), V(0,\pi))` (:func:`flip_energy_bounds`, evaluated with
-:func:`double_pendulum.energy.potential_energy`). Released from rest,
+:func:`double_pendulum.model.energy.potential_energy`). Released from rest,
 :math:`E = V(\varphi_{1,0}, \varphi_{2,0})`: the curve :math:`V(\varphi_{1,0}, \varphi_{2,0}) = 2 m_2 g l_2`
 bounds the region of the flip map where flipping is impossible.
 """
@@ -49,7 +49,8 @@ from typing import Any
 
 import numpy as np
 
-from .energy import kinetic_energy, potential_energy
+from ..model.energy import kinetic_energy, potential_energy
+from ..model.parameters import PendulumParameters
 from .ensemble import (
     BatchField,
     Dop853Batch,
@@ -60,7 +61,6 @@ from .ensemble import (
     rk4_iterate,
     rk4_step,
 )
-from .parameters import PendulumParameters
 
 COMPLEX_STEP = 1e-20
 STATE_DIM = 4
@@ -134,7 +134,7 @@ class _Rk4Stepper:
 
 
 class _Dop853Stepper:
-    """Per-trajectory DOP853 (:mod:`double_pendulum.ensemble`) behind the stepper interface."""
+    """Per-trajectory DOP853 (:mod:`double_pendulum.analysis.ensemble`) behind the stepper interface."""
 
     def __init__(self, field: BatchField, z0: np.ndarray, rtol: float, atol: float, t0: float = 0.0) -> None:
         self.batch = Dop853Batch(field, z0, t0, rtol, atol)
@@ -287,7 +287,7 @@ def lyapunov_benettin(
     """Largest (``n_vectors = 1``) or first ``n_vectors`` Lyapunov exponents [1/s] of a batch of starts.
 
     ``y0`` ``(d, N)``; tangent vectors renormalised (QR) every ``renorm_interval`` [s] up to
-    ``t_end`` [s]; ``field`` may include friction (any :data:`double_pendulum.ensemble.BatchField`).
+    ``t_end`` [s]; ``field`` may include friction (any :data:`double_pendulum.analysis.ensemble.BatchField`).
     RK4 with the complex step integrates the complexified flow (:class:`_ComplexStepRk4Tangents`),
     otherwise trajectory and tangents are one augmented real state.
     """
@@ -472,7 +472,7 @@ def flip_time_map(
 
     The rows of the grid are dealt round-robin into two chunks per worker (so every chunk gets
     low- and high-energy rows alike) and run on ``max_workers`` local processes (``None``: all
-    cores) by :func:`double_pendulum.sweep.parallel_map`; each chunk is one RK4 batch.
+    cores) by :func:`double_pendulum.analysis.sweep.parallel_map`; each chunk is one RK4 batch.
     """
     from .sweep import default_workers, parallel_map
 
@@ -608,7 +608,7 @@ def section_starts(
     """Starts on the section ``phi1 = 0``, ``omega1 > 0`` with total energy ``energy`` [J].
 
     For each ``(phi2, omega2)`` the kinetic energy is a quadratic ``a w1^2 + b w1 + c`` in
-    ``w1 = omega1``; its coefficients are read off :func:`double_pendulum.energy.kinetic_energy` at
+    ``w1 = omega1``; its coefficients are read off :func:`double_pendulum.model.energy.kinetic_energy` at
     ``w1 = -1, 0, 1`` and the larger root of ``a w1^2 + b w1 + c = E - V`` is taken. Points without
     a real root are dropped. Returns ``(4, n)``.
     """

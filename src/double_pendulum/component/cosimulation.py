@@ -1,7 +1,7 @@
 """The co-simulation component: parameters by name, initialisation, doStep, outputs.
 
 This is what the FMU runs (``fmu_src/DoublePendulum.py`` only maps FMI calls onto it) and what
-:func:`double_pendulum.simulate.simulate` runs in-process, so both give identical numbers.
+:func:`double_pendulum.fmu.simulate.simulate` runs in-process, so both give identical numbers.
 
 Life cycle (FMI 2.0 co-simulation):
 
@@ -20,19 +20,19 @@ from collections.abc import Iterator, Mapping
 from dataclasses import fields
 from typing import Any
 
-from .model import Model, ModelConfig, ModelError, build_model
-from .outputs import GROUP_OF, OUTPUT_GROUPS, OUTPUT_NAMES
-from .parameters import (
+from ..model.outputs import GROUP_OF, OUTPUT_GROUPS, OUTPUT_NAMES
+from ..model.parameters import (
     AirDragParameters,
     BearingParameters,
     InitialState,
     ParameterError,
     PendulumParameters,
-    SolverSettings,
     SuspensionParameters,
     check_value,
 )
-from .solvers import Integrator, SolverError, make_integrator
+from ..model.vector_field import Model, ModelConfig, ModelError, build_model
+from ..solvers import Integrator, SolverError, make_integrator
+from .settings import SolverSettings
 
 PARAMETER_GROUPS: tuple[type, ...] = (
     PendulumParameters,
@@ -65,7 +65,7 @@ class LazyOutputs(Mapping[str, float]):
     """The outputs at one communication point, computed group by group on first access.
 
     A host that reads only the angles never pays for the energies or the pivot force
-    (see :data:`double_pendulum.outputs.OUTPUT_GROUPS`).
+    (see :data:`double_pendulum.model.outputs.OUTPUT_GROUPS`).
     """
 
     def __init__(self, model: Model | None, y: list[float] | None, initial_energy: float | None,

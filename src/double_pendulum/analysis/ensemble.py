@@ -7,9 +7,9 @@ the whole ensemble, on contiguous rows.
 
 One copy of the physics: :func:`pendulum_field` is the model's right-hand side
 :math:`\dot\varphi_i = \omega_i`, :math:`\dot\omega_i = \ddot\varphi_i` with the accelerations from
-:func:`double_pendulum.dynamics.angular_accelerations` called with ``sin=np.sin, cos=np.cos``;
-energies and positions come from :mod:`double_pendulum.energy` and
-:mod:`double_pendulum.kinematics` the same way. The methods use the Butcher tableaus of
+:func:`double_pendulum.model.dynamics.angular_accelerations` called with ``sin=np.sin, cos=np.cos``;
+energies and positions come from :mod:`double_pendulum.model.energy` and
+:mod:`double_pendulum.model.kinematics` the same way. The methods use the Butcher tableaus of
 :mod:`double_pendulum.solvers.tableaus`.
 
 Two methods, chosen for two jobs:
@@ -30,7 +30,7 @@ Two methods, chosen for two jobs:
 
 Vector fields take ``(t, Y)`` and return ``dY/dt`` of the same shape; with per-trajectory steps
 ``t`` is an array of shape ``(N,)``. They may be called with complex ``Y`` (complex-step
-derivatives in :mod:`double_pendulum.chaos`); :func:`pendulum_field` supports that.
+derivatives in :mod:`double_pendulum.analysis.chaos`); :func:`pendulum_field` supports that.
 """
 
 from __future__ import annotations
@@ -42,12 +42,12 @@ from typing import Any
 
 import numpy as np
 
-from .dynamics import angular_accelerations
-from .energy import potential_energy, total_energy
-from .kinematics import positions
-from .parameters import PendulumParameters
-from .solvers import SolverError
-from .solvers import tableaus as tb
+from ..model.dynamics import angular_accelerations
+from ..model.energy import potential_energy, total_energy
+from ..model.kinematics import positions
+from ..model.parameters import PendulumParameters
+from ..solvers import SolverError
+from ..solvers import tableaus as tb
 
 BatchField = Callable[[Any, np.ndarray], np.ndarray]
 """``f(t, Y) -> dY/dt`` for ``Y`` of shape ``(d, N)``; ``t`` a float or an ``(N,)`` array [s]."""
@@ -79,7 +79,7 @@ def pendulum_field(params: PendulumParameters | None = None, forces: Generalised
     """Return the double pendulum's right-hand side for batches ``Y = [phi1, phi2, omega1, omega2]``.
 
     ``dY/dt = [omega1, omega2, phi1'', phi2'']`` with the accelerations [rad/s^2] of
-    :func:`double_pendulum.dynamics.angular_accelerations`; ``forces`` adds generalised forces
+    :func:`double_pendulum.model.dynamics.angular_accelerations`; ``forces`` adds generalised forces
     ``Q1, Q2`` [N m] (friction models plug in here), none by default (frictionless).
     """
     p = params if params is not None else PendulumParameters()
@@ -119,15 +119,15 @@ def columnwise_field(scalar_field: Callable[[float, list[float]], list[float]]) 
 
 
 def model_field(config: Any) -> BatchField:
-    """The scene ``config`` (:class:`double_pendulum.model.ModelConfig`) as a batch field over the rod states.
+    """The scene ``config`` (:class:`~double_pendulum.model.vector_field.ModelConfig`) as a batch field.
 
     Without any mechanism this is :func:`pendulum_field` (vectorised). With friction it evaluates
-    the model's own float vector field (:func:`double_pendulum.model.build_vector_field`) column by
+    the model's own float vector field (:func:`double_pendulum.model.vector_field.build_vector_field`) column by
     column (:func:`columnwise_field`): the dissipated-work states it appends are fed in as zeros and
     their rates dropped, since no equation depends on them. The suspension adds dynamic states of its
     own and is not supported here.
     """
-    from .model import build_vector_field, is_core, state_layout
+    from ..model.vector_field import build_vector_field, is_core, state_layout
 
     if config.suspension.suspension:
         raise ValueError("model_field: scenes with the suspension have more than the four rod states")
@@ -149,17 +149,17 @@ def initial_states(phi1: Any, phi2: Any, omega1: Any = 0.0, omega2: Any = 0.0) -
 
 
 def batch_energy(y: np.ndarray, params: PendulumParameters) -> np.ndarray:
-    """Total energy T + V [J] of each column of ``y`` (:func:`double_pendulum.energy.total_energy`)."""
+    """Total energy T + V [J] of each column of ``y`` (:func:`double_pendulum.model.energy.total_energy`)."""
     return total_energy(y[0], y[1], y[2], y[3], params, cos=np.cos)
 
 
 def batch_potential_energy(phi1: Any, phi2: Any, params: PendulumParameters) -> Any:
-    """Potential energy V [J] for array angles (:func:`double_pendulum.energy.potential_energy`)."""
+    """Potential energy V [J] for array angles (:func:`double_pendulum.model.energy.potential_energy`)."""
     return potential_energy(phi1, phi2, params, cos=np.cos)
 
 
 def batch_positions(y: np.ndarray, params: PendulumParameters) -> tuple[np.ndarray, ...]:
-    """Bob positions ``(x1, y1, x2, y2)`` [m] per column (:func:`double_pendulum.kinematics.positions`)."""
+    """Bob positions ``(x1, y1, x2, y2)`` [m] per column (:func:`double_pendulum.model.kinematics.positions`)."""
     return positions(y[0], y[1], params.l1, params.l2, sin=np.sin, cos=np.cos)
 
 

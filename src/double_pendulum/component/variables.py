@@ -10,8 +10,8 @@ from __future__ import annotations
 from dataclasses import fields
 from typing import Any, NamedTuple
 
+from ..model.outputs import OUTPUTS
 from .cosimulation import PARAMETER_GROUPS
-from .outputs import OUTPUTS
 
 MODEL_IDENTIFIER = "DoublePendulum"
 MODEL_DESCRIPTION = (

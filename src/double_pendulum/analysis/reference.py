@@ -18,8 +18,8 @@ from typing import Any
 
 import numpy as np
 
-from .cosimulation import DoublePendulumCoSimulation
-from .simulate import simulate
+from ..component.cosimulation import DoublePendulumCoSimulation
+from ..fmu.simulate import simulate
 
 STATE_OUTPUTS = ("phi1", "phi2", "omega1", "omega2")
 CACHE_DIR = Path(".cache") / "references"

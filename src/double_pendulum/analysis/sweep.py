@@ -1,9 +1,9 @@
 """Many FMU runs at once: parameter sweeps on all local cores or on a Dask cluster.
 
 :func:`run_sweep` runs the FMU once per *case* (a mapping of start values, as for
-:meth:`double_pendulum.runner.FmuRunner.simulate`) and returns the results in the order of the
+:meth:`double_pendulum.fmu.runner.FmuRunner.simulate`) and returns the results in the order of the
 cases. The cases are split into contiguous chunks; each worker process extracts the FMU once
-(one :class:`~double_pendulum.runner.FmuRunner` per process, kept for later chunks) and runs its
+(one :class:`~double_pendulum.fmu.runner.FmuRunner` per process, kept for later chunks) and runs its
 chunks one case after another.
 
 * Locally (default) the chunks go to a :class:`concurrent.futures.ProcessPoolExecutor` with one
@@ -18,7 +18,7 @@ chunks one case after another.
 Deterministic: the cases are fixed before anything is distributed (:func:`random_cases` draws
 them from a seeded generator), every run is deterministic, and results are put back in case
 order, so the same cases give bit-identical results with any number of workers, locally or on
-Dask. Long runs show a progress line on stderr (:class:`double_pendulum.progress.ProgressLine`).
+Dask. Long runs show a tqdm progress bar on stderr (rate and time left).
 """
 
 from __future__ import annotations
@@ -40,9 +40,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from tqdm.auto import tqdm
 
-from .progress import ProgressLine
-from .runner import FmuRunError, FmuRunner
+from ..fmu.runner import FmuRunError, FmuRunner
 
 CHUNKS_PER_WORKER = 4
 
@@ -105,6 +105,12 @@ def _call(func: Callable[..., Any], item: Any, shared: Any) -> Any:
     return func(item) if shared is None else func(item, shared)
 
 
+def progress_bar(total: int, label: str, *, enabled: bool | None = None) -> tqdm:
+    """A tqdm bar on stderr counting ``total`` items; ``enabled=None`` shows it only on a terminal."""
+    return tqdm(total=total, desc=label, disable=None if enabled is None else not enabled,
+                file=sys.stderr, mininterval=0.5, unit="run", dynamic_ncols=True)
+
+
 def parallel_map(
     func: Callable[..., Any],
     items: Sequence[Any],
@@ -121,11 +127,11 @@ def parallel_map(
     ``func(item)``, or ``func(item, shared)`` when ``shared`` is given (sent to Dask workers once).
     ``func`` must be importable (a module-level function). ``max_workers=None`` uses every local
     core, ``1`` runs in this process; ``scheduler`` (address or ``distributed.Client``) uses Dask.
-    ``weights`` (default 1 each) count each item's share of the progress line.
+    ``weights`` (default 1 each) count each item's share of the progress bar.
     """
     weights = list(weights) if weights is not None else [1] * len(items)
     results: list[Any] = [None] * len(items)
-    with ProgressLine(sum(weights), label, enabled=progress) as bar:
+    with progress_bar(sum(weights), label, enabled=progress) as bar:
         if scheduler is not None:
             return _dask_map(func, items, shared, scheduler, bar, weights, results)
         workers = min(default_workers() if max_workers is None else max_workers, max(len(items), 1))
@@ -240,7 +246,7 @@ def run_sweep(
     Each result is fmpy's structured array (``time`` and ``outputs``), or ``reduce(result)`` if
     given (computed on the worker, so only the reduced value travels back; it must be a
     module-level function). Parallelism as in :func:`parallel_map`; a failing case raises
-    :class:`~double_pendulum.runner.FmuRunError` naming the case.
+    :class:`~double_pendulum.fmu.runner.FmuRunError` naming the case.
     """
     options: dict[str, Any] = {"stop_time": stop_time, "output_interval": output_interval}
     if outputs is not None:

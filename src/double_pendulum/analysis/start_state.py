@@ -29,8 +29,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
+from ..fmu.runner import FmuRunner
 from .measurement import FRAME_INTERVAL, Reconstruction
-from .runner import FmuRunner
 
 POSITION_OUTPUTS: tuple[str, ...] = ("x1", "y1", "x2", "y2")
 """The FMU outputs compared with the track's positions [m]."""

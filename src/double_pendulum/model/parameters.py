@@ -61,7 +61,7 @@ def check_value(name: str, value: Any, unit: str, rule: str) -> None:
         raise ParameterError(f"invalid {shown}: must be >= 0")
 
 
-class _Validated:
+class Validated:
     """Mixin: validate every field against its declared rule after construction."""
 
     def __post_init__(self) -> None:
@@ -70,7 +70,7 @@ class _Validated:
 
 
 @dataclass(frozen=True)
-class PendulumParameters(_Validated):
+class PendulumParameters(Validated):
     """Physical parameters of the planar double pendulum (point masses on massless rods).
 
     Angles are measured from the downward vertical; y points up, the pivot is the origin.
@@ -84,7 +84,7 @@ class PendulumParameters(_Validated):
 
 
 @dataclass(frozen=True)
-class AirDragParameters(_Validated):
+class AirDragParameters(Validated):
     """Quadratic air drag (seed eq. 23), F = -1/2 rho c_W A |v| v, on the bobs and optionally the rods.
 
     Defaults: rho = 1.2 kg/m^3 and, for the rods, c_W = 2 are the seed's numbers (section 4.2.3).
@@ -107,7 +107,7 @@ class AirDragParameters(_Validated):
 
 
 @dataclass(frozen=True)
-class BearingParameters(_Validated):
+class BearingParameters(Validated):
     """Rolling friction in the ball bearings (seed eq. 24, F_R = c_R F_N) as a joint torque.
 
     Torque magnitude c_R r_b |F_joint| with F_joint the reaction force the joint carries, opposing
@@ -130,7 +130,7 @@ class BearingParameters(_Validated):
 
 
 @dataclass(frozen=True)
-class SuspensionParameters(_Validated):
+class SuspensionParameters(Validated):
     """Damped suspension carrying the pivot (seed 2.4.3): mass M_s on springs and dampers.
 
     The pivot coordinates xs, ys are displacements from the static equilibrium (the spring
@@ -150,7 +150,7 @@ class SuspensionParameters(_Validated):
 
 
 @dataclass(frozen=True)
-class InitialState(_Validated):
+class InitialState(Validated):
     """Start values of the rod angles and their rates (the suspension starts at rest)."""
 
     phi1_0: float = spec(1.0, "rad", "initial angle of the upper rod from the downward vertical")
@@ -161,29 +161,6 @@ class InitialState(_Validated):
     def as_list(self) -> list[float]:
         """Return ``[phi1, phi2, omega1, omega2]`` (rad, rad, rad/s, rad/s)."""
         return [self.phi1_0, self.phi2_0, self.omega1_0, self.omega2_0]
-
-
-@dataclass(frozen=True)
-class SolverSettings(_Validated):
-    """Choice of integrator and its accuracy settings (see :mod:`double_pendulum.solvers`)."""
-
-    solver: str = spec(
-        "dop853", "", "integration method: dop853, dopri5, rodas4 (stiff), gauss4, gauss2, rk4 or euler", rule="str"
-    )
-    rtol: float = spec(1e-9, "1", "relative tolerance of the adaptive solvers", rule="positive")
-    atol: float = spec(1e-12, "1", "absolute tolerance of the adaptive solvers (rad, rad/s)", rule="positive")
-    fixed_step: float = spec(
-        1e-3, "s", "step size of the fixed-step solvers (gauss4, gauss2, rk4, euler)", rule="positive"
-    )
-    max_steps: float = spec(
-        1e6, "1", "most integrator steps within one doStep before it fails (bounds the CPU time)", rule="positive"
-    )
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        from .solvers.registry import check_solver_name
-
-        check_solver_name(self.solver)
 
 
 def field_specs(cls: type) -> list[tuple[str, Any, str, str, str]]:

@@ -1,13 +1,13 @@
 r"""Map of the pendulum's decay rate b over the pivot suspension's stiffness k, damping c and mass M_s.
 
 Each point of the map is one FMU run from the measured start (see
-:mod:`double_pendulum.suspension_identification`) with an isotropic suspension k = k_x = k_y,
-c = c_x = c_y, M_s, swept in parallel by :func:`double_pendulum.sweep.run_sweep`; b is fitted to
+:mod:`double_pendulum.analysis.suspension_identification`) with an isotropic suspension k = k_x = k_y,
+c = c_x = c_y, M_s, swept in parallel by :func:`double_pendulum.analysis.sweep.run_sweep`; b is fitted to
 E_pendulum (and E_total) on the measured frames with the measured errors
-(:func:`~double_pendulum.suspension_identification.simulated_decay_rate`), plus one run without
+(:func:`~double_pendulum.analysis.suspension_identification.simulated_decay_rate`), plus one run without
 suspension for the base rate b0.
 
-Physics of the map. :mod:`double_pendulum.suspension_response` predicts the suspension's share of b
+Physics of the map. :mod:`double_pendulum.analysis.suspension_response` predicts the suspension's share of b
 from the spectrum of the force the pendulum exerts on a fixed pivot (linear response, one FMU run):
 a stiff suspension gives
 
@@ -41,8 +41,8 @@ from typing import Any
 
 import numpy as np
 
+from ..fmu.runner import FmuRunner
 from .measurement import FRAME_INTERVAL
-from .runner import FmuRunner
 from .suspension_identification import (
     FitFrames,
     Identification,
@@ -86,7 +86,7 @@ def decay_rate_sweep(
     cases: Sequence[Mapping[str, Any]],
     max_workers: int | None = None,
 ) -> list[dict[str, float]]:
-    """b of E_pendulum and E_total for every case, run in parallel by :func:`double_pendulum.sweep.run_sweep`.
+    """b of E_pendulum and E_total for every case, run in parallel by :func:`double_pendulum.analysis.sweep.run_sweep`.
 
     run_sweep starts each run at t = 0; the model is autonomous (no explicit time dependence), so
     this is the run from ``frames.t0`` shifted in time, and row n is frame ``t0 + n / FPS``.

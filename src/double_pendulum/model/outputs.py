@@ -14,7 +14,7 @@ from __future__ import annotations
 from typing import NamedTuple
 
 from .kinematics import positions
-from .model import Model
+from .vector_field import Model
 
 
 class Quantity(NamedTuple):
@@ -91,7 +91,7 @@ def energy_outputs(model: Model, y: list[float], initial_energy: float | None = 
 
     ``initial_energy`` is E_total at the start; ``None`` means this state is the start.
     """
-    from .model import energies
+    from .vector_field import energies
 
     e_kin, e_pot, e_sus = energies(model.config, y, model.layout)
     e_pend = e_kin + e_pot

@@ -1,11 +1,13 @@
 """Build ``DoublePendulum.fmu`` with pythonfmu and complete its modelDescription.
 
-pythonfmu writes the FMU from ``fmu_src/DoublePendulum.py``; this package is bundled into the
-FMU's ``resources/`` so the FMU runs without the project installed. pythonfmu's
+pythonfmu writes the FMU from the adapter ``fmu_src/DoublePendulum.py``; the package's runtime
+(``__init__``, :mod:`~double_pendulum.model`, :mod:`~double_pendulum.solvers`,
+:mod:`~double_pendulum.component`) is bundled into the FMU's ``resources/`` so the FMU runs
+without the project installed, and nothing else is (no analysis, plots or CLI). pythonfmu's
 modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the build then
 
 * adds ``UnitDefinitions`` (SI base-unit exponents) and a ``unit`` attribute on every physical
-  Real variable, from :func:`double_pendulum.fmu_interface.fmu_variables`;
+  Real variable, from :func:`double_pendulum.component.variables.fmu_variables`;
 * lists every output under ``ModelStructure/InitialUnknowns`` (they are computed at
   initialisation), so ``fmpy.validation.validate_fmu`` reports no problems;
 * writes ``resources/requirements.txt`` with what the FMU needs at run time.
@@ -20,9 +22,11 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from .fmu_interface import MODEL_IDENTIFIER, fmu_variables
+from ..component.variables import MODEL_IDENTIFIER, fmu_variables
 
-PACKAGE_DIR = Path(__file__).resolve().parent
+PACKAGE_DIR = Path(__file__).resolve().parents[1]
+# The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
+RUNTIME_SUBPACKAGES = ("model", "solvers", "component")
 DEFAULT_FMU_PATH = Path("build") / f"{MODEL_IDENTIFIER}.fmu"
 
 # SI base-unit exponents of every unit the interface uses (FMI 2.0 section 2.2.2).
@@ -52,20 +56,31 @@ RUNTIME_REQUIREMENTS = ["pythonfmu>=0.6.5"]
 
 
 def adapter_script() -> Path:
-    """Return the path of ``fmu_src/DoublePendulum.py`` (source tree or installed copy)."""
-    in_tree = PACKAGE_DIR.parents[1] / "fmu_src" / f"{MODEL_IDENTIFIER}.py"
-    if in_tree.is_file():
-        return in_tree
-    spec = importlib.util.find_spec("fmu_src")
+    """Return the path of the pythonfmu adapter ``DoublePendulum.py``.
+
+    It lives in the repository's ``fmu_src/``, installed as ``double_pendulum.adapters``.
+    """
+    spec = importlib.util.find_spec("double_pendulum.adapters")
     if spec is None or not spec.submodule_search_locations:
-        raise FileNotFoundError("cannot find fmu_src/DoublePendulum.py: is double-pendulum-fmu installed?")
+        raise FileNotFoundError("cannot find double_pendulum.adapters: is double-pendulum-fmu installed?")
     return Path(next(iter(spec.submodule_search_locations))) / f"{MODEL_IDENTIFIER}.py"
 
 
-def _copy_package(dest: Path) -> Path:
-    """Copy this package's Python sources (no caches) into ``dest/double_pendulum``."""
+def runtime_sources() -> list[Path]:
+    """The package's runtime sources, which the FMU bundles: ``__init__.py`` and the runtime subpackages."""
+    files = [PACKAGE_DIR / "__init__.py"]
+    for sub in RUNTIME_SUBPACKAGES:
+        files += sorted((PACKAGE_DIR / sub).rglob("*.py"))
+    return files
+
+
+def _copy_runtime(dest: Path) -> Path:
+    """Copy the runtime sources (no caches) into ``dest/double_pendulum``."""
     target = dest / PACKAGE_DIR.name
-    shutil.copytree(PACKAGE_DIR, target, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    for source in runtime_sources():
+        copy = target / source.relative_to(PACKAGE_DIR)
+        copy.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(source, copy)
     return target
 
 
@@ -156,7 +171,7 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH) -> Path:
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="dp_fmu_build_") as tmp:
         tmp_dir = Path(tmp)
-        package_copy = _copy_package(tmp_dir)
+        package_copy = _copy_runtime(tmp_dir)
         built = FmuBuilder.build_FMU(
             adapter_script(),
             dest=tmp_dir / f"{MODEL_IDENTIFIER}.fmu",
@@ -175,5 +190,5 @@ def fmu_is_current(fmu_path: str | Path) -> bool:
     if not fmu_path.is_file():
         return False
     built = fmu_path.stat().st_mtime
-    sources = [adapter_script(), *PACKAGE_DIR.rglob("*.py")]
+    sources = [adapter_script(), *runtime_sources()]
     return all(src.stat().st_mtime <= built for src in sources)

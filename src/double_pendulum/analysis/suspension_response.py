@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 from scipy.signal import welch
 
-from .runner import FmuRunner
+from ..fmu.runner import FmuRunner
 
 FORCE_SAMPLE_RATE = 200.0
 """Sampling rate [1/s] of the fixed-pivot force for its spectrum (Nyquist 628 rad/s)."""

@@ -2,7 +2,7 @@ r"""Equations of motion of the planar double pendulum with a fixed pivot.
 
 Generalised coordinates: the rod angles :math:`\varphi_1, \varphi_2` from the downward vertical.
 With :math:`\Delta = \varphi_1 - \varphi_2`, the Lagrangian
-:math:`L = T - V` (see :mod:`double_pendulum.energy`) gives (seed eqs. 14/15, re-derived; the
+:math:`L = T - V` (see :mod:`double_pendulum.model.energy`) gives (seed eqs. 14/15, re-derived; the
 seed's eqs. 12 and 13 have their left-hand sides swapped and its eq. 21 is
 :math:`\ddot\varphi_2`, not :math:`\ddot\varphi_1`):
 

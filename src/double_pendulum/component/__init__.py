@@ -1,0 +1,5 @@
+"""The co-simulation component: what the FMU adapter runs (pure Python, bundled into the FMU).
+
+:mod:`.cosimulation` (parameters by name, initialisation, doStep, outputs, FMU state),
+:mod:`.settings` (solver choice and tolerances) and :mod:`.variables` (the FMU's variable table).
+"""

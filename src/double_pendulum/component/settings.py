@@ -1,0 +1,33 @@
+"""Solver settings: the component's choice of integrator and its accuracy, as FMU parameters.
+
+They live with the component, not the model: the model is the physics, the component decides
+how to integrate it (see :mod:`double_pendulum.solvers`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..model.parameters import Validated, spec
+from ..solvers.registry import check_solver_name
+
+
+@dataclass(frozen=True)
+class SolverSettings(Validated):
+    """Choice of integrator and its accuracy settings (see :mod:`double_pendulum.solvers`)."""
+
+    solver: str = spec(
+        "dop853", "", "integration method: dop853, dopri5, rodas4 (stiff), gauss4, gauss2, rk4 or euler", rule="str"
+    )
+    rtol: float = spec(1e-9, "1", "relative tolerance of the adaptive solvers", rule="positive")
+    atol: float = spec(1e-12, "1", "absolute tolerance of the adaptive solvers (rad, rad/s)", rule="positive")
+    fixed_step: float = spec(
+        1e-3, "s", "step size of the fixed-step solvers (gauss4, gauss2, rk4, euler)", rule="positive"
+    )
+    max_steps: float = spec(
+        1e6, "1", "most integrator steps within one doStep before it fails (bounds the CPU time)", rule="positive"
+    )
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        check_solver_name(self.solver)

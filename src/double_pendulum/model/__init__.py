@@ -1,0 +1,7 @@
+"""The physics of the double pendulum, in pure Python (the FMU bundles it).
+
+:mod:`.parameters` (units, defaults, checks), :mod:`.kinematics` (positions, velocities),
+:mod:`.dynamics` (Lagrange equations of the fixed-pivot pendulum), :mod:`.forces` (air drag,
+bearing friction), :mod:`.energy`, :mod:`.vector_field` (a scene's assembled vector field with
+friction and suspension) and :mod:`.outputs` (the quantities reported at each communication point).
+"""

@@ -1,0 +1,25 @@
+"""Solver comparisons: error against CPU time."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib.pyplot as plt
+
+from .style import save
+
+
+def plot_work_precision(rows: list[dict], path: str | Path, *, title: str = "") -> Path:
+    """Max error over the horizon against CPU time [s], log-log, one line per method (ok runs only)."""
+    fig, ax = plt.subplots(figsize=(8, 6))
+    for solver in sorted({r["solver"] for r in rows}):
+        pts = sorted((r["cpu_time_s"], r["max_error"]) for r in rows if r["solver"] == solver and r["status"] == "ok")
+        if pts:
+            ax.loglog(*zip(*pts), "o-", label=solver)
+        failed = [r for r in rows if r["solver"] == solver and r["status"] != "ok"]
+        if failed:
+            ax.plot([], [], "x", label=f"{solver}: {len(failed)} failed/unstable")
+    ax.set(xlabel="CPU time [s]", ylabel="max error over the horizon [rad, rad/s]", title=title)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    return save(fig, path)
