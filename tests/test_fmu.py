@@ -53,7 +53,7 @@ def test_physical_variables_carry_fmi_units_and_descriptions(fmu_path):
 def test_fmu_bundles_the_package_and_lists_runtime_requirements(fmu_path):
     with zipfile.ZipFile(fmu_path) as z:
         names = z.namelist()
-        assert "resources/double_pendulum/dynamics.py" in names
+        assert "resources/double_pendulum/model/dynamics.py" in names
         assert "resources/DoublePendulum.py" in names
         assert "pythonfmu" in z.read("resources/requirements.txt").decode()
         # bytecode only for the FMU's own sources (nothing copied from a local __pycache__)
