@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import pytest
+from double_pendulum.scenarios import SCENARIOS
 
-from double_pendulum.cli import main
+import double_pendulum
+from double_pendulum.cli import main, run_scenario
 from double_pendulum.results_io import read_results_csv
 
 
@@ -34,13 +40,10 @@ def test_run_free_swing_writes_csv_plots_and_summary(fmu_path, tmp_path):
     assert chaotic["phi1"][0] == 2.0
 
 
-def test_unknown_scenario_is_a_clear_error(capsys):
-    try:
-        main(["run", "nope"])
-    except SystemExit as exc:
-        assert "unknown scenario 'nope'" in str(exc)
-    else:
-        raise AssertionError("expected SystemExit")
+def test_unknown_scenario_is_one_clear_line(capsys):
+    assert main(["run", "nope"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown scenario 'nope'" in err and "free_swing" in err
 
 
 def test_run_friction_budget_accounts_for_the_loss(fmu_path, tmp_path):
@@ -60,3 +63,92 @@ def test_variables_prints_the_readme_table(capsys):
     assert main(["variables"]) == 0
     table = capsys.readouterr().out.strip()
     assert table in (REPO / "README.md").read_text()
+
+
+def test_version_and_plain_help(capsys):
+    with pytest.raises(SystemExit) as exit_info:
+        main(["--version"])
+    assert exit_info.value.code == 0
+    assert capsys.readouterr().out.strip() == f"double-pendulum {double_pendulum.__version__}"
+    with pytest.raises(SystemExit):
+        main(["run", "--help"])
+    shown = capsys.readouterr().out
+    assert "`" not in shown
+    for name in SCENARIOS:  # every scenario listed with its one-line description
+        assert any(line.split()[:1] == [name] and len(line.split()) > 3 for line in shown.splitlines()), name
+
+
+def test_list_imports_no_scenario_and_no_numpy():
+    """``list`` reads the descriptions from the sources: it stays fast (no NumPy, SciPy, Matplotlib)."""
+    code = ("import sys; from double_pendulum.cli import main; main(['list']); "
+            "heavy = [m for m in ('numpy', 'scipy', 'matplotlib', 'fmpy') if m in sys.modules]; "
+            "assert not heavy, heavy")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert len(done.stdout.splitlines()) == len(SCENARIOS)
+
+
+@pytest.mark.parametrize("kind", ["file", "proc", "readonly"])
+def test_unusable_output_folder_is_one_clear_line(tmp_path, capsys, kind):
+    if kind == "file":
+        out = tmp_path / "a_file"
+        out.write_text("x")
+    elif kind == "proc":
+        out = Path("/proc/x/y")
+    else:
+        if os.geteuid() == 0:
+            pytest.skip("root can write to read-only folders")
+        out = tmp_path / "ro"
+        out.mkdir()
+        out.chmod(0o500)
+    assert main(["run", "free_swing", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot write results to" in err and "Traceback" not in err
+
+
+def test_corrupt_fmu_is_one_clear_line(tmp_path, capsys, monkeypatch):
+    fmu = tmp_path / "broken.fmu"
+    fmu.write_bytes(b"not a zip file")
+    monkeypatch.setattr("double_pendulum.fmu.build.fmu_is_current", lambda path: True)  # do not rebuild it
+    assert main(["run", "free_swing", "--fmu", str(fmu), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is not a usable FMU" in err and "BadZipFile" in err
+
+
+class _Scenario:
+    """A stand-in scenario module that writes one file, then fails or is interrupted if told to."""
+
+    def __init__(self, file_name: str, error: BaseException | None = None) -> None:
+        self.file_name, self.error = file_name, error
+
+    def run(self, runner, out_dir, *, quick=False):
+        (out_dir / self.file_name).write_text("data")
+        (out_dir / "summary.json").write_text("{}")
+        if self.error is not None:
+            raise self.error
+        return {}
+
+
+def test_scenario_folder_is_replaced_only_when_the_run_finishes(tmp_path):
+    run_scenario(_Scenario("first.csv"), "demo", None, tmp_path, quick=False)
+    run_scenario(_Scenario("second.csv"), "demo", None, tmp_path, quick=True)
+    assert sorted(p.name for p in (tmp_path / "demo").iterdir()) == ["second.csv", "summary.json"]  # no stale file
+    assert json.loads((tmp_path / "demo" / "summary.json").read_text()) == {"quick": True}
+    with pytest.raises(KeyboardInterrupt):
+        run_scenario(_Scenario("third.csv", KeyboardInterrupt()), "demo", None, tmp_path, quick=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["demo"]  # nothing half-written left
+    assert (tmp_path / "demo" / "second.csv").is_file()  # earlier results intact
+    with pytest.raises(RuntimeError):
+        run_scenario(_Scenario("fourth.csv", RuntimeError("boom")), "demo", None, tmp_path, quick=False)
+    assert (tmp_path / "demo" / "second.csv").is_file()
+    assert (tmp_path / "demo.failed" / "fourth.csv").is_file()  # what the failed run wrote is kept apart
+
+
+def test_ctrl_c_exits_130_with_one_line(tmp_path, capsys, monkeypatch, fmu_path):
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("double_pendulum.cli.run_scenario", interrupted)
+    assert main(["run", "free_swing", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 130
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "interrupted" in err

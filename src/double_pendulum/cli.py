@@ -1,42 +1,151 @@
-"""Command line: ``double-pendulum build | run SCENARIO | list | variables``."""
+"""Command line: build the FMU, run scenarios through it, list them, print the FMU's variables.
+
+Misuse and failures end with one line on stderr and a non-zero exit code, never a traceback:
+2 for a bad command line or unusable files, 1 if a scenario failed, 130 on Ctrl-C.
+"""
 
 from __future__ import annotations
 
 import argparse
+import ast
 import importlib
+import importlib.util
+import json
+import shutil
 import sys
 import time
 from pathlib import Path
 
+from . import __version__
 from .fmu.build import DEFAULT_FMU_PATH, build_fmu
+from .scenarios import SCENARIOS
+
+PROG = "double-pendulum"
 
 
-def _scenario_names() -> tuple[str, ...]:
-    from .scenarios import SCENARIOS
-
-    return SCENARIOS
+class CliError(Exception):
+    """A problem the user can fix (bad path, unusable FMU): reported as one line, exit code 2."""
 
 
-def _load_scenario(name: str):
-    if name not in _scenario_names():
-        raise SystemExit(f"unknown scenario {name!r}; available: {', '.join(_scenario_names())}")
-    return importlib.import_module(f"double_pendulum.scenarios.{name}")
+def scenario_description(name: str) -> str:
+    """The scenario's one-line ``DESCRIPTION``, read from its source without importing it (fast)."""
+    spec = importlib.util.find_spec(f"double_pendulum.scenarios.{name}")
+    tree = ast.parse(Path(spec.origin).read_text(encoding="utf-8"))
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "DESCRIPTION" for t in node.targets):
+            return ast.literal_eval(node.value)
+    return ""
+
+
+def scenario_listing() -> str:
+    """One line per scenario: name and description."""
+    return "\n".join(f"  {name:22s} {scenario_description(name)}" for name in SCENARIOS)
+
+
+def _check_scenario(name: str) -> tuple[str, ...]:
+    if name == "all":
+        return SCENARIOS
+    if name not in SCENARIOS:
+        raise CliError(f"unknown scenario {name!r}; choose one of: {', '.join(SCENARIOS)} (or 'all')")
+    return (name,)
+
+
+def _writable_folder(path: str) -> Path:
+    """Create ``path`` if needed and check that files can be written there."""
+    folder = Path(path)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        probe = folder / f".write-test-{time.monotonic_ns()}"
+        probe.write_bytes(b"")
+        probe.unlink()
+    except OSError as error:
+        reason = error.strerror or str(error)
+        raise CliError(f"cannot write results to {folder}: {reason}") from None
+    return folder
+
+
+def _load_fmu(path: str, rebuild: bool):
+    """Build the FMU if missing or stale, then open it with fmpy; unusable files become a CliError."""
+    import zipfile
+
+    from .fmu.build import fmu_is_current
+    from .fmu.runner import FmuRunner
+
+    fmu = Path(path)
+    if rebuild or not fmu_is_current(fmu):
+        print(f"building {fmu} (missing or older than the sources) ...", flush=True)
+        try:
+            build_fmu(fmu)
+        except OSError as error:
+            raise CliError(f"cannot build the FMU at {fmu}: {error.strerror or error}") from None
+    try:
+        return FmuRunner(fmu)
+    except (zipfile.BadZipFile, KeyError, OSError) as error:
+        raise CliError(f"{fmu} is not a usable FMU ({type(error).__name__}: {error}); "
+                       "delete it or pass --rebuild") from None
+    except Exception as error:  # fmpy's own validation errors
+        raise CliError(f"{fmu} is not a usable FMU: {error}") from None
+
+
+def _mark_quick(folder: Path, quick: bool) -> None:
+    """Make sure the scenario's summary says whether it was a quick run."""
+    summary_path = folder / "summary.json"
+    if not summary_path.is_file():
+        return
+    summary = json.loads(summary_path.read_text())
+    if summary.get("quick") != quick:
+        summary["quick"] = quick
+        summary_path.write_text(json.dumps(summary, indent=2) + "\n")
+
+
+def run_scenario(module, name: str, runner, out: Path, quick: bool) -> None:
+    """Run one scenario into a fresh folder that replaces ``out/name`` only once it has finished.
+
+    No stale file from an earlier run and no half-written folder survive: an interrupted run
+    leaves the earlier results as they were; a failed one also keeps what it wrote, in
+    ``out/name.failed/``, for diagnosis.
+    """
+    final = out / name
+    staging = out / f".{name}.incomplete"
+    shutil.rmtree(staging, ignore_errors=True)
+    staging.mkdir()
+    try:
+        module.run(runner, staging, quick=quick)
+        _mark_quick(staging, quick)
+    except KeyboardInterrupt:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    except Exception:
+        failed = out / f"{name}.failed"
+        shutil.rmtree(failed, ignore_errors=True)
+        staging.rename(failed)
+        raise
+    old = out / f".{name}.old"
+    shutil.rmtree(old, ignore_errors=True)
+    if final.exists():
+        final.rename(old)
+    staging.rename(final)
+    shutil.rmtree(old, ignore_errors=True)
+    shutil.rmtree(out / f"{name}.failed", ignore_errors=True)
 
 
 def cmd_build(args: argparse.Namespace) -> int:
-    path = build_fmu(args.output)
+    print(f"building {args.output} ...", flush=True)
+    try:
+        path = build_fmu(args.output)
+    except OSError as error:
+        raise CliError(f"cannot build the FMU at {args.output}: {error.strerror or error}") from None
     print(f"built {path}")
     return 0
 
 
 def cmd_list(args: argparse.Namespace) -> int:
-    for name in _scenario_names():
-        print(f"{name:24s} {_load_scenario(name).DESCRIPTION}")
+    print(scenario_listing())
     return 0
 
 
 def cmd_variables(args: argparse.Namespace) -> int:
-    """Print the FMU's variables as the Markdown table used in the README."""
+    """Print the FMU's variables as a Markdown table (the one in the documentation)."""
     from .component.variables import fmu_variables
 
     print("| name | causality | type | unit | start | description |")
@@ -49,55 +158,79 @@ def cmd_variables(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from .fmu.runner import FmuRunner, ensure_fmu
-
-    names = _scenario_names() if args.scenario == "all" else (args.scenario,)
-    modules = [_load_scenario(n) for n in names]
-    fmu = ensure_fmu(args.fmu, rebuild=args.rebuild)
+    names = _check_scenario(args.scenario)
+    out = _writable_folder(args.out)
     failed = []
-    with FmuRunner(fmu) as runner:
-        for name, module in zip(names, modules):
-            out_dir = Path(args.out) / name
-            out_dir.mkdir(parents=True, exist_ok=True)
+    with _load_fmu(args.fmu, args.rebuild) as runner:
+        for number, name in enumerate(names, start=1):
+            print(f"[{number}/{len(names)}] {name}: {scenario_description(name)} ...", flush=True)
+            module = importlib.import_module(f"double_pendulum.scenarios.{name}")
             start = time.perf_counter()
             try:
-                module.run(runner, out_dir, quick=args.quick)
+                run_scenario(module, name, runner, out, args.quick)
+            except KeyboardInterrupt:
+                raise
             except Exception as error:  # report, keep what was written, go on with the next
                 failed.append(name)
-                print(f"{name}: FAILED: {error}", file=sys.stderr)
+                print(f"{name}: FAILED: {error} (partial results in {out / (name + '.failed')})", file=sys.stderr)
                 continue
-            print(f"{name}: wrote {out_dir} in {time.perf_counter() - start:.1f} s")
+            print(f"{name}: wrote {out / name} in {time.perf_counter() - start:.1f} s", flush=True)
+    if failed:
+        print(f"{len(failed)} of {len(names)} scenarios failed: {', '.join(failed)}", file=sys.stderr)
     return 1 if failed else 0
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="double-pendulum", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser: plain-text help, the scenarios listed under ``run --help``."""
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="A planar double pendulum as an FMI 2.0 co-simulation FMU: build it, run the "
+        "scenarios through fmpy, print its variables.",
+    )
+    parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p_build = sub.add_parser("build", help="build the FMU")
+    p_build = sub.add_parser("build", help="build the FMU", description="Build DoublePendulum.fmu.")
     p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="FMU path or folder")
     p_build.set_defaults(func=cmd_build)
 
-    p_run = sub.add_parser("run", help="run a scenario (or 'all') through the FMU with fmpy")
-    p_run.add_argument("scenario", help="scenario name, or 'all'")
-    p_run.add_argument("--out", default="results", help="output folder (default: results/)")
-    p_run.add_argument("--fmu", default=str(DEFAULT_FMU_PATH), help="FMU to use; built if missing or stale")
+    p_run = sub.add_parser(
+        "run",
+        help="run a scenario (or 'all') through the FMU with fmpy",
+        description="Run a scenario through the FMU with fmpy; write CSV files, plots, summary.json "
+        "and a report into OUT/SCENARIO/.",
+        epilog="scenarios:\n" + scenario_listing() + "\n  all                    every scenario above, in this order",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p_run.add_argument("scenario", metavar="SCENARIO", help="scenario name (see below), or 'all'")
+    p_run.add_argument("--out", default="results", help="output folder (default: results)")
+    p_run.add_argument("--fmu", default=str(DEFAULT_FMU_PATH),
+                       help=f"FMU to use, built if missing or older than the sources (default: {DEFAULT_FMU_PATH})")
     p_run.add_argument("--rebuild", action="store_true", help="rebuild the FMU first")
     p_run.add_argument("--quick", action="store_true", help="short runs, for smoke tests")
     p_run.set_defaults(func=cmd_run)
 
-    p_list = sub.add_parser("list", help="list the scenarios")
+    p_list = sub.add_parser("list", help="list the scenarios", description="List the scenarios.")
     p_list.set_defaults(func=cmd_list)
 
-    p_vars = sub.add_parser("variables", help="print the FMU's variables (Markdown table)")
+    p_vars = sub.add_parser("variables", help="print the FMU's variables (Markdown table)",
+                            description="Print the FMU's variables as a Markdown table.")
     p_vars.set_defaults(func=cmd_variables)
-
-    args = parser.parse_args(argv)
-    return args.func(args)
+    return parser
 
 
-if __name__ == "__main__":
-    raise SystemExit(main())
+def main(argv: list[str] | None = None) -> int:
+    """Parse ``argv`` and run the command; return the exit code (errors as one line on stderr)."""
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except CliError as error:
+        print(f"{PROG}: error: {error}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted; finished scenarios are kept, the unfinished one is discarded",
+              file=sys.stderr)
+        return 130
 
 
 def entry() -> None:
@@ -109,7 +242,15 @@ def entry() -> None:
     """
     import os
 
-    code = main()
+    try:
+        code = main()
+    except KeyboardInterrupt:  # Ctrl-C while parsing or importing
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        code = 130
     sys.stdout.flush()
     sys.stderr.flush()
     os._exit(code)
+
+
+if __name__ == "__main__":
+    entry()
