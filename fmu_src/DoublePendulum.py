@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import os
 import sys
 from pathlib import Path
 
@@ -18,6 +19,7 @@ from pythonfmu.default_experiment import DefaultExperiment
 from pythonfmu.enums import Fmi2Status
 
 _BUNDLE_NAME = "_double_pendulum_fmu_bundle"
+STDERR_SWITCH = "DOUBLE_PENDULUM_FMU_STDERR"  # "0": errors go to the FMI log only
 
 
 
@@ -110,7 +112,13 @@ class DoublePendulum(Fmi2Slave):
             raise
 
     def _report(self, error) -> None:
-        print(f"[{self.instance_name}] DoublePendulum: {error}", file=sys.stderr, flush=True)
+        """Print the error to stderr, unless the host collects the FMU's log itself.
+
+        A host that logs every message and reports the failures it expects (the project's own
+        ``FmuRunner``) sets ``DOUBLE_PENDULUM_FMU_STDERR=0`` while it runs the FMU.
+        """
+        if os.environ.get(STDERR_SWITCH, "1") != "0":
+            print(f"[{self.instance_name}] DoublePendulum: {error}", file=sys.stderr, flush=True)
 
     def exit_initialization_mode(self):
         self._guarded(self._sim.initialise)

@@ -130,3 +130,20 @@ def test_solver_failure_is_reported_with_the_time_and_the_run_stops_cleanly(runn
         )
     assert info.value.partial_result is not None
 
+
+
+def test_through_the_runner_errors_reach_the_caller_not_stderr(fmu_path, tmp_path):
+    """FmuRunner collects the FMU's log and raises it; the FMU then leaves stderr alone (no alarm lines)."""
+    script = textwrap.dedent(f"""
+        import os
+        from double_pendulum.fmu.runner import FmuRunError, FmuRunner
+        with FmuRunner({str(fmu_path)!r}) as runner:
+            try:
+                runner.simulate({{"solver": "rk4", "fixed_step": 0.5, "phi1_0": 3.0, "omega2_0": 30.0}}, stop_time=20.0)
+            except FmuRunError as error:
+                print("raised:", error, flush=True)
+        os._exit(0)
+    """)
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert "raised:" in out.stdout and "rk4" in out.stdout
+    assert "DoublePendulum:" not in out.stderr
