@@ -222,4 +222,4 @@ if __name__ == "__main__":
     main()
     import os
 
-    os._exit(0)  # pythonfmu teardown, see README
+    os._exit(0)  # pythonfmu teardown, see docs/fmu.md

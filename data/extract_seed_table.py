@@ -1,6 +1,6 @@
 """Extract Table 1 of the seed lab report into ``data/seed_table1.csv``.
 
-Usage: ``python data/extract_seed_table.py ../shared/seed/000_0dc3765e406ac2ec.txt``
+Usage: ``python data/extract_seed_table.py REPORT.txt`` (REPORT.txt: path to the report's text)
 
 The report's table has five tab-separated columns (t [s], x1, y1, x2, y2 [m]) split over
 several pages with repeated headers and "Fortsetzung" lines; only rows of five numbers are kept,
@@ -34,7 +34,10 @@ def parse_rows(text: str) -> list[list[str]]:
 
 
 def main(argv: list[str]) -> int:
-    source = Path(argv[1]) if len(argv) > 1 else Path("../shared/seed/000_0dc3765e406ac2ec.txt")
+    if len(argv) != 2:
+        print(f"usage: python {argv[0]} REPORT.txt  (path to the report's text)", file=sys.stderr)
+        return 2
+    source = Path(argv[1])
     target = Path(__file__).with_name("seed_table1.csv")
     rows = parse_rows(source.read_text(encoding="utf-8"))
     with target.open("w", newline="") as fh:

@@ -57,12 +57,12 @@ def test_run_friction_budget_accounts_for_the_loss(fmu_path, tmp_path):
         assert (tmp_path / "friction_budget" / f"{name}.png").is_file()
 
 
-def test_variables_prints_the_readme_table(capsys):
+def test_variables_prints_the_table_in_the_fmu_docs(capsys):
     from conftest import REPO
 
     assert main(["variables"]) == 0
     table = capsys.readouterr().out.strip()
-    assert table in (REPO / "README.md").read_text()
+    assert table in (REPO / "docs" / "fmu.md").read_text()
 
 
 def test_version_and_plain_help(capsys):

@@ -35,7 +35,7 @@ def _libcosim_result(fmu_path, start, tmp_path) -> dict[str, float]:
         from double_pendulum.fmu.hosts import simulate_with_libcosim
         values = simulate_with_libcosim({str(fmu_path)!r}, {start!r}, {OUTPUTS!r}, stop_time=3.0, step_size=0.01)
         print(json.dumps(values), flush=True)
-        os._exit(0)  # skip teardown, see README (pythonfmu issue #228)
+        os._exit(0)  # skip teardown, see docs/fmu.md (pythonfmu issue #228)
     """)
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, timeout=300)
     assert out.returncode == 0, out.stderr[-2000:]

@@ -145,7 +145,7 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 
 def cmd_variables(args: argparse.Namespace) -> int:
-    """Print the FMU's variables as a Markdown table (the one in the documentation)."""
+    """Print the FMU's variables as the Markdown table in docs/fmu.md."""
     from .component.variables import fmu_variables
 
     print("| name | causality | type | unit | start | description |")
