@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 from double_pendulum.scenarios import measured_vs_sim as mv
 
-from double_pendulum.analysis.measurement import load_track, reconstruct
+from double_pendulum.analysis import track_comparison as tc
+from double_pendulum.analysis.measurement import FRAME_INTERVAL, load_track, reconstruct
+from double_pendulum.analysis.prediction_report import cause_text, fmt_horizon
 from double_pendulum.analysis.start_state import (
     ANGLE_OUTPUTS,
     FIT_SETTINGS,
@@ -25,8 +27,9 @@ TRUE_STATE = np.array([-0.2, 0.7, 2.0, -4.0])  # rad, rad, rad/s, rad/s
 
 def _synthetic_frames(runner, outputs, noise, n_frames=12, t0=0.5, seed=1):
     """FMU-generated frames from TRUE_STATE with white noise of standard deviation ``noise``."""
-    run = simulate_frames(runner, {**FIT_SETTINGS, **MODEL, **state_start_values(TRUE_STATE)}, t0, n_frames,
-                          outputs=outputs)
+    run = simulate_frames(
+        runner, {**FIT_SETTINGS, **MODEL, **state_start_values(TRUE_STATE)}, t0, n_frames, outputs=outputs
+    )
     clean = output_matrix(run, outputs)
     return clean + np.random.default_rng(seed).normal(0.0, noise, clean.shape)
 
@@ -35,8 +38,9 @@ def _synthetic_frames(runner, outputs, noise, n_frames=12, t0=0.5, seed=1):
 def test_least_squares_recovers_a_known_start_state_from_noisy_frames(runner, outputs, noise):
     data = _synthetic_frames(runner, outputs, noise)
     guess = TRUE_STATE + np.array([0.03, -0.03, 0.4, -0.6])  # a poor reconstruction
-    fit = fit_start_state(runner, 0.5, np.arange(len(data)), data, noise, guess, MODEL, outputs=outputs,
-                          absolute_sigma=True)
+    fit = fit_start_state(
+        runner, 0.5, np.arange(len(data)), data, noise, guess, MODEL, outputs=outputs, absolute_sigma=True
+    )
     error = fit.state - TRUE_STATE
     assert np.all(np.abs(error) < 4.0 * fit.stderr)  # consistent with its own error bars
     assert np.all(np.abs(error[:2]) < 5e-3) and np.all(np.abs(error[2:]) < 0.1)
@@ -46,9 +50,105 @@ def test_least_squares_recovers_a_known_start_state_from_noisy_frames(runner, ou
 
 def test_horizon_is_the_first_crossing():
     t = np.arange(6) * 0.1
-    assert mv.horizon(t, np.array([0.0, 0.005, 0.02, 0.001, 0.06, 0.07]), 0.01) == pytest.approx(0.2)
-    assert mv.horizon(t, np.zeros(6), 0.01) is None
-    assert mv.horizon(t, np.full(6, 0.5), 0.01) == 0.0
+    assert tc.horizon(t, np.array([0.0, 0.005, 0.02, 0.001, 0.06, 0.07]), 0.01) == pytest.approx(0.2)
+    assert tc.horizon(t, np.zeros(6), 0.01) is None
+    assert tc.horizon(t, np.full(6, 0.5), 0.01) == 0.0
+
+
+def _prediction(e1, e2, label="run", result=None):
+    t = np.arange(len(e1)) * 0.5
+    return tc.Prediction(label, np.zeros(4), result, t, np.asarray(e1, float), np.asarray(e2, float))
+
+
+def test_prediction_horizons_take_the_worse_bob_for_both():
+    p = _prediction([0.0, 0.02, 0.02, 0.06], [0.0, 0.005, 0.03, 0.03])
+    np.testing.assert_array_equal(p.e_both, [0.0, 0.02, 0.03, 0.06])
+    assert p.horizons() == {
+        "lower_bob_1cm_s": 1.0,  # e2 first above 1 cm at t = 1.0 s
+        "both_bobs_1cm_s": 0.5,  # the upper bob leaves first
+        "lower_bob_5cm_s": None,
+        "both_bobs_5cm_s": 1.5,
+    }
+    assert p.rms_lower_bob_error(0.5) == pytest.approx(np.sqrt((0.0 + 0.005**2) / 2))
+
+
+def test_chaos_horizons_and_error_curves():
+    t = np.arange(5) * FRAME_INTERVAL
+    spread = (t, np.array([1e-4, 1e-3, 0.02, 0.04, 0.2]))
+    assert tc.chaos_horizons(spread) == {
+        "1cm": pytest.approx(2 * FRAME_INTERVAL),
+        "5cm": pytest.approx(4 * FRAME_INTERVAL),
+    }
+    runs = [_prediction([0.0], [0.0], "a"), _prediction([0.0], [0.0], "b")]
+    curves = tc.error_curves(runs, spread)
+    assert list(curves)[:3] == ["a: lower bob", "b: lower bob", "b: both (larger)"]  # both bobs for the last run only
+    assert curves[list(curves)[-1]] is spread
+    assert tc.errors_units(runs)["e2_b"] == "m"
+
+
+@pytest.fixture(scope="module")
+def rec():
+    return reconstruct(load_track())
+
+
+def test_start_frame_is_valid_and_nearest_to_t0(rec):
+    i0 = tc.nearest_frame(rec, 0.8)
+    assert abs(rec.t[i0] - 0.8) <= FRAME_INTERVAL
+    assert rec.track.valid[i0] and np.isfinite(rec.omega1[i0]) and np.isfinite(rec.omega2[i0])
+    state = tc.reconstructed_state(rec, i0)
+    np.testing.assert_array_equal(state, [rec.phi1[i0], rec.phi2[i0], rec.omega1[i0], rec.omega2[i0]])
+
+
+def test_rod_length_floor_is_the_tracks_deviation_from_a_rigid_lower_rod(rec):
+    i0, n = 24, 60
+    t, dev = tc.rod_length_floor(rec, i0, n)
+    idx = i0 + np.round(t / FRAME_INTERVAL).astype(int)
+    assert t[0] == 0.0 and np.all(rec.track.valid[idx])
+    r2 = np.hypot(rec.x2[idx] - rec.x1[idx], rec.y2[idx] - rec.y1[idx])
+    np.testing.assert_allclose(dev, np.abs(r2 - rec.params.l2), rtol=1e-12)
+    floor = tc.rod_floor_summary(rec, i0, n)
+    assert floor["rms_m"] == pytest.approx(np.sqrt(np.mean(dev**2)))
+    assert floor["max_m"] == pytest.approx(dev.max())
+    assert floor["fraction_above_1cm"] == pytest.approx(np.mean(dev > 0.01))
+    assert 0.001 < floor["rms_m"] < 0.03  # millimetres to centimetres: the track's own resolution
+    table = tc.errors_table(rec, i0, n, [])
+    np.testing.assert_array_equal(table["rod2_deviation"], dev)
+    np.testing.assert_array_equal(table["x2"], rec.track.x2[idx])  # the track's own coordinates
+
+
+def test_simulated_positions_move_into_the_tracks_coordinates_by_the_pivot(rec):
+    """The FMU's origin is the pivot at rest: a bob at the FMU's origin sits at the fitted pivot of the track."""
+    names = ("time", "x1", "y1", "x2", "y2")
+    result = np.zeros(3, dtype=[(n, float) for n in names])
+    result["y2"] = -0.5
+    t, coords = tc.simulated_coordinates(rec, _prediction([0.0] * 3, [0.0] * 3, result=result))
+    pivot = rec.geometry.pivot
+    np.testing.assert_array_equal(coords["x1"], pivot.xc)
+    np.testing.assert_array_equal(coords["y2"], pivot.yc - 0.5)
+    t_meas, measured = tc.measured_coordinates(rec, 30, 20, lead=10)
+    assert t_meas[0] >= rec.t[20] and t_meas[-1] <= rec.t[49] and len(measured["x1"]) == len(t_meas)
+
+
+def _cause_summary(observed, chaos):
+    same = {"lower_bob_5cm_s": 1.0}
+    return {
+        "prediction_s": 2.0,
+        "model": {"masses_kg": 0.5},
+        "horizons_s": {
+            "lsq_start_identified": {"lower_bob_5cm_s": observed},
+            "seed_start_identified": same,
+            "seed_start_frictionless": {"lower_bob_5cm_s": 1.25},
+        },
+        "chaos_horizons_s": {"5cm": chaos},
+    }
+
+
+def test_cause_is_model_error_when_chaos_allows_more_than_twice_the_observed_horizon():
+    assert "model error" in cause_text(_cause_summary(0.4, None))  # chaos: beyond the 2 s prediction
+    assert "about 0.2 kg of acrylic rods" in cause_text(_cause_summary(0.4, None))
+    assert "start's uncertainty limits it" in cause_text(_cause_summary(0.6, 1.0))
+    assert cause_text(_cause_summary(0.6, 1.0)).endswith("by at most 0.25 s.")
+    assert fmt_horizon(None, 2.0) == "> 2.0" and fmt_horizon(0.123, 2.0) == "0.12"
 
 
 def test_quick_run_compares_both_starts_with_the_track(runner, tmp_path):
@@ -66,7 +166,7 @@ def test_quick_run_compares_both_starts_with_the_track(runner, tmp_path):
     assert np.hypot(run["x2"][0] + pivot["x"] - rec.track.x2[i0], run["y2"][0] + pivot["y"] - rec.track.y2[i0]) < 0.01
     errors = read_results_csv(tmp_path / "errors.csv")
     horizon = summary["horizons_s"]["lsq_start_identified"]["lower_bob_5cm_s"]
-    assert horizon == mv.horizon(errors["t_since_t0"], errors["e2_lsq_start_identified"], 0.05)
+    assert horizon == tc.horizon(errors["t_since_t0"], errors["e2_lsq_start_identified"], 0.05)
     for name in ("coordinates", "prediction_error"):
         assert (tmp_path / f"{name}.png").stat().st_size > 10_000
     assert "Prediction horizons" in (tmp_path / "report.md").read_text()

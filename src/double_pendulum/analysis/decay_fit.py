@@ -41,6 +41,9 @@ P_ONE_TOLERANCE = 1e-9
 AUTOCORRELATION_LAG_S = 1.5
 """Lag window [s] for the residual autocorrelation of the measured energy (the ``max_lag`` of
 :func:`effective_sample_factor` times the frame rate): about one slow swing (period 1.31 s)."""
+SEED_FIT = {"a_J": 0.813, "a_rel_err": 0.0126, "b_per_s": -0.024, "b_rel_err": 0.0489}
+"""The seed's exponential fit E = a exp(b t) of the measured energy (section 4.2.5): a [J], b [1/s]
+and their relative errors [1], for comparison."""
 
 
 @dataclass(frozen=True)

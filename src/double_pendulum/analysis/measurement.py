@@ -54,6 +54,8 @@ TRACK_COLUMNS = ("frame", "t_s", "x1_m", "y1_m", "x2_m", "y2_m")
 
 SEED_VELOCITY_ERROR = 0.1
 """The seed's assumed error of each bob's speed [m/s] (section 4.2.2, eq. 25)."""
+SEED_TOTAL_MASS_KG = 0.7
+"""The seed's total moving mass including the acrylic rods (section 4.2.3) [kg]."""
 SG_WINDOW = 7
 """Window (frames) of the Savitzky-Golay derivative filter; see :func:`savgol_derivative`."""
 SG_POLYORDER = 5
