@@ -112,6 +112,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     wall0 = time.perf_counter()
     out_dir = Path(out_dir)
     plan = QUICK if quick else FULL
+
+    # identification of c at the default k, M_s; the map b(k, c); c refitted along its valley
     rec = reconstruct(load_track())
     model = identify_suspension(runner, rec, quick=quick, m_s=plan.m_s_main)
     md, ident, spectrum = model.measured, model.identification, model.spectrum
@@ -123,6 +125,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     )
     map_wall = time.perf_counter() - t_map
     trace = trace_valley(runner, md, base, ident, maps[0], plan.valley_k_factors)
+
+    # runs on the measured frames: identified, no suspension, the resonant end of the iso-b curve
     runs = {
         "identified": simulate_frames_from(runner, model.values, md.frames),
         "no suspension": simulate_frames_from(runner, base, md.frames),
@@ -136,6 +140,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         runs["resonant"] = simulate_frames_from(runner, values, md.frames)
         flows["resonant"] = energy_flow_run(runner, values, md.frames)
         points["resonant end of the curve"] = resonant
+
     summary: dict[str, Any] = {
         "scenario": "suspension_transfer",
         "quick": quick,
@@ -157,6 +162,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "map_runs": int(sum(d.b.size + 1 for d in maps)),
         "map_wall_time_s": map_wall,
     }
+
     write_results_csv(out_dir / "decay_rate_map.csv", study.map_table(maps, spectrum.m12), MAP_UNITS)
     write_results_csv(out_dir / "frames.csv", study.frames_table(md, runs, ident.residuals), study.FRAME_UNITS)
     for label, flow in flows.items():
