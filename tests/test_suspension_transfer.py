@@ -103,4 +103,8 @@ def test_quick_run_writes_its_files_and_closes_the_energy_budget(runner, tmp_pat
         assert (tmp_path / f"{name}.png").stat().st_size > 10_000
     for name in ("identified", "fixed_pivot_force"):
         assert len(read_results_csv(tmp_path / f"{name}.csv")) > 100
-    assert "curve, not a point" in (tmp_path / "report.md").read_text()
+    report = (tmp_path / "report.md").read_text()
+    assert "curve, not a point" in report
+    ident = summary["identified"]
+    assert f"**c = {ident['c_N_s_per_m']:.1f} +- {ident['c_stderr']:.1f} N s/m**" in report
+    assert f"b = {summary['measured']['b_per_s']:.5f} +- " in report

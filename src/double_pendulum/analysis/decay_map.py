@@ -181,6 +181,27 @@ def decay_map(
     )
 
 
+def decay_maps(
+    fmu_path: str | Path,
+    base: Mapping[str, Any],
+    frames: FitFrames,
+    spectrum: ForceSpectrum,
+    k_grid: Sequence[float],
+    c_grid: Sequence[float],
+    m_s_main: float,
+    m_s_extra: Sequence[float] = (),
+    extra_stride: int = 1,
+    max_workers: int | None = None,
+) -> list[DecayMap]:
+    """The main (k, c) map at ``m_s_main`` [kg], then coarser ones at each of ``m_s_extra`` [kg] on every
+    ``extra_stride``-th value of both grids (see :func:`decay_map`)."""
+    maps = [decay_map(fmu_path, base, frames, spectrum, k_grid, c_grid, m_s_main, max_workers)]
+    k_coarse, c_coarse = k_grid[::extra_stride], c_grid[::extra_stride]
+    for m_s in m_s_extra:
+        maps.append(decay_map(fmu_path, base, frames, spectrum, k_coarse, c_coarse, m_s, max_workers))
+    return maps
+
+
 def linear_response_grid(
     spectrum: ForceSpectrum,
     b_base: float,
