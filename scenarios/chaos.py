@@ -1,20 +1,14 @@
 """Scenario ``chaos``: the seed's experiment 4.1 in silico, made quantitative.
 
-The seed released its pendulum by hand from rest with the upper bob held against a threaded rod
-(position known to about 5 mm) and the lower rod hanging; three long-exposure traces agreed for a
-while and then parted completely. The release angle is not stated: the default start here is the
-upper rod at 2.0 rad (the upper bob 12 cm above the pivot, high enough for the chaotic traces of its
-figs. 4-6), the lower rod hanging (phi2 = 0), at rest. Outputs in ``results/chaos/``:
+The seed released its pendulum by hand from rest, the upper bob held against a threaded rod (position
+known to about 5 mm), the lower rod hanging; three long-exposure traces agreed for a while, then parted.
+The release angle is not stated: here the upper rod starts at 2.0 rad (the upper bob 12 cm above the
+pivot, high enough for the chaotic traces of its figs. 4-6), the lower rod hanging, at rest.
 
-* three releases drawn with the 5 mm uncertainty and the nominal one through the FMU (CSVs), the lower
-  bob's traces with the point where they part, phase portraits at a regular and the chaotic energy;
-* ensembles (:mod:`double_pendulum.analysis.predictability`): the spread of the lower bob over time for
-  start uncertainties from 0.01 to 10 mm, clouds of the 5 mm ensemble, the predictability horizon;
-* Lyapunov exponents (:mod:`double_pendulum.analysis.lyapunov_study`): the largest exponent with its
-  convergence for DOP853 and RK4 at h and h/2, the two-trajectory cross-check, the spectrum
-  (lambda, 0, 0, -lambda), the exponent against the release angle, the exponent as friction acts;
-* the flip-time map and Poincare sections (:mod:`double_pendulum.analysis.phase_space`);
-* ``summary.json`` with ``lyapunov_per_s`` for the default start.
+Outputs in ``results/chaos/`` (CSVs, plots, ``summary.json`` with ``lyapunov_per_s``): FMU runs of the
+nominal and three drawn releases; ensembles and predictability horizons; Lyapunov exponents (convergence,
+step halving, two-trajectory check, spectrum, against the energy, with friction); the flip-time map and
+Poincare sections. The analysis: ``double_pendulum.analysis`` predictability, lyapunov_study, phase_space.
 """
 
 from __future__ import annotations
@@ -27,7 +21,7 @@ import numpy as np
 
 from double_pendulum import plots
 from double_pendulum.analysis import chaos, lyapunov_study, phase_space, predictability
-from double_pendulum.analysis.ensemble import batch_energy, initial_states, model_field, pendulum_field
+from double_pendulum.analysis.ensemble import initial_states, model_field, pendulum_field
 from double_pendulum.analysis.sweep import run_sweep
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.model.parameters import AirDragParameters, BearingParameters, PendulumParameters
@@ -37,6 +31,7 @@ from double_pendulum.results_io import write_json, write_results_csv
 DESCRIPTION = "sensitivity to the start (seed 4.1): ensembles, predictability, Lyapunov exponents, flip map"
 
 DEFAULT_START: dict[str, float] = {"phi1_0": 2.0, "phi2_0": 0.0, "omega1_0": 0.0, "omega2_0": 0.0}
+PHI0 = (DEFAULT_START["phi1_0"], DEFAULT_START["phi2_0"])  # rad, released from rest
 REGULAR_START: dict[str, float] = {"phi1_0": 0.5, "phi2_0": 0.5}
 START_UNCERTAINTY = 0.005  # m, the seed's estimate for the upper bob's position
 SEED = 41  # random draws of the releases (seed section 4.1)
@@ -45,11 +40,8 @@ THRESHOLDS = (0.01, 0.10)  # m, spread of the lower bob that ends predictability
 SNAPSHOTS = (0.0, 1.0, 2.0, 3.0, 5.0, 8.0)  # s, clouds of the 5 mm ensemble
 RENORM = 0.5  # s, Benettin renormalisation interval
 H = 1e-3  # s, RK4 step of the ensembles, maps and sections
-METHODS = {  # largest exponent: the high-accuracy DOP853 estimate, and RK4 at h and h/2
-    "dop853": chaos.Integration("dop853", rtol=1e-10, atol=1e-12),
-    "rk4_h": chaos.Integration("rk4", h=H),
-    "rk4_h_half": chaos.Integration("rk4", h=H / 2),
-}
+METHODS = {"dop853": chaos.Integration("dop853", rtol=1e-10, atol=1e-12),  # the high-accuracy estimate
+           "rk4_h": chaos.Integration("rk4", h=H), "rk4_h_half": chaos.Integration("rk4", h=H / 2)}  # step halving
 
 
 @dataclass(frozen=True)
@@ -87,8 +79,8 @@ QUICK = Plan(
 )
 
 
-def fmu_runs(runner: FmuRunner, out: Path, plan: Plan, params: PendulumParameters) -> tuple[dict, np.ndarray]:
-    """The nominal release, three drawn with 5 mm uncertainty and a regular start, through the FMU in parallel."""
+def fmu_runs(runner: FmuRunner, out: Path, plan: Plan, params: PendulumParameters) -> tuple[dict, float]:
+    """Nominal release, three drawn within 5 mm and a regular start via the FMU; summary, FMU-batch difference."""
     releases = predictability.drawn_releases(DEFAULT_START, START_UNCERTAINTY, 3, params, seed=SEED)
     cases = [{**c, **FMU_SETTINGS} for c in [*releases.values(), REGULAR_START]]
     start = time.perf_counter()
@@ -105,18 +97,17 @@ def fmu_runs(runner: FmuRunner, out: Path, plan: Plan, params: PendulumParameter
     )
     portraits = {"regular (phi1 = phi2 = 0.5 rad)": results[4], "chaotic (default start)": results[0]}
     plots.plot_phase_portraits(portraits, out / "phase_portraits.png")
-    summary = {"releases": releases, "settings": FMU_SETTINGS, "stop_time_s": plan.fmu_stop,
-               "releases_part_by_1cm_at_s": t_part, "wall_time_s": wall}
-    return summary, results[0]
+    fmu_vs_batch = predictability.batch_angle_difference(results[0], *PHI0, params, t_check=2.0,
+                                                         rtol=FMU_SETTINGS["rtol"], atol=FMU_SETTINGS["atol"])
+    return {"releases": releases, "settings": FMU_SETTINGS, "stop_time_s": plan.fmu_stop,
+            "releases_part_by_1cm_at_s": t_part, "wall_time_s": wall}, fmu_vs_batch
 
 
 def ensembles(out: Path, plan: Plan, params: PendulumParameters, lyapunov: float) -> dict:
     """Spread of release ensembles over time and the predictability horizon against the uncertainty."""
-    res = predictability.release_predictability(
-        pendulum_field(params), params, DEFAULT_START["phi1_0"], DEFAULT_START["phi2_0"], plan.sigmas, plan.members,
-        plan.spread_t_end, thresholds=THRESHOLDS, h=H, seed=SEED, snapshot_sigma=START_UNCERTAINTY,
-        snapshot_times=SNAPSHOTS,
-    )
+    res = predictability.release_predictability(pendulum_field(params), params, *PHI0, plan.sigmas, plan.members,
+                                                plan.spread_t_end, thresholds=THRESHOLDS, h=H, seed=SEED,
+                                                snapshot_sigma=START_UNCERTAINTY, snapshot_times=SNAPSHOTS)
     write_results_csv(out / "ensemble_spread.csv", *predictability.spread_table(res))
     write_results_csv(out / "predictability.csv", *predictability.horizon_table(res))
     spreads = {f"sigma = {s * 1e3:g} mm": res.spread.spread[:, j] for j, s in enumerate(res.sigmas)}
@@ -129,42 +120,45 @@ def ensembles(out: Path, plan: Plan, params: PendulumParameters, lyapunov: float
 
 
 def lyapunov(out: Path, plan: Plan, params: PendulumParameters) -> dict:
-    """Largest exponent of the default start and its neighbours within 5 mm, three integrations; their
-    mean (DOP853) is ``lyapunov_per_s``; then the spectrum, the scan over energy and the run with friction."""
-    field = pendulum_field(params)
-    starts = chaos.release_ensemble(DEFAULT_START["phi1_0"], DEFAULT_START["phi2_0"], START_UNCERTAINTY,
-                                    plan.lyap_members + 1, params, seed=SEED, include_nominal=True)
-    cmp = lyapunov_study.compare_integrations(field, starts, plan.lyap_t_end, METHODS, renorm=RENORM)
+    """Largest exponent of the default start and its neighbours within 5 mm (their DOP853 mean), three integrations."""
+    starts = chaos.release_ensemble(*PHI0, START_UNCERTAINTY, plan.lyap_members + 1, params, seed=SEED,
+                                    include_nominal=True)
+    cmp = lyapunov_study.compare_integrations(pendulum_field(params), starts, plan.lyap_t_end, METHODS, renorm=RENORM)
     write_results_csv(out / "lyapunov_convergence.csv", *lyapunov_study.convergence_table(cmp))
     curves = lyapunov_study.convergence_curves(cmp, "starts within 5 mm")
     plots.plot_lyapunov_convergence(curves, out / "lyapunov_convergence.png", title="largest exponent, default start")
-    method = (f"Benettin, complex-step tangent, renormalised every {RENORM} s, {METHODS['dop853'].label()}, "
-              f"{plan.lyap_t_end:g} s, mean over the default start and {plan.lyap_members} starts within 5 mm")
-    summary = lyapunov_study.largest_exponent_summary(cmp, "dop853", method)
-    y0 = initial_states(DEFAULT_START["phi1_0"], DEFAULT_START["phi2_0"])
+    return lyapunov_study.largest_exponent_summary(cmp, "dop853", "starts within 5 mm")
 
-    spec = lyapunov_study.lyapunov_spectrum(field, y0, plan.spectrum_t_end, params, renorm=RENORM, h=H)
+
+def spectrum(out: Path, plan: Plan, params: PendulumParameters) -> dict:
+    """All four exponents of the default start, their pairing and the bound on their sum."""
+    spec = lyapunov_study.lyapunov_spectrum(pendulum_field(params), initial_states(*PHI0), plan.spectrum_t_end,
+                                            params, renorm=RENORM, h=H)
     write_results_csv(out / "lyapunov_spectrum.csv", *lyapunov_study.spectrum_table(spec))
     plots.plot_lyapunov_spectrum(spec.times, spec.running, spec.sum_bound, out / "lyapunov_spectrum.png")
-    summary["spectrum"] = lyapunov_study.spectrum_summary(spec, plan.spectrum_t_end)
+    return lyapunov_study.spectrum_summary(spec, plan.spectrum_t_end)
 
-    scan = lyapunov_study.energy_scan(field, plan.scan_thetas, params, plan.scan_t_end, renorm=RENORM, h=H)
+
+def energy_scan(out: Path, plan: Plan, params: PendulumParameters) -> dict:
+    """Largest exponent against the release angle phi1 = phi2 = theta0 (from rest)."""
+    scan = lyapunov_study.energy_scan(pendulum_field(params), plan.scan_thetas, params, plan.scan_t_end,
+                                      renorm=RENORM, h=H)
     write_results_csv(out / "lyapunov_energy.csv", *lyapunov_study.energy_scan_table(scan))
     plots.plot_lyapunov_vs_energy(scan.theta0, scan.energy_ratio, scan.exponent, out / "lyapunov_energy.png")
-    summary["energy_scan"] = lyapunov_study.energy_scan_summary(scan, plan.scan_t_end)
+    return lyapunov_study.energy_scan_summary(scan, plan.scan_t_end)
 
-    friction = model_field(ModelConfig(pendulum=params, air=AirDragParameters(air_drag=True),
-                                       bearing=BearingParameters(bearing_friction=True)))
-    win = lyapunov_study.exponent_with_friction(friction, y0, plan.friction_t_end, params, renorm=RENORM,
-                                                window=plan.friction_window)
+
+def with_friction(out: Path, plan: Plan, params: PendulumParameters) -> dict:
+    """The largest exponent in time windows while the seed's air drag and bearing friction drain the energy."""
+    field = model_field(ModelConfig(params, AirDragParameters(air_drag=True), BearingParameters(bearing_friction=True)))
+    win = lyapunov_study.exponent_with_friction(field, initial_states(*PHI0), plan.friction_t_end, params,
+                                                renorm=RENORM, window=plan.friction_window)
     write_results_csv(out / "lyapunov_friction.csv", *lyapunov_study.friction_table(win))
     plots.plot_lyapunov_with_friction(
         win.centres, win.exponent, win.times, win.energy_ratio, out / "lyapunov_friction.png",
         title=f"default start, seed's air drag and bearing friction: exponent per {plan.friction_window:g} s",
     )
-    summary["with_friction"] = lyapunov_study.friction_summary(win, plan.friction_window,
-                                                               ["air_drag (bobs)", "bearing_friction"])
-    return summary
+    return lyapunov_study.friction_summary(win, plan.friction_window, ["air_drag (bobs)", "bearing_friction"])
 
 
 def flip_map(out: Path, plan: Plan, params: PendulumParameters) -> dict:
@@ -178,38 +172,25 @@ def flip_map(out: Path, plan: Plan, params: PendulumParameters) -> dict:
 
 def poincare(out: Path, plan: Plan, params: PendulumParameters) -> dict:
     """Sections phi1 = 0, omega1 > 0 at a regular energy and at the default start's energy."""
-    energies = {
-        "regular: E of phi1 = phi2 = 0.5 rad": initial_states(REGULAR_START["phi1_0"], REGULAR_START["phi2_0"]),
-        "chaotic: E of the default start": initial_states(DEFAULT_START["phi1_0"], DEFAULT_START["phi2_0"]),
-    }
-    sections = {
-        label: phase_space.poincare_at_energy(pendulum_field(params), float(batch_energy(y0, params)[0]),
-                                              plan.poincare_starts, params, t_end=plan.poincare_t_end, h=H)
-        for label, y0 in energies.items()
-    }
+    releases = {"regular: E of phi1 = phi2 = 0.5 rad": (0.5, 0.5), "chaotic: E of the default start": PHI0}
+    sections = {label: phase_space.poincare_at_energy(pendulum_field(params), phase_space.rest_energy(*phi, params),
+                                                      plan.poincare_starts, params, t_end=plan.poincare_t_end, h=H)
+                for label, phi in releases.items()}
     plots.plot_poincare_sections(phase_space.section_points(sections), out / "poincare_sections.png")
     return {label: phase_space.section_summary(s, params) for label, s in sections.items()}
 
 
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     """Run every part and write CSVs, plots and ``summary.json``."""
-    plan = QUICK if quick else FULL
-    params = PendulumParameters()
-    out = Path(out_dir)
+    plan, params, out = QUICK if quick else FULL, PendulumParameters(), Path(out_dir)
     start = time.perf_counter()
-    fmu, nominal = fmu_runs(runner, out, plan, params)
-    lyap = lyapunov(out, plan, params)
+    fmu, fmu_vs_batch = fmu_runs(runner, out, plan, params)
+    lyap = {**lyapunov(out, plan, params), "spectrum": spectrum(out, plan, params),
+            "energy_scan": energy_scan(out, plan, params), "with_friction": with_friction(out, plan, params)}
     summary: dict = {
-        "scenario": "chaos",
-        "quick": quick,
-        "default_start": DEFAULT_START,
-        "start_uncertainty_m": START_UNCERTAINTY,
-        "lyapunov_per_s": lyap["lyapunov_per_s"],
-        "lyapunov": lyap,
-        "fmu_runs": fmu,
-        "fmu_vs_batch_dop853_max_angle_difference_rad_first_2s": predictability.batch_angle_difference(
-            nominal, DEFAULT_START["phi1_0"], DEFAULT_START["phi2_0"], params, t_check=2.0,
-            rtol=FMU_SETTINGS["rtol"], atol=FMU_SETTINGS["atol"]),
+        "scenario": "chaos", "quick": quick, "default_start": DEFAULT_START, "start_uncertainty_m": START_UNCERTAINTY,
+        "lyapunov_per_s": lyap["lyapunov_per_s"], "lyapunov": lyap, "fmu_runs": fmu,
+        "fmu_vs_batch_dop853_max_angle_difference_rad_first_2s": fmu_vs_batch,
         "predictability": ensembles(out, plan, params, lyap["lyapunov_per_s"]),
         "flip_map": flip_map(out, plan, params),
         "poincare": poincare(out, plan, params),

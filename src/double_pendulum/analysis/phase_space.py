@@ -20,7 +20,7 @@ import numpy as np
 from ..model.parameters import PendulumParameters
 from ..results_io import table_from_columns
 from . import chaos
-from .ensemble import BatchField, batch_energy, batch_potential_energy
+from .ensemble import BatchField, batch_energy, batch_potential_energy, initial_states
 
 ENERGY_BOUND_TEXT = (
     "a rod can flip only if E >= V at its upright position; V is smallest there with the other "
@@ -63,6 +63,11 @@ def flip_map_summary(fmap: chaos.FlipMap, params: PendulumParameters) -> dict:
 
 
 # ---------------------------------------------------------------------------- Poincare sections
+def rest_energy(phi1: float, phi2: float, params: PendulumParameters) -> float:
+    """Energy [J] of a release from rest at (phi1, phi2) [rad]: ``E = V(phi1, phi2)``, the kinetic energy being 0."""
+    return float(batch_energy(initial_states(phi1, phi2), params)[0])
+
+
 def phi2_reach(energy: float, params: PendulumParameters, *, margin: float = 0.95) -> float:
     """Largest |phi2| [rad] on the section phi1 = 0 at rest with energy ``energy`` [J], times ``margin``.
 
