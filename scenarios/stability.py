@@ -1,6 +1,6 @@
 """Scenario ``stability``: stiff and extreme cases through the FMU, each with a pass criterion.
 
-Every case runs through fmpy and is judged on:
+Every case (:mod:`double_pendulum.analysis.stability_cases`) runs through fmpy and is judged on:
 
 * the run finished (the solver did not give up) -- or, for a case marked ``expect_failure``,
   the failure was detected and reported with a message (status and text in the table);
@@ -17,117 +17,33 @@ residual of the worst passing cases and CSVs of their trajectories.
 
 from __future__ import annotations
 
-import math
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from double_pendulum import plots
+from double_pendulum.analysis.stability_cases import (
+    Case,
+    cases,
+    failure_message,
+    judged_row,
+    new_row,
+    report,
+    run_length,
+    worst_passing,
+)
 from double_pendulum.fmu.runner import FmuRunError, FmuRunner
-from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.results_io import write_json, write_results_csv, write_table_csv, write_text
 
 DESCRIPTION = "stiff and extreme cases through the FMU with pass criteria (table, report, worst-case plots)"
 
-STIFF = "rodas4"
-SYMPLECTIC = "gauss4"
-BASE = {"phi1_0": 1.0, "phi2_0": 1.0}
-STIFF_SUSPENSION = {"suspension": True, "M_s": 0.01, "k_x": 1e8, "k_y": 1e8, "c_x": 200.0, "c_y": 200.0}
-STUCK = {"phi1_0": 5e-4, "phi2_0": 0.0, "bearing_friction": True, "c_R1": 0.05, "c_R2": 0.05, "omega_reg": 1e-6}
-STICK = {"phi1_0": 0.05, "phi2_0": 0.03, "bearing_friction": True, "c_R1": 0.05, "c_R2": 0.05, "omega_reg": 1e-6}
-
-
-@dataclass(frozen=True)
-class Case:
-    """One hard case: FMU start values, run length, communication step and its pass criterion."""
-
-    name: str
-    start: dict[str, Any]
-    stop_time: float = 2.0
-    output_interval: float = 0.01
-    tol: float = 1e-6  # allowed |energy_residual| / E_scale
-    cpu_budget_s: float = 60.0
-    expect_failure: bool = False
-    note: str = ""
-    quick_stop_time: float | None = None
-    tags: tuple[str, ...] = field(default_factory=tuple)
-
-
-def _critical_damping(k: float, m: float) -> float:
-    """c = 2 sqrt(k m) [N s/m]: critical damping of a mass m [kg] on a spring k [N/m]."""
-    return 2.0 * math.sqrt(k * m)
-
-
-def cases() -> list[Case]:
-    """The table of hard cases (see the module docstring for the criteria)."""
-    p = PendulumParameters()
-    m_t = 0.05 + p.m1 + p.m2
-    k = 1e6
-    c_crit = _critical_damping(k, m_t)
-    return [
-        Case("stiff suspension k=1e8, M_s=0.01, stiff solver", {**BASE, **STIFF_SUSPENSION, "solver": STIFF,
-             "rtol": 1e-8, "atol": 1e-12}, quick_stop_time=0.2, note="omega_s ~ 1.3e4 rad/s"),
-        Case("stiff suspension k=1e8, M_s=0.01, rk4 h=1e-3", {**BASE, **STIFF_SUSPENSION, "solver": "rk4",
-             "fixed_step": 1e-3}, expect_failure=True, note="explicit: unstable, blow-up must be detected"),
-        Case("stiff suspension k=1e8, M_s=0.01, dop853 (step budget)", {**BASE, **STIFF_SUSPENSION,
-             "solver": "dop853", "rtol": 1e-8, "max_steps": 200}, expect_failure=True,
-             note="explicit adaptive: stability-limited steps exhaust the per-doStep budget"),
-        Case("stiff suspension k=1e7, M_s=0.05, dop853", {**BASE, **STIFF_SUSPENSION, "M_s": 0.05, "k_x": 1e7,
-             "k_y": 1e7, "solver": "dop853", "rtol": 1e-8}, quick_stop_time=0.2, note="explicit but affordable"),
-        Case("critically damped suspension", {**BASE, "suspension": True, "M_s": 0.05, "k_x": k, "k_y": k,
-             "c_x": c_crit, "c_y": c_crit, "solver": STIFF, "rtol": 1e-8}, quick_stop_time=0.2,
-             note=f"c = 2 sqrt(k M_t) = {c_crit:.0f}"),
-        Case("strongly over-damped suspension", {**BASE, "suspension": True, "M_s": 0.05, "k_x": k, "k_y": k,
-             "c_x": 100 * c_crit, "c_y": 100 * c_crit, "solver": STIFF, "rtol": 1e-8}, note="c = 100 c_crit"),
-        Case("sharp bearing regularisation 1e-6 rad/s, coming to rest", {**STICK, "solver": "dop853",
-             "rtol": 1e-8}, stop_time=30.0, quick_stop_time=2.0,
-             note="stick-slip: ~35 swings decaying by Coulomb friction; dop853 steps over the reversals"),
-        Case("sharp bearing regularisation 1e-6 rad/s, stuck, stiff solver", {**STUCK, "solver": STIFF,
-             "rtol": 1e-8}, stop_time=5.0, note="at rest: friction acts as a damper c_R r_b |F| / omega_reg"),
-        Case("sharp bearing regularisation 1e-6 rad/s, stuck, dop853 (step budget)", {**STUCK,
-             "solver": "dop853", "rtol": 1e-8, "max_steps": 20}, stop_time=5.0, expect_failure=True,
-             note="explicit: stability limits h to ~1e-4 s; budget 20 steps per 10 ms"),
-        Case("m2 = 1e-4 m1", {**BASE, "m2": 1e-4 * p.m1, "solver": "dop853", "rtol": 1e-10}, tol=1e-7,
-             note="near-singular mass matrix"),
-        Case("m1 = 1e-4 m2", {**BASE, "m1": 1e-4 * p.m2, "solver": "dop853", "rtol": 1e-10}, tol=1e-7),
-        Case("l2 = 1 mm", {**BASE, "l2": 1e-3, "solver": "dop853", "rtol": 1e-10}, tol=1e-7,
-             note="fast lower pendulum, omega ~ 100 rad/s"),
-        Case("high energy, many flips (omega2 = 50 rad/s)", {"phi1_0": 0.0, "phi2_0": 0.0, "omega1_0": 20.0,
-             "omega2_0": 50.0, "solver": "dop853", "rtol": 1e-10}, stop_time=10.0, quick_stop_time=2.0, tol=1e-7),
-        Case("1000 s frictionless, gauss4", {"phi1_0": 0.3, "phi2_0": 0.3, "solver": SYMPLECTIC,
-             "fixed_step": 0.01}, stop_time=1000.0, quick_stop_time=20.0, output_interval=0.5, tol=1e-6,
-             cpu_budget_s=300.0, note="symplectic: bounded energy error"),
-        Case("1000 s frictionless, dop853 rtol 1e-10", {"phi1_0": 0.3, "phi2_0": 0.3, "solver": "dop853",
-             "rtol": 1e-10}, stop_time=1000.0, quick_stop_time=20.0, output_interval=0.5, tol=1e-7,
-             cpu_budget_s=300.0),
-        Case("large communication step 0.5 s", {**BASE, "solver": "dop853", "rtol": 1e-10}, stop_time=20.0,
-             output_interval=0.5, tol=1e-8),
-        Case("tiny communication step 1e-5 s", {**BASE, "solver": "dop853", "rtol": 1e-10}, stop_time=0.5,
-             quick_stop_time=0.05, output_interval=1e-5, tol=1e-8),
-        Case("unstable upright equilibrium", {"phi1_0": math.pi, "phi2_0": math.pi, "solver": "dop853",
-             "rtol": 1e-12, "atol": 1e-14}, stop_time=10.0, tol=1e-9, note="stays up for a while, then falls"),
-        Case("all mechanisms, stiff suspension, stiff solver", {**BASE, **STIFF_SUSPENSION, "k_x": 1e7, "k_y": 1e7,
-             "air_drag": True, "rod_drag": True, "bearing_friction": True, "solver": STIFF, "rtol": 1e-8},
-             quick_stop_time=0.2),
-    ]
-
-
-def _energy_scale(start: dict[str, Any]) -> float:
-    p = PendulumParameters(**{k: start[k] for k in ("m1", "m2", "l1", "l2", "g") if k in start})
-    return (p.m1 + p.m2) * p.g * (p.l1 + p.l2)
-
 
 def run_case(runner: FmuRunner, case: Case, quick: bool) -> tuple[dict[str, Any], np.ndarray | None]:
     """Run one case through the FMU and judge it; return the table row and the result (if any)."""
-    stop = case.quick_stop_time if (quick and case.quick_stop_time) else case.stop_time
-    if quick:
-        stop = min(stop, 5.0)
-    row: dict[str, Any] = {"case": case.name, "solver": case.start.get("solver", "dop853"), "stop_time_s": stop,
-                           "output_interval_s": case.output_interval, "expect_failure": case.expect_failure,
-                           "note": case.note}
+    stop = run_length(case, quick)
+    row = new_row(case, stop)
     t0 = time.process_time()
     result = None
     try:
@@ -136,63 +52,10 @@ def run_case(runner: FmuRunner, case: Case, quick: bool) -> tuple[dict[str, Any]
         row["message"] = ""
     except FmuRunError as error:
         row["status"] = "failed"
-        row["message"] = str(error).split("FMU says: ")[-1][:300]
+        row["message"] = failure_message(error)
         result = error.partial_result
     row["cpu_time_s"] = time.process_time() - t0
-    if result is not None and len(result):
-        scale = max(float(result["E_total"][0]), _energy_scale(case.start))
-        finite = all(bool(np.all(np.isfinite(result[n]))) for n in result.dtype.names)
-        row["finite"] = finite
-        row["max_rel_energy_residual"] = float(np.max(np.abs(result["energy_residual"]))) / scale
-        row["solver_steps"] = int(result["solver_steps"][-1])
-        row["rhs_evaluations"] = int(result["solver_rhs_evaluations"][-1])
-        row["reached_time_s"] = float(result["time"][-1])
-    row["passed"], row["verdict"] = judge(case, row)
-    return row, result
-
-
-def judge(case: Case, row: dict[str, Any]) -> tuple[bool, str]:
-    """Apply the case's pass criterion to its table row."""
-    if case.expect_failure:
-        if row["status"] == "failed" and row["message"]:
-            return True, "failure detected and reported, as expected"
-        return False, "expected the explicit solver to fail loudly, but it finished"
-    if row["status"] != "finished":
-        return False, f"solver gave up: {row['message']}"
-    if not row.get("finite", False):
-        return False, "non-finite outputs"
-    if row["max_rel_energy_residual"] > case.tol:
-        return False, f"energy residual {row['max_rel_energy_residual']:.2e} > {case.tol:.0e}"
-    if row["cpu_time_s"] > case.cpu_budget_s:
-        return False, f"CPU time {row['cpu_time_s']:.1f} s > budget {case.cpu_budget_s:.0f} s"
-    return True, "ok"
-
-
-def _report(rows: list[dict[str, Any]], quick: bool) -> str:
-    lines = [
-        "# Stability report",
-        "",
-        "Generated by `double-pendulum run stability`" + (" --quick (shortened runs)" if quick else "") + ".",
-        "Criteria: run finished (or, for explicit solvers on stiff cases, failed *loudly*), finite outputs,",
-        "|energy_residual| / E_scale within the case tolerance, CPU time within budget.",
-        "",
-        "| case | solver | status | passed | max rel. residual | steps | CPU [s] | verdict |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for r in rows:
-        res = r.get("max_rel_energy_residual")
-        lines.append(
-            f"| {r['case']} | {r['solver']} | {r['status']} | {'yes' if r['passed'] else '**NO**'} | "
-            f"{'' if res is None else f'{res:.1e}'} | {r.get('solver_steps', '')} | {r['cpu_time_s']:.2f} | "
-            f"{r['verdict']} |"
-        )
-    failed = [r for r in rows if r["status"] == "failed"]
-    if failed:
-        lines += ["", "## Failure messages (as reported by the FMU)", ""]
-        lines += [f"- **{r['case']}**: {r['message']}" for r in failed]
-    n_pass = sum(r["passed"] for r in rows)
-    lines += ["", f"{n_pass} of {len(rows)} cases passed their criterion."]
-    return "\n".join(lines) + "\n"
+    return judged_row(row, case, result), result
 
 
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
@@ -204,9 +67,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         if result is not None:
             results[case.name] = result
     write_table_csv(out_dir / "stability.csv", rows)
-    write_text(out_dir / "report.md", _report(rows, quick))
-    passing = [r for r in rows if r["status"] == "finished" and "max_rel_energy_residual" in r]
-    worst = sorted(passing, key=lambda r: r["max_rel_energy_residual"], reverse=True)[:3]
+    write_text(out_dir / "report.md", report(rows, quick))
+    worst = worst_passing(rows, 3)
     for i, r in enumerate(worst):
         write_results_csv(out_dir / f"worst_{i + 1}.csv", results[r["case"]], runner.units)
     plots.plot_residuals({r["case"]: results[r["case"]] for r in worst}, out_dir / "worst_residuals.png")

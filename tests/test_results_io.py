@@ -49,3 +49,14 @@ def test_json_converts_numpy_and_non_finite_values(tmp_path):
         tmp_path / "s.json", {"a": np.float64(1.5), "b": [np.int64(2), math.nan], "c": {"d": np.inf}}
     )
     assert json.loads(path.read_text()) == {"a": 1.5, "b": [2, None], "c": {"d": None}}
+
+
+def test_table_from_columns_flattens_grids_into_float_columns_that_round_trip(tmp_path):
+    grid = np.arange(6).reshape(2, 3)
+    table = results_io.table_from_columns(time=np.linspace(0.0, 0.5, 6), rod=grid.astype(np.int8), E_0=grid * 0.1)
+    assert table.dtype.names == ("time", "rod", "E_0") and table["rod"].dtype == float
+    assert table["rod"].tolist() == [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]  # row-major, as the grid's ravel
+    write_results_csv(tmp_path / "t.csv", table, {"E_0": "J"})
+    back = read_results_csv(tmp_path / "t.csv")
+    assert back.dtype.names == table.dtype.names
+    np.testing.assert_array_equal(back["E_0"], table["E_0"])

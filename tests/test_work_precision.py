@@ -1,11 +1,16 @@
-"""The work-precision report generator on a tiny configuration (through the FMU)."""
+"""Work-precision: errors, drift and the choice per band, and the report on a tiny configuration (FMU)."""
 
 from __future__ import annotations
 
 import csv
 import math
 
+import numpy as np
+import pytest
 from double_pendulum.scenarios import work_precision
+
+from double_pendulum.analysis import work_precision as wp
+from double_pendulum.analysis.reference import Reference
 
 
 def test_work_precision_report_on_a_tiny_configuration(runner, tmp_path):
@@ -23,3 +28,70 @@ def test_work_precision_report_on_a_tiny_configuration(runner, tmp_path):
     report = (tmp_path / "report.md").read_text()
     assert "fastest method" in report and "regular" in report
     assert (tmp_path / "work_precision_regular.png").is_file()
+
+
+# ---------------------------------------------------------------------------- errors, drift and the choice per band
+def _reference(t: np.ndarray) -> Reference:
+    states = {"phi1": np.sin(t), "phi2": np.cos(t), "omega1": np.cos(t), "omega2": -np.sin(t)}
+    return Reference(t, states, np.ones_like(t), 1e-12)
+
+
+def _result(t: np.ndarray, offset: np.ndarray) -> np.ndarray:
+    columns = {"phi1": np.sin(t) + offset, "phi2": np.cos(t), "omega1": np.cos(t), "omega2": -np.sin(t)}
+    return np.rec.fromarrays(list(columns.values()), names=list(columns)).view(np.ndarray)
+
+
+def test_settings_sweep_tolerances_of_adaptive_and_steps_of_fixed_step_methods():
+    adaptive = wp.settings_for("dop853", quick=True)
+    assert [s["rtol"] for s in adaptive] == [1e-5, 1e-8]
+    assert [s["atol"] for s in adaptive] == pytest.approx([1e-7, 1e-10], rel=1e-12)  # atol = rtol / 100
+    assert [s["fixed_step"] for s in wp.settings_for("euler", quick=False)] == [1e-3, 1e-4, 2e-5]  # first order
+    assert [s["fixed_step"] for s in wp.settings_for("rk4", quick=False)] == [2e-2, 1e-2, 5e-3, 2e-3, 1e-3]
+
+
+def test_errors_compare_the_run_with_the_reference_at_the_same_times():
+    ref = _reference(np.arange(0, 101) * 0.01)  # 1 s on a 10 ms grid
+    coarse = np.arange(0, 11) * 0.1
+    final, largest = wp.errors(_result(coarse, 1e-6 * coarse), ref, 0.1)  # error growing linearly to 1e-6
+    assert final == pytest.approx(1e-6) and largest == pytest.approx(1e-6)
+    fine = np.arange(0, 201) * 0.005  # every other sample lies on the reference grid
+    offset = np.where(np.arange(201) % 2 == 1, 1.0, 0.0) + np.where(np.arange(201) == 100, 3e-7, 0.0)
+    final, largest = wp.errors(_result(fine, offset), ref, 0.005)
+    assert final == 0.0 and largest == pytest.approx(3e-7)  # the off-grid samples are not compared
+
+
+def test_energy_drift_is_relative_to_the_start_energy():
+    result = np.rec.fromarrays(
+        [np.array([2.0, 2.002, 1.999]), np.array([0.0, -1e-3, 4e-3])], names=["E_total", "energy_residual"]
+    ).view(np.ndarray)
+    assert wp.energy_drift(result, dissipative=False) == pytest.approx(1e-3)
+    assert wp.energy_drift(result, dissipative=True) == pytest.approx(2e-3)
+
+
+def test_timing_and_failure_columns():
+    assert wp.timing_columns([0.3, 0.1, 0.2]) == {"cpu_time_s": 0.2, "cpu_spread": pytest.approx(1.0)}
+    assert wp.timing_columns([0.0]) == {"cpu_time_s": 0.0, "cpu_spread": 0.0}
+    unstable = wp.failure_columns(RuntimeError("doStep failed. FMU says: numerical instability at t = 1 s"))
+    assert unstable == {"status": "unstable", "message": "numerical instability at t = 1 s"}
+    assert wp.failure_columns(RuntimeError("x" * 300)) == {"status": "failed", "message": "x" * 200}
+
+
+def test_best_per_band_takes_the_fastest_run_within_each_bound_above_the_floor():
+    rows = [
+        {"case": "r", "status": "ok", "solver": "rk4", "fixed_step": 0.01, "comm_step_s": 0.01, "max_error": 5e-4,
+         "cpu_time_s": 0.01},
+        {"case": "r", "status": "ok", "solver": "dop853", "rtol": 1e-8, "comm_step_s": 0.01, "max_error": 1e-7,
+         "cpu_time_s": 0.05},
+        {"case": "r", "status": "ok", "solver": "dop853", "rtol": 1e-10, "comm_step_s": 0.01, "max_error": 1e-10,
+         "cpu_time_s": 0.08},
+        {"case": "r", "status": "unstable", "solver": "euler", "fixed_step": 0.01, "comm_step_s": 0.01},
+        {"case": "other", "status": "ok", "solver": "rk4", "max_error": 0.0, "cpu_time_s": 0.0},
+    ]
+    best = wp.best_per_band(rows, "r", floor=1e-11)
+    assert [None if b is None else b["solver"] for b in best.values()] == ["rk4", "dop853", "dop853"]
+    assert best["1e-06"]["rtol"] == 1e-8 and best["1e-09"]["rtol"] == 1e-10
+    assert wp.best_per_band(rows, "r", floor=1e-8)["1e-09"] is None  # below the reference floor
+    text = wp.report(rows, {"r": wp.best_per_band(rows, "r", floor=1e-8)}, {"r": 1e-8}, quick=True)
+    assert "| 0.001 | rk4 | h 0.01 s | 0.01 | 5.0e-04 | 0.010 |" in text
+    assert "| 1e-09 | (none reached it, or below the reference floor) | | | | |" in text
+    assert "- euler 0.01: unstable: " in text

@@ -61,6 +61,12 @@ def write_results_csv(path: str | Path, result: np.ndarray, units: Mapping[str, 
     return path
 
 
+def table_from_columns(**columns: Any) -> np.ndarray:
+    """Columns of equal length (flattened, as floats) as a structured array for :func:`write_results_csv`."""
+    arrays = [np.asarray(v, dtype=float).ravel() for v in columns.values()]
+    return np.rec.fromarrays(arrays, names=list(columns)).view(np.ndarray)
+
+
 def read_results_csv(path: str | Path) -> np.ndarray:
     """Read a CSV written by :func:`write_results_csv` into a structured array (plain names)."""
     with open(path) as fh:

@@ -1,0 +1,163 @@
+"""Work-precision study: cases, solver settings, errors against a reference, the fastest method per band.
+
+Error of a run (:func:`errors`): ``e(t) = max_i |x_i(t) - x_i^ref(t)|`` over the states
+``x = (phi1, phi2, omega1, omega2)`` [rad, rad/s] against the cached reference
+(:mod:`double_pendulum.analysis.reference`), on the output times the run and the reference share;
+reported are the final error ``e(T)`` and the maximum over the horizon ``max_t e(t)``.
+Energy drift (:func:`energy_drift`): ``max |E_total - E_0| / E_0`` frictionless, ``max |energy_residual| / E_0``
+with dissipation. :func:`best_per_band` picks the fastest run (CPU time) whose max error is within
+each band of :data:`BANDS`.
+"""
+
+from __future__ import annotations
+
+import statistics
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..solvers import make_method
+from .reference import STATE_OUTPUTS, Reference
+
+BANDS = (1e-3, 1e-6, 1e-9)  # report the fastest configuration reaching each max-error level
+COMM_STEPS = (1e-3, 1e-2, 1e-1)
+BASE_COMM_STEP = 1e-2
+
+
+@dataclass(frozen=True)
+class Case:
+    """A start state and horizon over which the reference is trustworthy."""
+
+    name: str
+    start: dict[str, Any]
+    horizon: float
+    quick_horizon: float
+    dissipative: bool = False
+
+
+CASES = (
+    Case("regular", {"phi1_0": 0.3, "phi2_0": 0.3}, 30.0, 1.0),
+    Case("chaotic", {"phi1_0": 2.0, "phi2_0": 2.0}, 3.0, 0.5),
+    Case(
+        "stiff_suspension",
+        {"phi1_0": 1.0, "phi2_0": 1.0, "suspension": True, "M_s": 0.05, "k_x": 1e7, "k_y": 1e7, "c_x": 20.0,
+         "c_y": 20.0},
+        2.0,
+        0.2,
+        dissipative=True,
+    ),
+)
+
+
+def settings_for(solver: str, quick: bool) -> list[dict[str, float]]:
+    """The sweep of one solver: tolerances for adaptive methods, step sizes for fixed-step ones."""
+    method = make_method(solver)
+    if method.adaptive:
+        tols = (1e-5, 1e-8) if quick else (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+        return [{"rtol": t, "atol": t * 1e-2} for t in tols]
+    order = method.order
+    if quick:
+        steps = (1e-2, 5e-3)
+    elif order == 1:
+        steps = (1e-3, 1e-4, 2e-5)
+    else:
+        steps = (2e-2, 1e-2, 5e-3, 2e-3, 1e-3)
+    return [{"fixed_step": h} for h in steps]
+
+
+def errors(result: np.ndarray, ref: Reference, comm_step: float) -> tuple[float, float]:
+    """(final error, max error over the horizon) on the reference's output grid.
+
+    The run's outputs every ``comm_step`` [s] are matched to the reference's samples at the same times
+    (every k-th reference sample if ``comm_step`` is coarser, every k-th run sample if finer).
+    """
+    stride = comm_step / (ref.time[1] - ref.time[0])
+    if stride >= 1:
+        idx_ref = np.arange(0, len(ref.time), int(round(stride)))
+        idx_res = np.arange(len(idx_ref))
+    else:
+        idx_res = np.arange(0, len(result), int(round(1 / stride)))
+        idx_ref = np.arange(len(idx_res))
+    n = min(len(idx_ref), len(idx_res))
+    diff = np.max([np.abs(result[name][idx_res[:n]] - ref.states[name][idx_ref[:n]]) for name in STATE_OUTPUTS], axis=0)
+    return float(diff[-1]), float(np.max(diff))
+
+
+def energy_drift(result: np.ndarray, dissipative: bool) -> float:
+    """``max |E_total - E_0| / E_0`` (frictionless) or ``max |energy_residual| / E_0`` (with dissipation)."""
+    e0 = float(result["E_total"][0])
+    drift = result["energy_residual"] if dissipative else result["E_total"] - e0
+    return float(np.max(np.abs(drift))) / e0
+
+
+def timing_columns(cpu: list[float]) -> dict[str, float]:
+    """``cpu_time_s``: the median CPU time [s] of the repeats; ``cpu_spread``: (max - min) / median."""
+    med = statistics.median(cpu)
+    return {"cpu_time_s": med, "cpu_spread": (max(cpu) - min(cpu)) / med if med > 0 else 0.0}
+
+
+def failure_columns(error: Exception) -> dict[str, str]:
+    """``status`` (``unstable`` if the FMU reported an instability, else ``failed``) and its ``message``."""
+    msg = str(error).split("FMU says: ")[-1]
+    return {"status": "unstable" if "instability" in msg else "failed", "message": msg[:200]}
+
+
+def accuracy_columns(result: np.ndarray, case: Case, ref: Reference, comm: float) -> dict[str, Any]:
+    """Final and max error, energy drift, RHS evaluations and steps of a finished run."""
+    final_error, max_error = errors(result, ref, comm)
+    return {
+        "final_error": final_error,
+        "max_error": max_error,
+        "energy_drift": energy_drift(result, case.dissipative),
+        "rhs_evaluations": int(result["solver_rhs_evaluations"][-1]),
+        "steps": int(result["solver_steps"][-1]),
+    }
+
+
+def best_per_band(rows: list[dict[str, Any]], case: str, floor: float) -> dict[str, Any]:
+    """The fastest ok configuration of ``case`` (least CPU time) whose max error is within each band's bound.
+
+    Keyed by the bound (``"0.001"``); None where no run reached it or the bound is below the reference's
+    error floor ``floor`` (errors that small cannot be resolved).
+    """
+    out = {}
+    for bound in BANDS:
+        if bound < floor:
+            out[f"{bound:g}"] = None
+            continue
+        ok = [r for r in rows if r["case"] == case and r["status"] == "ok" and r["max_error"] <= bound]
+        best = min(ok, key=lambda r: r["cpu_time_s"], default=None)
+        out[f"{bound:g}"] = None if best is None else {k: best.get(k) for k in (
+            "solver", "rtol", "fixed_step", "comm_step_s", "max_error", "cpu_time_s")}
+    return out
+
+
+def report(
+    rows: list[dict[str, Any]], best: dict[str, dict[str, Any]], floors: dict[str, float], quick: bool
+) -> str:
+    """The Markdown report: per case the reference floor, the fastest method per band, the failures."""
+    lines = ["# Work-precision report", "",
+             "Generated by `double-pendulum run work_precision`" + (" --quick" if quick else "") + ".",
+             "Error: max over phi1, phi2, omega1, omega2 against a DOP853 rtol 1e-13 reference "
+             "(cross-checked with SciPy Radau: the floor below). CPU: median over repeats, through fmpy.", ""]
+    for case, floor in floors.items():
+        lines += [f"## {case}", "", f"Reference error floor: {floor:.1e}", "",
+                  "| max error <= | fastest method | setting | comm step [s] | max error | CPU [s] |",
+                  "|---|---|---|---|---|---|"]
+        for bound, b in best[case].items():
+            if b is None:
+                lines.append(f"| {bound} | (none reached it, or below the reference floor) | | | | |")
+            else:
+                setting = f"rtol {b['rtol']:g}" if b.get("rtol") is not None else f"h {b['fixed_step']:g} s"
+                lines.append(f"| {bound} | {b['solver']} | {setting} | {b['comm_step_s']:g} | "
+                             f"{b['max_error']:.1e} | {b['cpu_time_s']:.3f} |")
+        bad = [r for r in rows if r["case"] == case and r["status"] != "ok"]
+        if bad:
+            lines += ["", "Failed or unstable configurations:", ""]
+            lines += [f"- {r['solver']} {r.get('rtol') or r.get('fixed_step')}: {r['status']}: {r.get('message', '')}"
+                      for r in bad]
+        lines.append("")
+    return "\n".join(lines)
+
+
