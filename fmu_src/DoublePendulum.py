@@ -83,6 +83,15 @@ class DoublePendulum(Fmi2Slave):
                 getter=lambda: self._sim.get(name),
                 setter=lambda value: self._guarded(self._sim.set, name, value),
             )
+        elif var.causality == "input":
+            variable = Real(
+                name,
+                causality=Fmi2Causality.input,
+                variability=Fmi2Variability.continuous,
+                description=var.description,
+                getter=lambda: self._sim.get(name),
+                setter=lambda value: self._guarded(self._sim.set_input, name, value),
+            )
         else:
             variable = Real(
                 name,

@@ -10,13 +10,15 @@ from __future__ import annotations
 from dataclasses import fields
 from typing import Any, NamedTuple
 
+from ..model.inputs import INPUTS
 from ..model.outputs import OUTPUTS
 from .cosimulation import PARAMETER_GROUPS
 
 MODEL_IDENTIFIER = "DoublePendulum"
 MODEL_DESCRIPTION = (
-    "Planar double pendulum (point masses on massless rods, fixed pivot), equations of motion "
-    "from the Lagrangian; FMI 2.0 co-simulation with an integrator that persists across doStep."
+    "Planar double pendulum (point masses on massless rods; fixed, moving or suspended pivot), "
+    "equations of motion from the Lagrangian; inputs: pivot motion and joint torques; FMI 2.0 "
+    "co-simulation with an integrator that persists across doStep."
 )
 DEFAULT_EXPERIMENT = {"start_time": 0.0, "stop_time": 10.0, "step_size": 0.01}
 
@@ -26,10 +28,10 @@ class FmuVariable(NamedTuple):
 
     name: str
     fmi_type: str  # "Real", "Boolean" or "String"
-    causality: str  # "parameter" or "output"
+    causality: str  # "parameter", "input" or "output"
     unit: str  # FMI unit string, "" for none
     description: str
-    start: Any  # start value for parameters, None for outputs
+    start: Any  # start value for parameters and inputs, None for outputs
 
 
 def _fmi_type(rule: str) -> str:
@@ -42,7 +44,7 @@ def described(description: str, unit: str) -> str:
 
 
 def fmu_variables() -> list[FmuVariable]:
-    """Return all FMU variables: parameters (in dataclass order), then outputs."""
+    """Return all FMU variables: parameters (in dataclass order), inputs, then outputs."""
     variables = [
         FmuVariable(
             f.name,
@@ -54,6 +56,9 @@ def fmu_variables() -> list[FmuVariable]:
         )
         for group in PARAMETER_GROUPS
         for f in fields(group)
+    ]
+    variables += [
+        FmuVariable(q.name, "Real", "input", q.unit, described(q.description, q.unit), 0.0) for q in INPUTS
     ]
     variables += [
         FmuVariable(q.name, "Real", "output", q.unit, described(q.description, q.unit), None) for q in OUTPUTS

@@ -10,6 +10,9 @@ modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the buil
   Real variable, from :func:`double_pendulum.component.variables.fmu_variables`;
 * lists every output under ``ModelStructure/InitialUnknowns`` (they are computed at
   initialisation), so ``fmpy.validation.validate_fmu`` reports no problems;
+* states each output's direct dependencies on the inputs under ``ModelStructure/Outputs``
+  (:data:`double_pendulum.model.outputs.INPUT_DEPENDENCIES`; ``dependencies=""`` for none),
+  which pythonfmu leaves open (open means: depends on every input);
 * writes ``resources/requirements.txt`` with what the FMU needs at run time.
 """
 
@@ -23,6 +26,7 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..component.variables import MODEL_IDENTIFIER, fmu_variables
+from ..model.outputs import INPUT_DEPENDENCIES
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
@@ -101,14 +105,17 @@ def complete_model_description(xml_text: bytes) -> bytes:
     root.insert(position, unit_defs)
 
     outputs_index = []
+    index_of: dict[str, int] = {}
     for index, sv in enumerate(root.find("ModelVariables"), start=1):
         real = sv.find("Real")
+        index_of[sv.get("name")] = index
         if real is not None and sv.get("name") in units:
             real.set("unit", units[sv.get("name")])
         if sv.get("causality") == "output":
             outputs_index.append(index)
 
     structure = root.find("ModelStructure")
+    _set_output_dependencies(structure, index_of)
     for old in structure.findall("InitialUnknowns"):
         structure.remove(old)
     initial = ET.SubElement(structure, "InitialUnknowns")
@@ -116,6 +123,16 @@ def complete_model_description(xml_text: bytes) -> bytes:
         ET.SubElement(initial, "Unknown", index=str(index))
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+def _set_output_dependencies(structure: ET.Element, index_of: dict[str, int]) -> None:
+    """Give every ``Outputs/Unknown`` its direct dependencies on the inputs (indices, ascending)."""
+    name_of = {index: name for name, index in index_of.items()}
+    outputs = structure.find("Outputs")
+    for unknown in outputs if outputs is not None else ():
+        name = name_of[int(unknown.get("index"))]
+        deps = sorted(index_of[n] for n in INPUT_DEPENDENCIES.get(name, ()))
+        unknown.set("dependencies", " ".join(map(str, deps)))
 
 
 def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
