@@ -99,8 +99,10 @@ def test_sinusoidal_pivot_motion_through_the_fmu_matches_the_in_process_componen
 @pytest.mark.parametrize(
     ("start", "columns"),
     [
-        ({"air_drag": True, "bearing_friction": True},
-         {"tau1": lambda t: 0.3 * math.sin(4 * t), "tau2": lambda t: -0.1}),
+        (
+            {"air_drag": True, "bearing_friction": True},
+            {"tau1": lambda t: 0.3 * math.sin(4 * t), "tau2": lambda t: -0.1},
+        ),
         ({"air_drag": True}, pivot_motion(shaker(0.02, 9.0), shaker(0.04, 13.0))),
         ({"suspension": True}, pivot_motion(shaker(0.002, 40.0), shaker(0.003, 55.0))),
         ({"suspension": True, "suspension_x": False}, pivot_motion(shaker(0.01, 8.0), shaker(0.003, 55.0))),

@@ -8,7 +8,7 @@ import sys
 import time
 from pathlib import Path
 
-from .fmu.build import DEFAULT_FMU_PATH, build_fmu
+from .fmu.build import DEFAULT_FMU_PATH, build_all
 
 
 def _scenario_names() -> tuple[str, ...]:
@@ -24,8 +24,8 @@ def _load_scenario(name: str):
 
 
 def cmd_build(args: argparse.Namespace) -> int:
-    path = build_fmu(args.output)
-    print(f"built {path}")
+    for path in build_all(args.output):
+        print(f"built {path}")
     return 0
 
 
@@ -74,8 +74,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="double-pendulum", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
 
-    p_build = sub.add_parser("build", help="build the FMU")
-    p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="FMU path or folder")
+    p_build = sub.add_parser("build", help="build DoublePendulum.fmu and, next to it, Suspension.fmu")
+    p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="DoublePendulum FMU path or folder")
     p_build.set_defaults(func=cmd_build)
 
     p_run = sub.add_parser("run", help="run a scenario (or 'all') through the FMU with fmpy")

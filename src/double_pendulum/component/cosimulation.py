@@ -63,6 +63,41 @@ class CoSimulationError(RuntimeError):
     """A co-simulation call was made out of order or with an invalid argument."""
 
 
+def check_step_call(initialised: bool, time: float, current_time: float, step_size: float) -> None:
+    """Raise :class:`CoSimulationError` for a doStep out of order or with a non-positive step [s]."""
+    if not initialised:
+        raise CoSimulationError("doStep called before initialisation")
+    if not (math.isfinite(step_size) and step_size > 0.0):
+        raise CoSimulationError(f"invalid communication step size {step_size!r} s: must be > 0")
+    if abs(current_time - time) > 1e-9 * max(1.0, abs(time)):
+        raise CoSimulationError(
+            f"doStep at t = {current_time!r} s does not continue from the last communication "
+            f"point t = {time!r} s"
+        )
+
+
+def checked_parameter(rules: Mapping[str, tuple[str, str]], name: str, value: Any, initialised: bool) -> Any:
+    """Return ``value`` for parameter ``name`` (ints as floats) after checking it against ``rules``.
+
+    Raises :class:`ParameterError` for an unknown name or a value that breaks its rule and
+    :class:`CoSimulationError` after initialisation (FMI: fixed parameters).
+    """
+    if name not in rules:
+        raise ParameterError(f"unknown parameter {name!r}")
+    if initialised:
+        raise CoSimulationError(
+            f"cannot set parameter {name} = {value!r} after initialisation (FMI: fixed parameters "
+            "may only be set before fmi2ExitInitializationMode)"
+        )
+    unit, rule = rules[name]
+    if rule != "str" and rule != "bool" and isinstance(value, int) and not isinstance(value, bool):
+        value = float(value)
+    check_value(name, value, unit, rule)
+    if name == "solver":
+        SolverSettings(solver=value)  # checks the name
+    return value
+
+
 def _parameter_rules() -> dict[str, tuple[str, str]]:
     """Map each parameter name to ``(unit, rule)``."""
     return {
@@ -131,20 +166,7 @@ class DoublePendulumCoSimulation:
     # ------------------------------------------------------------------ parameters
     def set(self, name: str, value: Any) -> None:
         """Set parameter ``name``; raises :class:`ParameterError` for an invalid value."""
-        if name not in self.RULES:
-            raise ParameterError(f"unknown parameter {name!r}")
-        if self.initialised:
-            raise CoSimulationError(
-                f"cannot set parameter {name} = {value!r} after initialisation (FMI: fixed parameters "
-                "may only be set before fmi2ExitInitializationMode)"
-            )
-        unit, rule = self.RULES[name]
-        if rule != "str" and rule != "bool" and isinstance(value, int) and not isinstance(value, bool):
-            value = float(value)
-        check_value(name, value, unit, rule)
-        if name == "solver":
-            SolverSettings(solver=value)  # checks the name
-        self.values[name] = value
+        self.values[name] = checked_parameter(self.RULES, name, value, self.initialised)
 
     def get(self, name: str) -> Any:
         """Return a parameter, input or output value by name."""
@@ -259,15 +281,7 @@ class DoublePendulumCoSimulation:
         :class:`SolverError` when the integrator gives up; the state is then left at the last
         successful communication point.
         """
-        if not self.initialised or self.integrator is None:
-            raise CoSimulationError("doStep called before initialisation")
-        if not (math.isfinite(step_size) and step_size > 0.0):
-            raise CoSimulationError(f"invalid communication step size {step_size!r} s: must be > 0")
-        if abs(current_time - self.time) > 1e-9 * max(1.0, abs(self.time)):
-            raise CoSimulationError(
-                f"doStep at t = {current_time!r} s does not continue from the last communication "
-                f"point t = {self.time!r} s"
-            )
+        check_step_call(self.initialised and self.integrator is not None, self.time, current_time, step_size)
         t_end = current_time + step_size
         try:
             if self.driven and not self._hold.continued_by(self.time, self._input_values()):

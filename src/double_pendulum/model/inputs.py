@@ -120,4 +120,3 @@ class InputHold:
         """
         held = self.at(t0)
         return all(_same(a, b) for a, b in zip(held, values))
-
