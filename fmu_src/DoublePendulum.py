@@ -1,141 +1,21 @@
-"""pythonfmu adapter: maps FMI 2.0 co-simulation calls onto ``double_pendulum.component.cosimulation``.
-
-All physics, numerics and validation live in the ``double_pendulum`` package, whose runtime part
-(model, solvers, component) the build bundles into the FMU's resources next to this file. The
-bundled copy is loaded under a private module name so the FMU always runs its own code, whatever
-``double_pendulum`` the host process may have imported.
+"""pythonfmu adapter of ``DoublePendulum.fmu``: the component
+:class:`double_pendulum.component.cosimulation.DoublePendulumCoSimulation` behind FMI 2.0
+co-simulation (the mapping itself is :class:`double_pendulum_slave.ComponentSlave`).
 """
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
-import os
-import sys
-from pathlib import Path
-
-from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Real, String
+from double_pendulum_slave import ComponentSlave, runtime_module
 from pythonfmu.default_experiment import DefaultExperiment
-from pythonfmu.enums import Fmi2Status
 
-_BUNDLE_NAME = "_double_pendulum_fmu_bundle"
-STDERR_SWITCH = "DOUBLE_PENDULUM_FMU_STDERR"  # "0": errors go to the FMI log only
-
+_cosim = runtime_module("component.cosimulation")
+_interface = runtime_module("component.variables").INTERFACES["DoublePendulum"]
 
 
-def _compensate_pythonfmu_release(*objects) -> None:
-    """Add one reference count to each object, without keeping a reference.
+class DoublePendulum(ComponentSlave):
+    description = _interface.description
+    default_experiment = DefaultExperiment(**_interface.default_experiment)
+    interface = _interface
 
-    When a Python exception reaches pythonfmu's C++ layer (<= 0.7.0), its ``handle_py_exception``
-    calls ``cleanPyObject``, which releases the slave's references (class, instance, log queue)
-    while the C++ object still holds and later releases them again. In our test runs a few dozen
-    failed calls then left the host to crash in the garbage collector (segfault, about 2 runs in 3).
-    Balancing the release of the instance's log queue removed the crash in every repeated run
-    (balancing the class or the instance alone did not). The cost is one small list kept alive per
-    failed call.
-    """
-    import ctypes
-
-    for obj in objects:
-        ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
-
-
-def _load_package():
-    """Import the bundled package (resources/double_pendulum) or, at build time, the installed one."""
-    bundled = Path(__file__).resolve().parent / "double_pendulum"
-    if not (bundled / "__init__.py").is_file():
-        return importlib.import_module("double_pendulum")
-    if _BUNDLE_NAME not in sys.modules:
-        spec = importlib.util.spec_from_file_location(
-            _BUNDLE_NAME, bundled / "__init__.py", submodule_search_locations=[str(bundled)]
-        )
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[_BUNDLE_NAME] = module
-        spec.loader.exec_module(module)
-    return sys.modules[_BUNDLE_NAME]
-
-
-_package = _load_package()
-_cosim = importlib.import_module(_package.__name__ + ".component.cosimulation")
-_interface = importlib.import_module(_package.__name__ + ".component.variables")
-_FMI_TYPES = {"Real": Real, "Boolean": Boolean, "String": String}
-
-
-class DoublePendulum(Fmi2Slave):
-    author = "double-pendulum-fmu contributors"
-    license = "MIT"
-    version = _package.__version__
-    description = _interface.MODEL_DESCRIPTION
-    default_experiment = DefaultExperiment(**_interface.DEFAULT_EXPERIMENT)
-
-    def __init__(self, **kwargs):
-        super().__init__(**kwargs)
-        self._sim = _cosim.DoublePendulumCoSimulation()
-        for var in _interface.fmu_variables():
-            self._register(var)
-
-    def _register(self, var) -> None:
-        name = var.name
-        if var.causality == "parameter":
-            variable = _FMI_TYPES[var.fmi_type](
-                name,
-                causality=Fmi2Causality.parameter,
-                variability=Fmi2Variability.fixed,
-                description=var.description,
-                getter=lambda: self._sim.get(name),
-                setter=lambda value: self._guarded(self._sim.set, name, value),
-            )
-        else:
-            variable = Real(
-                name,
-                causality=Fmi2Causality.output,
-                variability=Fmi2Variability.continuous,
-                description=var.description,
-                getter=lambda: self._sim.outputs[name],
-            )
-        self.register_variable(variable)
-
-    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
-        self._guarded(self._sim.set_start_time, start_time)
-
-    def _guarded(self, call, *args):
-        """Run ``call``; on error also print the message to stderr, then re-raise.
-
-        pythonfmu turns the exception into fmi2Fatal and passes its message to the host's logger
-        only when logging is on; stderr makes it visible to a user with logging off too.
-        """
-        try:
-            return call(*args)
-        except Exception as error:
-            self._report(error)
-            _compensate_pythonfmu_release(self.log_queue)
-            raise
-
-    def _report(self, error) -> None:
-        """Print the error to stderr, unless the host collects the FMU's log itself.
-
-        A host that logs every message and reports the failures it expects (the project's own
-        ``FmuRunner``) sets ``DOUBLE_PENDULUM_FMU_STDERR=0`` while it runs the FMU.
-        """
-        if os.environ.get(STDERR_SWITCH, "1") != "0":
-            print(f"[{self.instance_name}] DoublePendulum: {error}", file=sys.stderr, flush=True)
-
-    def exit_initialization_mode(self):
-        self._guarded(self._sim.initialise)
-
-    # FMU state (fmi2Get/SetFMUstate, fmi2(De)SerializeFMUstate): the co-simulation's complete
-    # state, including the integrator's hidden state, as JSON-serialisable data.
-    def _get_fmu_state(self):
-        return self._sim.get_state()
-
-    def _set_fmu_state(self, state):
-        self._guarded(self._sim.set_state, state)
-
-    def do_step(self, current_time, step_size):
-        try:
-            self._sim.do_step(current_time, step_size)
-        except Exception as error:  # any failure is a discarded step, never an exception into pythonfmu
-            self.log(f"doStep failed: {error}", Fmi2Status.error)
-            self._report(error)
-            return False
-        return True
+    def make_component(self):
+        return _cosim.DoublePendulumCoSimulation()

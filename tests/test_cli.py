@@ -25,6 +25,7 @@ def test_build_writes_the_fmu(tmp_path):
     target = tmp_path / "out" / "X.fmu"
     assert main(["build", "-o", str(target)]) == 0
     assert target.is_file()
+    assert (target.parent / "Suspension.fmu").is_file()  # every FMU, next to DoublePendulum
 
 
 def test_run_free_swing_writes_csv_plots_and_summary(fmu_path, tmp_path):

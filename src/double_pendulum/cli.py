@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 from . import __version__
-from .fmu.build import DEFAULT_FMU_PATH, build_fmu
+from .fmu.build import DEFAULT_FMU_PATH, build_all, build_fmu
 from .scenarios import SCENARIOS
 
 PROG = "double-pendulum"
@@ -130,12 +130,13 @@ def run_scenario(module, name: str, runner, out: Path, quick: bool) -> None:
 
 
 def cmd_build(args: argparse.Namespace) -> int:
-    print(f"building {args.output} ...", flush=True)
+    print(f"building the FMUs next to {args.output} ...", flush=True)
     try:
-        path = build_fmu(args.output)
+        paths = build_all(args.output)
     except OSError as error:
-        raise CliError(f"cannot build the FMU at {args.output}: {error.strerror or error}") from None
-    print(f"built {path}")
+        raise CliError(f"cannot build the FMUs at {args.output}: {error.strerror or error}") from None
+    for path in paths:
+        print(f"built {path}")
     return 0
 
 
@@ -190,8 +191,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p_build = sub.add_parser("build", help="build the FMU", description="Build DoublePendulum.fmu.")
-    p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="FMU path or folder")
+    p_build = sub.add_parser("build", help="build DoublePendulum.fmu and, next to it, Suspension.fmu",
+                             description="Build DoublePendulum.fmu and, next to it, Suspension.fmu.")
+    p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="DoublePendulum FMU path or folder")
     p_build.set_defaults(func=cmd_build)
 
     p_run = sub.add_parser(

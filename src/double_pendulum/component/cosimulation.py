@@ -11,6 +11,19 @@ Life cycle (FMI 2.0 co-simulation):
    integrator, and computes the outputs at the start time;
 3. :meth:`do_step` advances from ``current_time`` by ``step_size``; the integrator persists
    between calls, so results do not depend on the communication step.
+
+Inputs (:mod:`double_pendulum.model.inputs`) may be set at any time with :meth:`set_input`; a
+non-finite value is refused. While every input is 0 the component runs the model without
+inputs (bit-identical to a build without them). The first non-zero input switches it, at the
+current communication point, to the model with inputs (one more state, ``W_input``). Each
+``do_step`` then holds the inputs set for it (second-order hold,
+:class:`~double_pendulum.model.inputs.InputHold`); when they do not continue the previous step's
+hold, the right-hand side jumps at ``current_time`` and the integrator is restarted there
+(:meth:`~double_pendulum.solvers.Integrator.restart`), so no step or dense output computed with
+the old inputs is used beyond the communication point. If the new values make the pivot's (or
+base's) position or velocity jump, the energy changes at once (kinetic energy with the pivot
+velocity, spring energy with the base position); that change is booked into ``W_input`` at the
+jump, so ``energy_residual`` keeps measuring only the integration error.
 """
 
 from __future__ import annotations
@@ -20,6 +33,7 @@ from collections.abc import Iterator, Mapping
 from dataclasses import fields
 from typing import Any
 
+from ..model.inputs import INPUT_NAMES, INPUT_UNITS, ZERO_INPUTS, InputHold, InputValues
 from ..model.outputs import GROUP_OF, OUTPUT_GROUPS, OUTPUT_NAMES
 from ..model.parameters import (
     AirDragParameters,
@@ -30,7 +44,7 @@ from ..model.parameters import (
     SuspensionParameters,
     check_value,
 )
-from ..model.vector_field import Model, ModelConfig, ModelError, build_model
+from ..model.vector_field import Model, ModelConfig, ModelError, build_model, build_vector_field, energies
 from ..solvers import Integrator, SolverError, make_integrator
 from .settings import SolverSettings
 
@@ -47,6 +61,41 @@ ENERGY_BLOWUP_FACTOR = 1e3
 
 class CoSimulationError(RuntimeError):
     """A co-simulation call was made out of order or with an invalid argument."""
+
+
+def check_step_call(initialised: bool, time: float, current_time: float, step_size: float) -> None:
+    """Raise :class:`CoSimulationError` for a doStep out of order or with a non-positive step [s]."""
+    if not initialised:
+        raise CoSimulationError("doStep called before initialisation")
+    if not (math.isfinite(step_size) and step_size > 0.0):
+        raise CoSimulationError(f"invalid communication step size {step_size!r} s: must be > 0")
+    if abs(current_time - time) > 1e-9 * max(1.0, abs(time)):
+        raise CoSimulationError(
+            f"doStep at t = {current_time!r} s does not continue from the last communication "
+            f"point t = {time!r} s"
+        )
+
+
+def checked_parameter(rules: Mapping[str, tuple[str, str]], name: str, value: Any, initialised: bool) -> Any:
+    """Return ``value`` for parameter ``name`` (ints as floats) after checking it against ``rules``.
+
+    Raises :class:`ParameterError` for an unknown name or a value that breaks its rule and
+    :class:`CoSimulationError` after initialisation (FMI: fixed parameters).
+    """
+    if name not in rules:
+        raise ParameterError(f"unknown parameter {name!r}")
+    if initialised:
+        raise CoSimulationError(
+            f"cannot set parameter {name} = {value!r} after initialisation (FMI: fixed parameters "
+            "may only be set before fmi2ExitInitializationMode)"
+        )
+    unit, rule = rules[name]
+    if rule != "str" and rule != "bool" and isinstance(value, int) and not isinstance(value, bool):
+        value = float(value)
+    check_value(name, value, unit, rule)
+    if name == "solver":
+        SolverSettings(solver=value)  # checks the name
+    return value
 
 
 def _parameter_rules() -> dict[str, tuple[str, str]]:
@@ -69,8 +118,9 @@ class LazyOutputs(Mapping[str, float]):
     """
 
     def __init__(self, model: Model | None, y: list[float] | None, initial_energy: float | None,
-                 solver_stats: dict[str, float], values: Mapping[str, float] | None = None) -> None:
-        self._model, self._y, self._e0 = model, y, initial_energy
+                 solver_stats: dict[str, float], values: Mapping[str, float] | None = None,
+                 inputs: InputValues | None = None) -> None:
+        self._model, self._y, self._e0, self._u = model, y, initial_energy, inputs
         self._values: dict[str, float] = {**solver_stats, **(values or {})}
         self._done: set[int] = set() if values is None else set(range(len(OUTPUT_GROUPS)))
 
@@ -83,7 +133,7 @@ class LazyOutputs(Mapping[str, float]):
         if name not in self._values:
             group = GROUP_OF[name]  # KeyError for unknown names, as a dict would
             if group not in self._done:
-                self._values.update(OUTPUT_GROUPS[group](self._model, self._y, self._e0))
+                self._values.update(OUTPUT_GROUPS[group](self._model, self._y, self._e0, self._u))
                 self._done.add(group)
         return self._values[name]
 
@@ -107,31 +157,79 @@ class DoublePendulumCoSimulation:
         self.model: Model = build_model(ModelConfig())
         self.outputs: Mapping[str, float] = {}
         self.initial_energy: float | None = None
-        self._update_outputs(self.model.initial_state(*InitialState().as_list()))
+        self.inputs: dict[str, float] = dict.fromkeys(INPUT_NAMES, 0.0)
+        self.driven = False  # the model with inputs is running (from the first non-zero input on)
+        self._hold: InputHold | None = None  # the hold the integrator is integrating
+        self._y: list[float] = self.model.initial_state(*InitialState().as_list())  # state at self.time
+        self._update_outputs(self._y)
 
     # ------------------------------------------------------------------ parameters
     def set(self, name: str, value: Any) -> None:
         """Set parameter ``name``; raises :class:`ParameterError` for an invalid value."""
-        if name not in self.RULES:
-            raise ParameterError(f"unknown parameter {name!r}")
-        if self.initialised:
-            raise CoSimulationError(
-                f"cannot set parameter {name} = {value!r} after initialisation (FMI: fixed parameters "
-                "may only be set before fmi2ExitInitializationMode)"
-            )
-        unit, rule = self.RULES[name]
-        if rule != "str" and rule != "bool" and isinstance(value, int) and not isinstance(value, bool):
-            value = float(value)
-        check_value(name, value, unit, rule)
-        if name == "solver":
-            SolverSettings(solver=value)  # checks the name
-        self.values[name] = value
+        self.values[name] = checked_parameter(self.RULES, name, value, self.initialised)
 
     def get(self, name: str) -> Any:
-        """Return a parameter or output value by name."""
+        """Return a parameter, input or output value by name."""
         if name in self.values:
             return self.values[name]
+        if name in self.inputs:
+            return self.inputs[name]
         return self.outputs[name]
+
+    # ------------------------------------------------------------------ inputs
+    def set_input(self, name: str, value: float) -> None:
+        """Set input ``name`` [its unit] for the next ``do_step``; any time, any number of times.
+
+        Raises :class:`ParameterError` naming the input and value if it is not a finite number
+        (the input keeps its previous value). Outputs read afterwards see the new inputs (the
+        pivot force depends on them directly).
+        """
+        if name not in self.inputs:
+            raise ParameterError(f"unknown input {name!r}")
+        if isinstance(value, int) and not isinstance(value, bool):
+            value = float(value)
+        check_value(f"input {name}", value, INPUT_UNITS[name], "finite")
+        if value == self.inputs[name]:
+            return
+        self.inputs[name] = value
+        if self.initialised:
+            if not self.driven:
+                self._start_driving()
+            new = self._input_values()
+            y = self._with_jump_work(self._y, self._hold.at(self.time), new)  # as it will be booked
+            self.outputs = self._outputs_at(y, new)
+
+    def _input_values(self) -> InputValues:
+        return InputValues(**self.inputs)
+
+    def _with_jump_work(self, y: list[float], old: InputValues, new: InputValues) -> list[float]:
+        """Return ``y`` with the energy jump [J] of switching the inputs ``old -> new`` added to ``W_input``.
+
+        Only the pivot (base) position and velocity change the energy at once; a consistent hold
+        makes the jump vanish with the communication step.
+        """
+        config, layout = self.model.config, self.model.layout
+        jump = sum(energies(config, y, layout, new)) - sum(energies(config, y, layout, old))
+        if jump == 0.0:
+            return y
+        booked = list(y)
+        booked[layout.index("W_input")] += jump
+        return booked
+
+    def _start_driving(self) -> None:
+        """Switch to the model with inputs at the current point: add ``W_input = 0``, restart."""
+        self.driven = True
+        self.model = build_model(self._config())
+        self._y = self._y + [0.0]  # W_input is the last state
+        self._restart(self.time)
+
+    def _restart(self, t: float) -> None:
+        """Restart the integrator at ``t`` from the current state with the inputs set now."""
+        new = self._input_values()
+        self._y = self._with_jump_work(self._y, self._hold.at(t) if self._hold else ZERO_INPUTS, new)
+        self._hold = InputHold(t, new)
+        f = build_vector_field(self.model.config, self.model.evaluate, self._hold)
+        self.integrator.restart(t, self._y, f)
 
     def _group(self, cls: type) -> Any:
         return cls(**{f.name: self.values[f.name] for f in fields(cls)})
@@ -143,21 +241,26 @@ class DoublePendulumCoSimulation:
             raise CoSimulationError(f"invalid start time {start_time!r} s: must be finite")
         self.time = float(start_time)
 
-    def initialise(self) -> None:
-        """Validate all parameters together and start the integrator at the start time."""
-        config = ModelConfig(
+    def _config(self) -> ModelConfig:
+        return ModelConfig(
             pendulum=self._group(PendulumParameters),
             air=self._group(AirDragParameters),
             bearing=self._group(BearingParameters),
             suspension=self._group(SuspensionParameters),
+            inputs=self.driven,
         )
+
+    def initialise(self) -> None:
+        """Validate all parameters together and start the integrator at the start time."""
+        self.driven = self.driven or any(self.inputs.values())
         initial = self._group(InitialState)
         settings = self._group(SolverSettings)
-        self.model = build_model(config)
+        self.model = build_model(self._config())
         y0 = self.model.initial_state(*initial.as_list())
+        self._hold = InputHold(self.time, self._input_values()) if self.driven else None
         self.integrator = make_integrator(
             settings.solver,
-            self.model.vector_field,
+            build_vector_field(self.model.config, self.model.evaluate, self._hold),
             self.time,
             y0,
             rtol=settings.rtol,
@@ -166,6 +269,7 @@ class DoublePendulumCoSimulation:
             max_steps_per_call=max(1, int(settings.max_steps)),
         )
         self.initial_energy = None
+        self._y = y0
         self._update_outputs(y0)
         self.initial_energy = self.outputs["E_total"]
         self.initialised = True
@@ -177,28 +281,23 @@ class DoublePendulumCoSimulation:
         :class:`SolverError` when the integrator gives up; the state is then left at the last
         successful communication point.
         """
-        if not self.initialised or self.integrator is None:
-            raise CoSimulationError("doStep called before initialisation")
-        if not (math.isfinite(step_size) and step_size > 0.0):
-            raise CoSimulationError(f"invalid communication step size {step_size!r} s: must be > 0")
-        if abs(current_time - self.time) > 1e-9 * max(1.0, abs(self.time)):
-            raise CoSimulationError(
-                f"doStep at t = {current_time!r} s does not continue from the last communication "
-                f"point t = {self.time!r} s"
-            )
+        check_step_call(self.initialised and self.integrator is not None, self.time, current_time, step_size)
         t_end = current_time + step_size
         try:
+            if self.driven and not self._hold.continued_by(self.time, self._input_values()):
+                self._restart(self.time)  # the inputs jump here: integrate nothing across it
             y = self.integrator.advance_to(t_end)
         except ModelError as error:
             raise SolverError(str(error)) from error
-        outputs = self._outputs_at(y)
+        outputs = self._outputs_at(y, self._hold.at(t_end) if self.driven else None)
         if not self.integrator.method.adaptive:  # adaptive methods reject non-finite or inaccurate steps
             self._check_bounded(y, outputs, t_end)
         self.time = t_end
+        self._y = list(y)
         self.outputs = outputs
 
     # ------------------------------------------------------------------ FMU state
-    STATE_VERSION = 1
+    STATE_VERSION = 2
 
     def get_state(self) -> dict[str, Any]:
         """Return the complete state (parameters, time, integrator) as JSON-serialisable data.
@@ -214,6 +313,10 @@ class DoublePendulumCoSimulation:
             "initial_energy": self.initial_energy,
             "outputs": dict(self.outputs),
             "integrator": self.integrator.get_state() if self.integrator is not None else None,
+            "inputs": dict(self.inputs),
+            "driven": self.driven,
+            "hold": [self._hold.t0, list(self._hold.values)] if self._hold is not None else None,
+            "y": list(self._y),
         }
 
     def set_state(self, state: dict[str, Any]) -> None:
@@ -227,23 +330,30 @@ class DoublePendulumCoSimulation:
         self.initialised = False
         self.integrator = None
         self.time = float(state["time"])
+        self.inputs = {name: float(state["inputs"][name]) for name in INPUT_NAMES}
+        self.driven = bool(state["driven"])
         if state["initialised"]:
             self.initialise()  # rebuilds model and integrator from the restored parameters
+            hold = state["hold"]
+            if hold is not None:
+                self._hold = InputHold(float(hold[0]), InputValues(*hold[1]))
+                self.integrator.f = build_vector_field(self.model.config, self.model.evaluate, self._hold)
             self.integrator.set_state(state["integrator"])
             self.time = float(state["time"])
+            self._y = list(state["y"])
         self.initial_energy = state["initial_energy"]
         self.outputs = LazyOutputs(None, None, None, {}, values=state["outputs"])
 
     def _check_bounded(self, y: list[float], outputs: Mapping[str, float], t_end: float) -> None:
         """Raise :class:`SolverError` if the motion has blown up numerically.
 
-        The model has no inputs, so its energy can never rise above the start energy. An energy
-        beyond ``ENERGY_BLOWUP_FACTOR`` times the start energy plus the energy scale
-        ``(m1 + m2) g (l1 + l2)``, or a non-finite state, can only come from an unstable
-        integration (e.g. explicit Euler with too large a step); it is reported instead of
-        returning meaningless numbers.
+        Without inputs the energy can never rise above the start energy, and with inputs
+        ``E_total - W_input`` cannot. A value beyond ``ENERGY_BLOWUP_FACTOR`` times the start
+        energy plus the energy scale ``(m1 + m2) g (l1 + l2)``, or a non-finite state, can only
+        come from an unstable integration (e.g. explicit Euler with too large a step); it is
+        reported instead of returning meaningless numbers.
         """
-        energy = outputs["E_total"]
+        energy = outputs["E_total"] - outputs["W_input"]
         p = self.model.config.pendulum
         e0 = self.initial_energy or 0.0
         limit = ENERGY_BLOWUP_FACTOR * (abs(e0) + (p.m1 + p.m2) * p.g * (p.l1 + p.l2))
@@ -254,16 +364,17 @@ class DoublePendulumCoSimulation:
                 "use an adaptive solver)"
             )
 
-    def _outputs_at(self, y: list[float]) -> LazyOutputs:
+    def _outputs_at(self, y: list[float], inputs: InputValues | None = None) -> LazyOutputs:
         it = self.integrator
         stats = {
             "solver_steps": float(it.n_steps) if it is not None else 0.0,
             "solver_rhs_evaluations": float(it.nfev) if it is not None else 0.0,
         }
-        return LazyOutputs(self.model, list(y), self.initial_energy, stats)
+        return LazyOutputs(self.model, list(y), self.initial_energy, stats, inputs=inputs)
 
     def _update_outputs(self, y: list[float]) -> None:
-        self.outputs = self._outputs_at(y)
+        """Outputs at the current point with the inputs as set now."""
+        self.outputs = self._outputs_at(y, self._input_values() if self.driven else None)
 
 
 __all__ = [

@@ -1,22 +1,28 @@
-"""The FMU's variables, derived from the parameter dataclasses and the output table.
+"""The FMUs' variables, derived from the parameter dataclasses and the input and output tables.
 
-Both the pythonfmu adapter (which registers them) and the build step (which adds FMI unit
-definitions to the modelDescription) read this one list, so names, units, descriptions and
-start values cannot drift apart.
+Both the pythonfmu adapters (which register them) and the build step (which adds FMI unit
+definitions and output dependencies to the modelDescription) read these lists, so names, units,
+descriptions and start values cannot drift apart. :data:`INTERFACES` holds one
+:class:`FmuInterface` per model identifier: ``DoublePendulum`` and ``Suspension``.
 """
 
 from __future__ import annotations
 
-from dataclasses import fields
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import Field, fields
 from typing import Any, NamedTuple
 
-from ..model.outputs import OUTPUTS
+from ..model import suspension
+from ..model.inputs import INPUTS
+from ..model.outputs import INPUT_DEPENDENCIES, OUTPUTS, Quantity
 from .cosimulation import PARAMETER_GROUPS
+from .suspension import INPUT_START, PARAMETER_FIELDS
 
 MODEL_IDENTIFIER = "DoublePendulum"
 MODEL_DESCRIPTION = (
-    "Planar double pendulum (point masses on massless rods, fixed pivot), equations of motion "
-    "from the Lagrangian; FMI 2.0 co-simulation with an integrator that persists across doStep."
+    "Planar double pendulum (point masses on massless rods; fixed, moving or suspended pivot), "
+    "equations of motion from the Lagrangian; inputs: pivot motion and joint torques; FMI 2.0 "
+    "co-simulation with an integrator that persists across doStep."
 )
 DEFAULT_EXPERIMENT = {"start_time": 0.0, "stop_time": 10.0, "step_size": 0.01}
 
@@ -26,10 +32,10 @@ class FmuVariable(NamedTuple):
 
     name: str
     fmi_type: str  # "Real", "Boolean" or "String"
-    causality: str  # "parameter" or "output"
+    causality: str  # "parameter", "input" or "output"
     unit: str  # FMI unit string, "" for none
     description: str
-    start: Any  # start value for parameters, None for outputs
+    start: Any  # start value for parameters and inputs, None for outputs
 
 
 def _fmi_type(rule: str) -> str:
@@ -41,8 +47,13 @@ def described(description: str, unit: str) -> str:
     return f"{description} [{unit}]" if unit else description
 
 
-def fmu_variables() -> list[FmuVariable]:
-    """Return all FMU variables: parameters (in dataclass order), then outputs."""
+def _variables(
+    parameters: Iterable[Field],
+    inputs: Iterable[Quantity],
+    input_start: Mapping[str, float],
+    outputs: Iterable[Quantity],
+) -> list[FmuVariable]:
+    """Parameters (dataclass fields, in order), inputs, then outputs as FMU variables."""
     variables = [
         FmuVariable(
             f.name,
@@ -52,10 +63,48 @@ def fmu_variables() -> list[FmuVariable]:
             described(f.metadata["description"], f.metadata["unit"]),
             f.default,
         )
-        for group in PARAMETER_GROUPS
-        for f in fields(group)
+        for f in parameters
     ]
     variables += [
-        FmuVariable(q.name, "Real", "output", q.unit, described(q.description, q.unit), None) for q in OUTPUTS
+        FmuVariable(q.name, "Real", "input", q.unit, described(q.description, q.unit), input_start.get(q.name, 0.0))
+        for q in inputs
+    ]
+    variables += [
+        FmuVariable(q.name, "Real", "output", q.unit, described(q.description, q.unit), None) for q in outputs
     ]
     return variables
+
+
+def fmu_variables() -> list[FmuVariable]:
+    """Return all DoublePendulum variables: parameters (in dataclass order), inputs, then outputs."""
+    return _variables((f for group in PARAMETER_GROUPS for f in fields(group)), INPUTS, {}, OUTPUTS)
+
+
+def suspension_fmu_variables() -> list[FmuVariable]:
+    """Return all Suspension variables (:mod:`double_pendulum.model.suspension`)."""
+    return _variables(PARAMETER_FIELDS, suspension.INPUTS, INPUT_START, suspension.OUTPUTS)
+
+
+class FmuInterface(NamedTuple):
+    """What the build and an adapter need to know about one FMU."""
+
+    model_identifier: str
+    description: str
+    variables: Callable[[], list[FmuVariable]]
+    output_dependencies: Mapping[str, tuple[str, ...]]  # output -> inputs it depends on directly
+    default_experiment: Mapping[str, float]
+
+
+INTERFACES: dict[str, FmuInterface] = {
+    MODEL_IDENTIFIER: FmuInterface(
+        MODEL_IDENTIFIER, MODEL_DESCRIPTION, fmu_variables, INPUT_DEPENDENCIES, DEFAULT_EXPERIMENT
+    ),
+    "Suspension": FmuInterface(
+        "Suspension",
+        "Suspension mass on springs and dampers to the ground, loaded by a force (inputs F_x, F_y); "
+        "couples to DoublePendulum (F_pivot -> F, motion -> pivot_*) to give the pendulum on a suspension.",
+        suspension_fmu_variables,
+        suspension.INPUT_DEPENDENCIES,
+        {"start_time": 0.0, "stop_time": 1.0, "step_size": 1e-3},
+    ),
+}

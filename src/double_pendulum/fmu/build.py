@@ -1,15 +1,21 @@
-"""Build ``DoublePendulum.fmu`` with pythonfmu and complete its modelDescription.
+"""Build the project's FMUs with pythonfmu and complete their modelDescription.
 
-pythonfmu writes the FMU from the adapter ``fmu_src/DoublePendulum.py``; the package's runtime
+Each FMU of :data:`double_pendulum.component.variables.INTERFACES` (``DoublePendulum``,
+``Suspension``) is built from its adapter ``fmu_src/<model identifier>.py``, which maps FMI calls
+onto a component through the shared ``fmu_src/double_pendulum_slave.py``; the package's runtime
 (``__init__``, :mod:`~double_pendulum.model`, :mod:`~double_pendulum.solvers`,
 :mod:`~double_pendulum.component`) is bundled into the FMU's ``resources/`` so the FMU runs
 without the project installed, and nothing else is (no analysis, plots or CLI). pythonfmu's
 modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the build then
 
 * adds ``UnitDefinitions`` (SI base-unit exponents) and a ``unit`` attribute on every physical
-  Real variable, from :func:`double_pendulum.component.variables.fmu_variables`;
+  Real variable, from the interface's variables (e.g.
+  :func:`double_pendulum.component.variables.fmu_variables`);
 * lists every output under ``ModelStructure/InitialUnknowns`` (they are computed at
   initialisation), so ``fmpy.validation.validate_fmu`` reports no problems;
+* states each output's direct dependencies on the inputs under ``ModelStructure/Outputs``
+  (the interface's ``output_dependencies``; ``dependencies=""`` for none),
+  which pythonfmu leaves open (open means: depends on every input);
 * writes ``resources/requirements.txt`` with what the FMU needs at run time.
 """
 
@@ -22,12 +28,13 @@ import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
-from ..component.variables import MODEL_IDENTIFIER, fmu_variables
+from ..component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
 RUNTIME_SUBPACKAGES = ("model", "solvers", "component")
 DEFAULT_FMU_PATH = Path("build") / f"{MODEL_IDENTIFIER}.fmu"
+SHARED_ADAPTER = "double_pendulum_slave.py"  # the FMI-to-component mapping every adapter uses
 
 # SI base-unit exponents of every unit the interface uses (FMI 2.0 section 2.2.2).
 UNIT_EXPONENTS: dict[str, dict[str, int]] = {
@@ -55,15 +62,24 @@ UNIT_EXPONENTS: dict[str, dict[str, int]] = {
 RUNTIME_REQUIREMENTS = ["pythonfmu>=0.6.5"]
 
 
-def adapter_script() -> Path:
-    """Return the path of the pythonfmu adapter ``DoublePendulum.py``.
-
-    It lives in the repository's ``fmu_src/``, installed as ``double_pendulum.adapters``.
-    """
+def _adapters_dir() -> Path:
     spec = importlib.util.find_spec("double_pendulum.adapters")
     if spec is None or not spec.submodule_search_locations:
         raise FileNotFoundError("cannot find double_pendulum.adapters: is double-pendulum-fmu installed?")
-    return Path(next(iter(spec.submodule_search_locations))) / f"{MODEL_IDENTIFIER}.py"
+    return Path(next(iter(spec.submodule_search_locations)))
+
+
+def adapter_script(model_identifier: str = MODEL_IDENTIFIER) -> Path:
+    """Return the path of the pythonfmu adapter ``<model_identifier>.py``.
+
+    It lives in the repository's ``fmu_src/``, installed as ``double_pendulum.adapters``.
+    """
+    return _adapters_dir() / f"{model_identifier}.py"
+
+
+def shared_adapter() -> Path:
+    """Return the path of the slave class all adapters share (bundled into every FMU)."""
+    return _adapters_dir() / SHARED_ADAPTER
 
 
 def runtime_sources() -> list[Path]:
@@ -84,10 +100,11 @@ def _copy_runtime(dest: Path) -> Path:
     return target
 
 
-def complete_model_description(xml_text: bytes) -> bytes:
-    """Add unit definitions, unit attributes and InitialUnknowns to a pythonfmu modelDescription."""
+def complete_model_description(xml_text: bytes, model_identifier: str = MODEL_IDENTIFIER) -> bytes:
+    """Add units, output dependencies and InitialUnknowns to a pythonfmu modelDescription."""
+    interface = INTERFACES[model_identifier]
     root = ET.fromstring(xml_text)
-    units = {v.name: v.unit for v in fmu_variables() if v.fmi_type == "Real" and v.unit not in ("", "1")}
+    units = {v.name: v.unit for v in interface.variables() if v.fmi_type == "Real" and v.unit not in ("", "1")}
     used = sorted(set(units.values()))
     unknown = [u for u in used if u not in UNIT_EXPONENTS]
     if unknown:
@@ -101,14 +118,17 @@ def complete_model_description(xml_text: bytes) -> bytes:
     root.insert(position, unit_defs)
 
     outputs_index = []
+    index_of: dict[str, int] = {}
     for index, sv in enumerate(root.find("ModelVariables"), start=1):
         real = sv.find("Real")
+        index_of[sv.get("name")] = index
         if real is not None and sv.get("name") in units:
             real.set("unit", units[sv.get("name")])
         if sv.get("causality") == "output":
             outputs_index.append(index)
 
     structure = root.find("ModelStructure")
+    _set_output_dependencies(structure, index_of, interface)
     for old in structure.findall("InitialUnknowns"):
         structure.remove(old)
     initial = ET.SubElement(structure, "InitialUnknowns")
@@ -116,6 +136,16 @@ def complete_model_description(xml_text: bytes) -> bytes:
         ET.SubElement(initial, "Unknown", index=str(index))
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+def _set_output_dependencies(structure: ET.Element, index_of: dict[str, int], interface: FmuInterface) -> None:
+    """Give every ``Outputs/Unknown`` its direct dependencies on the inputs (indices, ascending)."""
+    name_of = {index: name for name, index in index_of.items()}
+    outputs = structure.find("Outputs")
+    for unknown in outputs if outputs is not None else ():
+        name = name_of[int(unknown.get("index"))]
+        deps = sorted(index_of[n] for n in interface.output_dependencies.get(name, ()))
+        unknown.set("dependencies", " ".join(map(str, deps)))
 
 
 def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
@@ -138,7 +168,7 @@ def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
         return cached, cfile.read_bytes()
 
 
-def _rewrite_fmu(fmu: Path) -> None:
+def _rewrite_fmu(fmu: Path, model_identifier: str) -> None:
     """Rewrite the zip with the completed modelDescription, bytecode and requirements.txt.
 
     Precompiled bytecode spares every fresh extraction (fmpy extracts the FMU anew for each
@@ -149,7 +179,7 @@ def _rewrite_fmu(fmu: Path) -> None:
         for item in src.infolist():
             data = src.read(item.filename)
             if item.filename == "modelDescription.xml":
-                data = complete_model_description(data)
+                data = complete_model_description(data, model_identifier)
             dst.writestr(item, data, compress_type=zipfile.ZIP_DEFLATED)
             if item.filename.startswith("resources/") and item.filename.endswith(".py"):
                 cached, code = compiled_bytecode(data, item.filename)
@@ -158,37 +188,47 @@ def _rewrite_fmu(fmu: Path) -> None:
     tmp.replace(fmu)
 
 
-def build_fmu(dest: str | Path = DEFAULT_FMU_PATH) -> Path:
-    """Build the FMU at ``dest`` (a ``.fmu`` path or a folder) and return its path.
+def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL_IDENTIFIER) -> Path:
+    """Build the FMU ``model_identifier`` at ``dest`` (a ``.fmu`` path or a folder) and return its path.
 
     The FMU is first written to a temporary folder and moved into place at the end, so a failed
     build never leaves a broken FMU behind.
     """
     from pythonfmu.builder import FmuBuilder
 
+    if model_identifier not in INTERFACES:
+        raise ValueError(f"unknown model identifier {model_identifier!r}; known: {', '.join(INTERFACES)}")
     dest = Path(dest)
-    fmu_path = dest if dest.suffix == ".fmu" else dest / f"{MODEL_IDENTIFIER}.fmu"
+    fmu_path = dest if dest.suffix == ".fmu" else dest / f"{model_identifier}.fmu"
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="dp_fmu_build_") as tmp:
         tmp_dir = Path(tmp)
         package_copy = _copy_runtime(tmp_dir)
         built = FmuBuilder.build_FMU(
-            adapter_script(),
-            dest=tmp_dir / f"{MODEL_IDENTIFIER}.fmu",
-            project_files=[package_copy],
+            adapter_script(model_identifier),
+            dest=tmp_dir / f"{model_identifier}.fmu",
+            project_files=[package_copy, shared_adapter()],
             canGetAndSetFMUstate=True,
             canSerializeFMUstate=True,
         )
-        _rewrite_fmu(Path(built))
+        _rewrite_fmu(Path(built), model_identifier)
         shutil.move(str(built), fmu_path)
     return fmu_path
 
 
-def fmu_is_current(fmu_path: str | Path) -> bool:
+def build_all(dest: str | Path = DEFAULT_FMU_PATH) -> list[Path]:
+    """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it."""
+    dest = Path(dest)
+    first = build_fmu(dest, MODEL_IDENTIFIER)
+    others = [build_fmu(first.parent / f"{name}.fmu", name) for name in INTERFACES if name != MODEL_IDENTIFIER]
+    return [first, *others]
+
+
+def fmu_is_current(fmu_path: str | Path, model_identifier: str = MODEL_IDENTIFIER) -> bool:
     """True if ``fmu_path`` exists and is newer than every source file it is built from."""
     fmu_path = Path(fmu_path)
     if not fmu_path.is_file():
         return False
     built = fmu_path.stat().st_mtime
-    sources = [adapter_script(), *runtime_sources()]
+    sources = [adapter_script(model_identifier), shared_adapter(), *runtime_sources()]
     return all(src.stat().st_mtime <= built for src in sources)

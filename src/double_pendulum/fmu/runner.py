@@ -78,11 +78,19 @@ class FmuRunner:
         """Run the FMU and return fmpy's structured result array (``time`` plus ``outputs``).
 
         ``output_interval`` [s] is also the communication step size. Extra keyword arguments go
-        to :func:`fmpy.simulate_fmu`.
+        to :func:`fmpy.simulate_fmu` (e.g. ``input=`` a structured array of input signals). A
+        failing call raises :class:`FmuRunError` with the rows recorded before it.
         """
         from fmpy import simulate_fmu
 
         messages: list[str] = []
+        recorders: list[Any] = []
+        user_step_finished = fmpy_options.pop("step_finished", None)
+
+        def step_finished(time: float, recorder: Any) -> bool:
+            if not recorders:
+                recorders.append(recorder)
+            return True if user_step_finished is None else user_step_finished(time, recorder)
 
         def logger(_env: Any, _instance: Any, status: int, _category: Any, message: bytes) -> None:
             if status >= 2:  # discard, error, fatal
@@ -103,10 +111,12 @@ class FmuRunner:
                     output=list(outputs),
                     debug_logging=True,
                     logger=logger,
+                    step_finished=step_finished,
                     **fmpy_options,
                 )
         except Exception as error:
-            raise FmuRunError(f"{error} -- FMU says: {_summarise(messages)}") from error
+            partial = recorders[0].result() if recorders else None
+            raise FmuRunError(f"{error} -- FMU says: {_summarise(messages)}", partial_result=partial) from error
         # fmpy ends a run quietly when doStep returns fmi2Discard: turn that into an error.
         end = float(result["time"][-1]) if len(result) else start_time
         if end < stop_time and not np.isclose(end, stop_time, rtol=1e-12, atol=1e-12):

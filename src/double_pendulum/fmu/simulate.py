@@ -38,6 +38,21 @@ def communication_points(
         n += 1
 
 
+def apply_inputs(sim: DoublePendulumCoSimulation, signals: np.ndarray | None, time: float) -> None:
+    """Set the inputs in ``signals`` at ``time`` [s], as fmpy's ``simulate_fmu(input=...)`` does.
+
+    ``signals`` is a structured array: ``time`` first, then a column per input; each value is
+    interpolated linearly in time (held before the first and after the last row; exact at the
+    rows). Input events (repeated time rows) are not supported here.
+    """
+    if signals is None:
+        return
+    names = signals.dtype.names
+    t = signals[names[0]]
+    for name in names[1:]:
+        sim.set_input(name, float(np.interp(time, t, signals[name])))
+
+
 def simulate(
     start_values: Mapping[str, Any] | None = None,
     *,
@@ -45,14 +60,21 @@ def simulate(
     output_interval: float = 0.01,
     start_time: float = 0.0,
     outputs: Sequence[str] = OUTPUT_NAMES,
+    input: np.ndarray | None = None,  # noqa: A002 - fmpy's name
 ) -> np.ndarray:
-    """Simulate in-process and return a structured array with ``time`` and ``outputs``."""
+    """Simulate in-process and return a structured array with ``time`` and ``outputs``.
+
+    ``input``: input signals as for :func:`fmpy.simulate_fmu` (see :func:`apply_inputs`), set
+    before initialisation and before each step at its start time.
+    """
     sim = DoublePendulumCoSimulation(start_time)
     for name, value in (start_values or {}).items():
         sim.set(name, value)
+    apply_inputs(sim, input, start_time)
     sim.initialise()
     rows = [(sim.time, *(sim.outputs[n] for n in outputs))]
     for current, step in communication_points(start_time, stop_time, output_interval):
+        apply_inputs(sim, input, current)
         sim.do_step(current, step)
         rows.append((sim.time, *(sim.outputs[n] for n in outputs)))
     dtype = [("time", np.float64)] + [(n, np.float64) for n in outputs]

@@ -3,5 +3,7 @@
 :mod:`.parameters` (units, defaults, checks), :mod:`.kinematics` (positions, velocities),
 :mod:`.dynamics` (Lagrange equations of the fixed-pivot pendulum), :mod:`.forces` (air drag,
 bearing friction), :mod:`.energy`, :mod:`.vector_field` (a scene's assembled vector field with
-friction and suspension) and :mod:`.outputs` (the quantities reported at each communication point).
+friction, suspension and inputs), :mod:`.inputs` (pivot motion and joint torques, their hold over a
+communication step), :mod:`.outputs` (the quantities reported at each communication point) and
+:mod:`.suspension` (the suspension on its own, the ``Suspension`` FMU's model).
 """

@@ -5,16 +5,23 @@ result, in-process or through fmpy. Quantities of a mechanism that is switched o
 
 Energy bookkeeping: ``E_total = E_pendulum + E_suspension`` is conserved without dissipation;
 each mechanism's dissipated work ``W_*`` is integrated as a state, so
-``energy_residual = E_total(t) + W_air + W_bearing + W_suspension - E_total(0)`` measures only
-the integration error.
+``energy_residual = E_total(t) + W_air + W_bearing + W_suspension - W_input - E_total(0)`` measures
+only the integration error, ``W_input`` being the work fed in through the inputs
+(:mod:`double_pendulum.model.inputs`).
+
+Every output group takes the inputs ``u`` at the output's instant (``None`` without inputs):
+the pivot's motion and the pivot force depend on them directly (see :data:`INPUT_DEPENDENCIES`).
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 from .kinematics import positions
 from .vector_field import Model
+
+if TYPE_CHECKING:
+    from .inputs import InputValues
 
 
 class Quantity(NamedTuple):
@@ -46,10 +53,13 @@ OUTPUTS: tuple[Quantity, ...] = (
     Quantity("W_air", "J", "work dissipated by air drag since the start"),
     Quantity("W_bearing", "J", "work dissipated by bearing friction since the start"),
     Quantity("W_suspension", "J", "work dissipated in the suspension dampers since the start"),
-    Quantity("P_to_suspension", "W", "power flowing from the pendulum into the suspension through the pivot"),
+    Quantity(
+        "P_to_suspension", "W", "power flowing from the pendulum through the pivot into the suspension (or the driver)"
+    ),
     Quantity("F_pivot_x", "N", "horizontal force of the pendulum on its pivot"),
     Quantity("F_pivot_y", "N", "vertical force of the pendulum on its pivot (-(m1+m2) g at rest)"),
-    Quantity("energy_residual", "J", "E_total(t) + W_air + W_bearing + W_suspension - E_total(0)"),
+    Quantity("energy_residual", "J", "E_total(t) + W_air + W_bearing + W_suspension - W_input - E_total(0)"),
+    Quantity("W_input", "J", "work fed in through the inputs (pivot motion, joint torques) since the start"),
 )
 
 # Integrator statistics, for work-precision studies (counts since the start).
@@ -64,20 +74,27 @@ OUTPUT_NAMES: tuple[str, ...] = tuple(q.name for q in OUTPUTS)
 WORK_NAMES: tuple[str, ...] = ("W_air", "W_bearing", "W_suspension")
 
 
-def _pivot(model: Model, y: list[float]) -> tuple[float, float, float, float]:
-    """``(xs, ys, vxs, vys)`` of state ``y`` (zeros for a fixed pivot)."""
+def _pivot(model: Model, y: list[float], u: InputValues | None = None) -> tuple[float, float, float, float]:
+    """``(xs, ys, vxs, vys)`` of the pivot: state ``y``, or the inputs ``u`` where it is prescribed."""
     layout = model.layout
     ix, iy = layout.index("xs"), layout.index("ys")
     xs, vxs = (y[ix], y[ix + 1]) if ix is not None else (0.0, 0.0)
     ys, vys = (y[iy], y[iy + 1]) if iy is not None else (0.0, 0.0)
+    if u is not None:
+        if ix is None:
+            xs, vxs = u.pivot_x, u.pivot_vx
+        if iy is None:
+            ys, vys = u.pivot_y, u.pivot_vy
     return xs, ys, vxs, vys
 
 
-def kinematic_outputs(model: Model, y: list[float], initial_energy: float | None = None) -> dict[str, float]:
+def kinematic_outputs(
+    model: Model, y: list[float], initial_energy: float | None = None, u: InputValues | None = None
+) -> dict[str, float]:
     """Angles, rates, bob positions and the pivot's motion (cheap: no energies, no forces)."""
     p = model.config.pendulum
     phi1, phi2 = y[0], y[1]
-    xs, ys, vxs, vys = _pivot(model, y)
+    xs, ys, vxs, vys = _pivot(model, y, u)
     x1, y1, x2, y2 = positions(phi1, phi2, p.l1, p.l2)
     return {
         "phi1": phi1, "phi2": phi2, "omega1": y[2], "omega2": y[3],
@@ -86,30 +103,35 @@ def kinematic_outputs(model: Model, y: list[float], initial_energy: float | None
     }  # fmt: skip
 
 
-def energy_outputs(model: Model, y: list[float], initial_energy: float | None = None) -> dict[str, float]:
-    """Energies, dissipated works and the energy residual [J].
+def energy_outputs(
+    model: Model, y: list[float], initial_energy: float | None = None, u: InputValues | None = None
+) -> dict[str, float]:
+    """Energies, dissipated works, the work of the inputs and the energy residual [J].
 
     ``initial_energy`` is E_total at the start; ``None`` means this state is the start.
     """
     from .vector_field import energies
 
-    e_kin, e_pot, e_sus = energies(model.config, y, model.layout)
+    e_kin, e_pot, e_sus = energies(model.config, y, model.layout, u)
     e_pend = e_kin + e_pot
     e_total = e_pend + e_sus
     layout = model.layout
     work = {n: (y[i] if (i := layout.index(n)) is not None else 0.0) for n in WORK_NAMES}
     e0 = e_total if initial_energy is None else initial_energy
+    w_input = y[i] if (i := layout.index("W_input")) is not None else 0.0
     return {
         "E_kin": e_kin, "E_pot": e_pot, "E_total": e_total, "E_pendulum": e_pend, "E_suspension": e_sus,
-        **work, "energy_residual": e_total + sum(work.values()) - e0,
+        **work, "energy_residual": e_total + sum(work.values()) - w_input - e0, "W_input": w_input,
     }  # fmt: skip
 
 
-def force_outputs(model: Model, y: list[float], initial_energy: float | None = None) -> dict[str, float]:
+def force_outputs(
+    model: Model, y: list[float], initial_energy: float | None = None, u: InputValues | None = None
+) -> dict[str, float]:
     """Pivot force [N] and the power into the suspension [W] (needs the accelerations)."""
     p = model.config.pendulum
-    _, _, vxs, vys = _pivot(model, y)
-    ev = model.evaluate(y)
+    _, _, vxs, vys = _pivot(model, y, u)
+    ev = model.evaluate(y) if u is None else model.evaluate(y, u)
     # power into the suspension: the pivot force about its static value (the preload carries the weight)
     p_susp = ev.f_pivot_x * vxs + (ev.f_pivot_y + (p.m1 + p.m2) * p.g) * vys
     return {"P_to_suspension": p_susp, "F_pivot_x": ev.f_pivot_x, "F_pivot_y": ev.f_pivot_y}
@@ -121,9 +143,29 @@ GROUP_OF: dict[str, int] = {
     for k, names in enumerate(
         (
             ("phi1", "phi2", "omega1", "omega2", "x1", "y1", "x2", "y2", "xs", "ys", "vxs", "vys"),
-            ("E_kin", "E_pot", "E_total", "E_pendulum", "E_suspension", *WORK_NAMES, "energy_residual"),
+            ("E_kin", "E_pot", "E_total", "E_pendulum", "E_suspension", *WORK_NAMES, "energy_residual", "W_input"),
             ("P_to_suspension", "F_pivot_x", "F_pivot_y"),
         )
     )
     for name in names
+}
+
+# Direct dependence of each output on the inputs at the same instant (FMI ModelStructure/Outputs):
+# the pivot's motion and the bob positions on the pivot position or velocity, the energies too
+# (kinetic energy with the pivot velocity, spring stretch relative to the base), the pivot force on
+# every input (the acceleration and torques drive the angular accelerations it contains, drag and
+# spring forces use the position and velocity): direct feedthrough. Angles, rates, E_pot and the
+# integrated works are states or functions of the states only: no direct dependence.
+_MOTION = ("pivot_x", "pivot_y", "pivot_vx", "pivot_vy")
+INPUT_DEPENDENCIES: dict[str, tuple[str, ...]] = {
+    **{name: () for name in OUTPUT_NAMES},
+    **{name: ("pivot_x",) for name in ("x1", "x2", "xs")},
+    **{name: ("pivot_y",) for name in ("y1", "y2", "ys")},
+    "vxs": ("pivot_vx",),
+    "vys": ("pivot_vy",),
+    "E_kin": ("pivot_vx", "pivot_vy"),
+    "E_suspension": ("pivot_x", "pivot_y"),
+    **{name: _MOTION for name in ("E_total", "E_pendulum", "energy_residual")},
+    **{name: (*_MOTION, "pivot_ax", "pivot_ay", "tau1", "tau2") for name in ("F_pivot_x", "F_pivot_y")},
+    "P_to_suspension": (*_MOTION, "pivot_ax", "pivot_ay", "tau1", "tau2"),
 }

@@ -169,3 +169,19 @@ def field_specs(cls: type) -> list[tuple[str, Any, str, str, str]]:
         (f.name, f.default, f.metadata["unit"], f.metadata["description"], f.metadata["rule"])
         for f in fields(cls)
     ]
+
+
+@dataclass(frozen=True)
+class SuspensionLoad(Validated):
+    """The static load of the stand-alone ``Suspension`` FMU (see :mod:`double_pendulum.model.suspension`).
+
+    Its coordinates are displacements from the static equilibrium under this load, so a load
+    equal to it leaves the mass at rest. The default is the weight of the default pendulum
+    hanging at rest, the force it exerts on its pivot: -(m1 + m2) g.
+    """
+
+    F_static_y: float = spec(
+        -(PendulumParameters.m1 + PendulumParameters.m2) * PendulumParameters.g,
+        "N",
+        "static vertical load on the suspension mass (default: -(m1 + m2) g of the default pendulum)",
+    )

@@ -32,6 +32,21 @@ are eliminated (Schur complement) and the remaining 2x2 system solved in closed 
 Bearing friction torques depend on the joint reaction forces, which depend on the accelerations:
 the coupled system is solved by fixed-point iteration (the map contracts by about
 :math:`c_R r_b / l`, ~1e-5 here, so two or three iterations reach rounding level).
+
+Inputs (:mod:`double_pendulum.model.inputs`, only with ``ModelConfig.inputs``; the evaluator then
+takes the inputs ``u`` at the evaluated instant): in a direction without a suspension state the
+pivot moves as prescribed, which adds the fictitious forces of its acceleration
+:math:`(a_x, a_y)` to the angle equations,
+
+.. math::
+
+    b_1 \mathrel{-}= A_{1x} a_x + A_{1y} a_y,\qquad b_2 \mathrel{-}= A_{2x} a_x + A_{2y} a_y
+
+(a constant upward :math:`a_y` acts as gravity :math:`g + a_y`), and uses its velocity in the bob
+velocities; in a suspended direction the input is the base, and the pivot row reads
+:math:`\dots - k_x (x_s - x_b) - c_x (\dot x_s - v_{b,x}) + Q_x`. The joint torques add
+:math:`Q_1 \mathrel{+}= \tau_1 - \tau_2`, :math:`Q_2 \mathrel{+}= \tau_2`. The state ``W_input`` [J]
+integrates the power the inputs feed in (see :mod:`double_pendulum.model.inputs`).
 """
 
 from __future__ import annotations
@@ -39,12 +54,15 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 from .dynamics import fixed_pivot_vector_field
 from .energy import kinetic_energy_moving_pivot, potential_energy, suspension_energy
 from .forces import bearing_torque, quadratic_drag, rod_drag_integrals
 from .parameters import AirDragParameters, BearingParameters, PendulumParameters, SuspensionParameters
+
+if TYPE_CHECKING:
+    from .inputs import InputHold, InputValues
 
 MAX_FRICTION_ITERATIONS = 50
 
@@ -61,6 +79,7 @@ class ModelConfig:
     air: AirDragParameters = field(default_factory=AirDragParameters)
     bearing: BearingParameters = field(default_factory=BearingParameters)
     suspension: SuspensionParameters = field(default_factory=SuspensionParameters)
+    inputs: bool = False  # pivot motion and joint torques enter as inputs (adds the W_input state)
 
 
 @dataclass(frozen=True)
@@ -92,6 +111,8 @@ def state_layout(config: ModelConfig) -> StateLayout:
         names.append("W_bearing")
     if s.suspension:
         names.append("W_suspension")
+    if config.inputs:
+        names.append("W_input")
     return StateLayout(tuple(names))
 
 
@@ -108,15 +129,22 @@ class Evaluation(NamedTuple):
     p_air: float  # W
     p_bearing: float  # W
     p_suspension: float  # W, dissipated in the suspension dampers
+    p_input: float = 0.0  # W, power fed in through the inputs
 
 
 def is_core(config: ModelConfig) -> bool:
     """True if every mechanism is off: the scene is the frictionless fixed-pivot pendulum."""
-    return not (config.air.air_drag or config.bearing.bearing_friction or config.suspension.suspension)
+    return not (
+        config.air.air_drag or config.bearing.bearing_friction or config.suspension.suspension or config.inputs
+    )
 
 
-def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
-    """Return ``evaluate(y) -> Evaluation`` with only the enabled terms (general path)."""
+def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
+    """Return ``evaluate(y, u=None) -> Evaluation`` with only the enabled terms (general path).
+
+    ``u`` (:class:`~double_pendulum.model.inputs.InputValues`) are the inputs at the evaluated
+    instant; ``None`` (no inputs) skips every input term.
+    """
     p, air, brg, sus = config.pendulum, config.air, config.bearing, config.suspension
     layout = state_layout(config)
     m1, m2, l1, l2, g = p.m1, p.m2, p.l1, p.l2, p.g
@@ -137,11 +165,23 @@ def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
     sin, cos, torque = math.sin, math.cos, bearing_torque
     torque_scale_p = brg.c_R1 * brg.r_b1 * m12 * g + 1e-300
     torque_scale_e = brg.c_R2 * brg.r_b2 * m2 * g + 1e-300
+    input_slot = layout.index("W_input")
 
-    def evaluate(y: list[float]) -> Evaluation:
+    def evaluate(y: list[float], u: InputValues | None = None) -> Evaluation:
         phi1, phi2, w1, w2 = y[0], y[1], y[2], y[3]
         xs, vxs = (y[ix], y[ix + 1]) if has_x else (0.0, 0.0)
         ys, vys = (y[iy], y[iy + 1]) if has_y else (0.0, 0.0)
+        apx = apy = 0.0  # prescribed pivot acceleration (directions without a suspension state)
+        xb = vxb = yb = vyb = 0.0  # motion of the suspension's base
+        if u is not None:
+            if has_x:
+                xb, vxb = u.pivot_x, u.pivot_vx
+            else:
+                vxs, apx = u.pivot_vx, u.pivot_ax
+            if has_y:
+                yb, vyb = u.pivot_y, u.pivot_vy
+            else:
+                vys, apy = u.pivot_vy, u.pivot_ay
         s1, c1, s2, c2 = sin(phi1), cos(phi1), sin(phi2), cos(phi2)
         sd, cd = sin(phi1 - phi2), cos(phi1 - phi2)
         # absolute bob velocities
@@ -180,18 +220,27 @@ def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
                 fext_y -= kappa2 * i0 * s2
                 p_air += kappa2 * i3
 
+        if u is not None:  # joint torques
+            q1 += u.tau1 - u.tau2
+            q2 += u.tau2
+
         # mass matrix and right-hand side of the angle equations
         a11 = m12 * l1 * l1
         a12 = m2 * l1 * l2 * cd
         a22 = m2 * l2 * l2
         b1 = -m2 * l1 * l2 * w2 * w2 * sd - m12 * g * l1 * s1 + q1
         b2 = m2 * l1 * l2 * w1 * w1 * sd - m2 * g * l2 * s2 + q2
+        if u is not None:  # fictitious forces of the prescribed pivot acceleration
+            b1 -= m12 * l1 * (c1 * apx + s1 * apy)
+            b2 -= m2 * l2 * (c2 * apx + s2 * apy)
         # eliminate the pivot coordinates (Schur complement)
         bx = by = 0.0
         ax1 = ax2 = ay1 = ay2 = 0.0
         if has_x:
             ax1, ax2 = m12 * l1 * c1, m2 * l2 * c2
             bx = m12 * l1 * s1 * w1 * w1 + m2 * l2 * s2 * w2 * w2 - k_x * xs - c_x * vxs + qx
+            if u is not None:  # the spring and damper act relative to the moving base
+                bx += k_x * xb + c_x * vxb
             a11 -= ax1 * ax1 / m_t
             a12 -= ax1 * ax2 / m_t
             a22 -= ax2 * ax2 / m_t
@@ -200,6 +249,8 @@ def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
         if has_y:
             ay1, ay2 = m12 * l1 * s1, m2 * l2 * s2
             by = -m12 * l1 * c1 * w1 * w1 - m2 * l2 * c2 * w2 * w2 - k_y * ys - c_y * vys + qy
+            if u is not None:
+                by += k_y * yb + c_y * vyb
             a11 -= ay1 * ay1 / m_t
             a12 -= ay1 * ay2 / m_t
             a22 -= ay2 * ay2 / m_t
@@ -213,8 +264,8 @@ def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
             e2 = b2 - tau_e
             alpha1 = (e1 * a22 - a12 * e2) / det
             alpha2 = (a11 * e2 - a12 * e1) / det
-            axs = (bx - ax1 * alpha1 - ax2 * alpha2) / m_t if has_x else 0.0
-            ays = (by - ay1 * alpha1 - ay2 * alpha2) / m_t if has_y else 0.0
+            axs = (bx - ax1 * alpha1 - ax2 * alpha2) / m_t if has_x else apx
+            ays = (by - ay1 * alpha1 - ay2 * alpha2) / m_t if has_y else apy
             # bob accelerations and the reaction forces the joints carry
             acc1x = axs + l1 * (c1 * alpha1 - s1 * w1 * w1)
             acc1y = ays + l1 * (s1 * alpha1 + c1 * w1 * w1)
@@ -246,6 +297,13 @@ def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
 
         p_bearing = tau_p * w1 + tau_e * (w2 - w1) if has_bearing else 0.0
         p_susp = c_x * vxs * vxs + c_y * vys * vys
+        p_input = 0.0
+        if u is not None:
+            p_susp, p_input = _input_powers(
+                (has_x, xs - xb, vxs, vxb, k_x, c_x, fp_x),
+                (has_y, ys - yb, vys, vyb, k_y, c_y, fp_y - m12 * g),
+                u.tau1 * w1 + u.tau2 * (w2 - w1),
+            )
         dydt = [0.0] * n
         dydt[0], dydt[1], dydt[2], dydt[3] = w1, w2, alpha1, alpha2
         if has_x:
@@ -255,21 +313,56 @@ def build_evaluator(config: ModelConfig) -> Callable[[list[float]], Evaluation]:
         for slot, power in zip(work_slots, (p_air, p_bearing, p_susp)):
             if slot is not None:
                 dydt[slot] = power
-        return Evaluation(dydt, alpha1, alpha2, axs, ays, -fp_x, -fp_y, p_air, p_bearing, p_susp)
+        if input_slot is not None:
+            dydt[input_slot] = p_input
+        return Evaluation(dydt, alpha1, alpha2, axs, ays, -fp_x, -fp_y, p_air, p_bearing, p_susp, p_input)
 
     return evaluate
 
 
+def _input_powers(
+    x: tuple[bool, float, float, float, float, float, float],
+    y: tuple[bool, float, float, float, float, float, float],
+    torque_power: float,
+) -> tuple[float, float]:
+    r"""Return ``(p_suspension, p_input)`` [W] with inputs.
+
+    Per direction ``(suspended, stretch [m], v_pivot [m/s], v_base [m/s], k, c, f_dyn [N])``:
+    suspended, the damper dissipates :math:`c(\dot x_s - v_b)^2` and the base feeds in
+    :math:`(-k\,\mathrm{stretch} - c(\dot x_s - v_b))\,v_b`; prescribed, the pivot feeds in the
+    dynamic part ``f_dyn`` of its force on the pendulum times its velocity.
+    """
+    p_susp, p_input = 0.0, torque_power
+    for suspended, stretch, v_pivot, v_base, k, c, f_dyn in (x, y):
+        if suspended:
+            dv = v_pivot - v_base
+            p_susp += c * dv * dv
+            p_input += (-k * stretch - c * dv) * v_base
+        else:
+            p_input += f_dyn * v_pivot
+    return p_susp, p_input
+
+
 def build_vector_field(
-    config: ModelConfig, evaluate: Callable[[list[float]], Evaluation] | None = None
+    config: ModelConfig,
+    evaluate: Callable[..., Evaluation] | None = None,
+    hold: InputHold | None = None,
 ) -> Callable[[float, list[float]], list[float]]:
     """Return ``f(t, y) -> dy/dt`` for the states of :func:`state_layout` (only enabled terms).
 
-    ``evaluate`` is the scene's evaluator if already built (see :func:`build_model`).
+    ``evaluate`` is the scene's evaluator if already built (see :func:`build_model`); ``hold``
+    (with ``config.inputs``) gives the inputs as functions of time over a communication step.
     """
     if is_core(config):
         return fixed_pivot_vector_field(config.pendulum)
     evaluate = evaluate or build_evaluator(config)
+    if hold is not None:
+        at = hold.at
+
+        def driven_vector_field(t: float, y: list[float]) -> list[float]:
+            return evaluate(y, at(t)).dydt
+
+        return driven_vector_field
 
     def vector_field(t: float, y: list[float]) -> list[float]:
         return evaluate(y).dydt
@@ -283,18 +376,27 @@ def initial_state(config: ModelConfig, phi1: float, phi2: float, omega1: float, 
     return y + [0.0] * (state_layout(config).size - 4)
 
 
-def energies(config: ModelConfig, y: list[float], layout: StateLayout | None = None) -> tuple[float, float, float]:
-    """Return ``(E_kin, E_pot, E_suspension)`` [J] of state ``y``.
+def energies(
+    config: ModelConfig, y: list[float], layout: StateLayout | None = None, u: InputValues | None = None
+) -> tuple[float, float, float]:
+    """Return ``(E_kin, E_pot, E_suspension)`` [J] of state ``y`` (inputs ``u`` at that instant).
 
     ``E_kin``: both bobs, absolute velocities; ``E_pot``: pendulum potential relative to the pivot,
-    zero hanging at rest; ``E_suspension``: see :func:`double_pendulum.model.energy.suspension_energy`.
+    zero hanging at rest; ``E_suspension``: see :func:`double_pendulum.model.energy.suspension_energy`,
+    with the springs stretched by the displacement relative to the base.
     """
     layout = layout or state_layout(config)
     ix, iy = layout.index("xs"), layout.index("ys")
     xs, vxs = (y[ix], y[ix + 1]) if ix is not None else (0.0, 0.0)
     ys, vys = (y[iy], y[iy + 1]) if iy is not None else (0.0, 0.0)
     p, s = config.pendulum, config.suspension
-    e_kin = kinetic_energy_moving_pivot(y[0], y[1], y[2], y[3], vxs, vys, p)
+    vpx, vpy = vxs, vys  # pivot velocity
+    if u is not None:
+        vpx = vxs if ix is not None else u.pivot_vx
+        vpy = vys if iy is not None else u.pivot_vy
+        xs = xs - u.pivot_x if ix is not None else 0.0
+        ys = ys - u.pivot_y if iy is not None else 0.0
+    e_kin = kinetic_energy_moving_pivot(y[0], y[1], y[2], y[3], vpx, vpy, p)
     e_pot = potential_energy(y[0], y[1], p)
     e_sus = suspension_energy(xs, ys, vxs, vys, s.M_s, s.k_x, s.k_y) if s.suspension else 0.0
     return e_kin, e_pot, e_sus
@@ -307,7 +409,7 @@ class Model:
     config: ModelConfig
     layout: StateLayout
     vector_field: Callable[[float, list[float]], list[float]]
-    evaluate: Callable[[list[float]], Evaluation]
+    evaluate: Callable[..., Evaluation]
 
     def initial_state(self, phi1: float, phi2: float, omega1: float, omega2: float) -> list[float]:
         """Start vector for the given angles [rad] and rates [rad/s]."""

@@ -10,6 +10,10 @@ carries over from one ``doStep`` to the next.
 Step-size control (Hairer, Norsett, Wanner I, II.4): a step is accepted when the scaled error
 norm ``err <= 1``; the next step is ``h * min(10, max(0.2, 0.9 * err^(-1/(q+1))))`` with ``q`` the
 order of the error estimate, never growing right after a rejection.
+
+A jump of the right-hand side (an FMU input changing at a communication point) is handled by
+:meth:`Integrator.restart`: the last step and its dense output are forgotten, the integration
+goes on from the given state with the new right-hand side and the current step size.
 """
 
 from __future__ import annotations
@@ -70,6 +74,7 @@ class Integrator:
         self.nfev = 1
         self.n_steps = 0
         self.n_rejected = 0
+        self.grid_start = 0  # n_steps at the origin t0 of the fixed-step grid
         # The last accepted step [t_prev, t], kept for dense output.
         self.t_prev = self.t
         self.y_prev = list(y0)
@@ -108,7 +113,7 @@ class Integrator:
         self.n_steps += 1
 
     def _fixed_step(self) -> None:
-        n = self.n_steps + 1
+        n = self.n_steps - self.grid_start + 1
         t_new = self.t0 + n * self.fixed_step
         h = t_new - self.t
         y_new, f_new, stages = self.method.step(self.f, self.t, self.y, self.fy, h)
@@ -157,6 +162,28 @@ class Integrator:
             self._adaptive_step()
         else:
             self._fixed_step()
+
+    def restart(self, t: float, y: list[float], f: VectorField | None = None) -> None:
+        """Go on from ``(t, y)`` with right-hand side ``f`` (default: the current one).
+
+        For a discontinuity at ``t``: the last step, its stages and dense output are dropped, so
+        nothing computed with the old right-hand side is reused beyond ``t``; ``f(t, y)`` is
+        evaluated anew. The step size (adaptive) and the counters carry over; the fixed-step grid
+        restarts at ``t``.
+        """
+        y = [float(v) for v in y]
+        if not _all_finite(y):
+            raise SolverError(f"non-finite state {y} at t = {t:.6g} s")
+        if f is not None:
+            self.f = f
+        self.t0 = self.t = self.t_prev = float(t)
+        self.y, self.y_prev = y, list(y)
+        self.fy = self.f(self.t, y)
+        self.fy_prev = list(self.fy)
+        self.nfev += 1
+        self.stages = []
+        self._interp = None
+        self.grid_start = self.n_steps
 
     # ------------------------------------------------------------------ output
     def advance_to(self, t_out: float) -> list[float]:
@@ -207,6 +234,7 @@ class Integrator:
         "nfev",
         "n_steps",
         "n_rejected",
+        "grid_start",
     )
 
     def get_state(self) -> dict[str, Any]:

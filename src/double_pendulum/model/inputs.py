@@ -1,0 +1,122 @@
+r"""The model's inputs: motion of the pivot (or of the suspension's base) and two joint torques.
+
+Inputs (all start at 0; with every input 0 the model is exactly the one without inputs):
+
+* ``pivot_x, pivot_y`` [m], ``pivot_vx, pivot_vy`` [m/s], ``pivot_ax, pivot_ay`` [m/s2]: the motion
+  of the point the pendulum hangs from. In a direction without a suspension state (``suspension``
+  off, or that direction of the suspension switched off) it *is* the pivot's motion: the angles are
+  driven by the acceleration (a fictitious force :math:`-m_i \vec a_p` on each bob), positions and
+  velocities (bob positions ``x1..y2``, air drag, kinetic energy) use the position and velocity. In
+  a direction with a suspension state it is the motion of the suspension's base (ground excitation):
+  the spring and damper act on :math:`x_s - x_b` and :math:`\dot x_s - v_b`; the base acceleration
+  does not enter (the base's inertia is the host's business).
+* ``tau1`` [N.m]: torque on the upper rod at the pivot (a motor between support and rod 1), acting
+  on :math:`\omega_1`; ``tau2`` [N.m]: torque of the upper rod on the lower rod at the elbow, acting
+  on :math:`\omega_2 - \omega_1` (its reaction acts on rod 1). Generalised forces:
+  :math:`Q_1 \mathrel{+}= \tau_1 - \tau_2`, :math:`Q_2 \mathrel{+}= \tau_2`.
+
+**Second-order hold.** FMI 2.0 co-simulation holds inputs between communication points. This
+model holds the pivot motion as the quadratic through the values set for the step starting at
+:math:`t_0` (:class:`InputHold`):
+
+.. math::
+
+    x(t_0+\tau) = x + v\tau + \tfrac12 a\tau^2,\qquad v(t_0+\tau) = v + a\tau,\qquad
+    a(t_0+\tau) = a,\qquad \tau_{1,2}(t_0+\tau) = \tau_{1,2}.
+
+A host that sends consistent values (``v`` the derivative of ``x``, ``a`` of ``v``) gets a motion
+continuous in position and velocity. **Inconsistent values are used as given**, each for what it
+drives: the angles see ``a``, drag, energies and bob positions see ``x`` and ``v``; at each
+communication point the hold restarts from the values then set (so a host that sets only
+``pivot_ay`` gets the right angles for that acceleration, with the pivot position held at
+``pivot_y`` + the quadratic from each step's start).
+
+**Work.** ``W_input`` [J] integrates the power of the inputs into the system: the torques'
+:math:`\tau_1\omega_1 + \tau_2(\omega_2-\omega_1)`, plus, per direction, the pivot force on the
+pendulum about its static value (the weight share :math:`(m_1+m_2) g` lifts the whole pendulum,
+which :math:`E_{pot}`, measured relative to the pivot, does not count either), or for a suspended
+direction the dynamic spring-damper force :math:`-k(x_s-x_b)-c(\dot x_s-v_b)` times the base
+velocity. Then ``energy_residual = E_total(t) + W_air + W_bearing + W_suspension - W_input - E_total(0)``
+still measures only the integration error.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+from .outputs import Quantity
+
+INPUTS: tuple[Quantity, ...] = (
+    Quantity("pivot_x", "m", "horizontal position of the pivot (suspension on: of its base)"),
+    Quantity("pivot_y", "m", "vertical position of the pivot (suspension on: of its base), up positive"),
+    Quantity("pivot_vx", "m/s", "horizontal velocity of the pivot (suspension on: of its base)"),
+    Quantity("pivot_vy", "m/s", "vertical velocity of the pivot (suspension on: of its base)"),
+    Quantity("pivot_ax", "m/s2", "horizontal acceleration of the pivot (drives the angles)"),
+    Quantity("pivot_ay", "m/s2", "vertical acceleration of the pivot (drives the angles)"),
+    Quantity("tau1", "N.m", "torque on the upper rod at the pivot (motor), along omega1"),
+    Quantity("tau2", "N.m", "torque of the upper rod on the lower rod at the elbow, along omega2 - omega1"),
+)
+INPUT_NAMES: tuple[str, ...] = tuple(q.name for q in INPUTS)
+INPUT_UNITS: dict[str, str] = {q.name: q.unit for q in INPUTS}
+
+
+class InputValues(NamedTuple):
+    """The inputs at one instant (SI units, see :data:`INPUTS`)."""
+
+    pivot_x: float = 0.0
+    pivot_y: float = 0.0
+    pivot_vx: float = 0.0
+    pivot_vy: float = 0.0
+    pivot_ax: float = 0.0
+    pivot_ay: float = 0.0
+    tau1: float = 0.0
+    tau2: float = 0.0
+
+    def is_zero(self) -> bool:
+        """True if every input is exactly 0."""
+        return not any(self)
+
+
+ZERO_INPUTS = InputValues()
+# Values that agree to this relative tolerance are the same hold (rounding of the host's own
+# extrapolation), so a consistent quadratic keeps the integrator running across the step.
+HOLD_MATCH_RTOL = 1e-13
+
+
+def _same(a: float, b: float) -> bool:
+    return a == b or abs(a - b) <= HOLD_MATCH_RTOL * max(abs(a), abs(b))
+
+
+@dataclass(frozen=True)
+class InputHold:
+    """The second-order hold of one communication step: the values set at ``t0`` [s]."""
+
+    t0: float
+    values: InputValues
+
+    def at(self, t: float) -> InputValues:
+        """Return the held inputs at time ``t`` [s] (quadratic position, linear velocity)."""
+        v = self.values
+        tau = t - self.t0
+        if tau == 0.0 or not (v.pivot_vx or v.pivot_vy or v.pivot_ax or v.pivot_ay):
+            return v
+        return InputValues(
+            v.pivot_x + tau * (v.pivot_vx + 0.5 * tau * v.pivot_ax),
+            v.pivot_y + tau * (v.pivot_vy + 0.5 * tau * v.pivot_ay),
+            v.pivot_vx + tau * v.pivot_ax,
+            v.pivot_vy + tau * v.pivot_ay,
+            v.pivot_ax,
+            v.pivot_ay,
+            v.tau1,
+            v.tau2,
+        )
+
+    def continued_by(self, t0: float, values: InputValues) -> bool:
+        """True if ``values`` set at ``t0`` describe this same hold (no discontinuity at ``t0``).
+
+        Then the integrator may go on with this hold; otherwise the right-hand side jumps at
+        ``t0`` and the integration must restart there.
+        """
+        held = self.at(t0)
+        return all(_same(a, b) for a, b in zip(held, values))
