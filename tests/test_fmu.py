@@ -230,7 +230,7 @@ def test_fmu_ships_hash_checked_bytecode(fmu_path):
 
     with zipfile.ZipFile(fmu_path) as z:
         names = set(z.namelist())
-        cached = importlib.util.cache_from_source("resources/double_pendulum/dynamics.py")
+        cached = importlib.util.cache_from_source("resources/double_pendulum/model/dynamics.py")
         assert cached in names
         flags = int.from_bytes(z.read(cached)[4:8], "little")
         assert flags == 0b11  # PEP 552: hash-based, checked against the source
