@@ -292,3 +292,15 @@ def test_bearing_drag_loss_per_cycle_is_amplitude_independent_so_decay_is_linear
     half = len(amp) // 2
     first, second = amp[0] - amp[half], amp[half] - amp[-1]
     assert second == pytest.approx(first, rel=0.15)
+
+
+def test_batch_field_for_ensembles_has_the_rods_too():
+    """The NumPy ensemble field (chaos, maps) uses the same rigid-link accelerations as the FMU's core."""
+    from double_pendulum.analysis.ensemble import pendulum_field
+
+    rng = np.random.default_rng(3)
+    states = rng.uniform(-3, 3, size=(4, 20))
+    batch = pendulum_field(HEAVY)(0.0, states)
+    scalar = fixed_pivot_vector_field(HEAVY)
+    for k in range(states.shape[1]):
+        assert batch[:, k] == pytest.approx(scalar(0.0, list(states[:, k])), rel=1e-13, abs=1e-13)

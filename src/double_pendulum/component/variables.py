@@ -15,8 +15,9 @@ from .cosimulation import PARAMETER_GROUPS
 
 MODEL_IDENTIFIER = "DoublePendulum"
 MODEL_DESCRIPTION = (
-    "Planar double pendulum (point masses on massless rods, fixed pivot), equations of motion "
-    "from the Lagrangian; FMI 2.0 co-simulation with an integrator that persists across doStep."
+    "Planar double pendulum (bobs on rods that may carry mass; fixed pivot or damped suspension; air "
+    "drag and bearing friction), equations of motion from the Lagrangian; FMI 2.0 co-simulation with "
+    "an integrator that persists across doStep."
 )
 DEFAULT_EXPERIMENT = {"start_time": 0.0, "stop_time": 10.0, "step_size": 0.01}
 
