@@ -130,7 +130,9 @@ class AirDragParameters(Validated):
     member is two plates 4 mm thick (frontal width 8 mm), the lower one plate 6 mm thick. The
     report gives no bob geometry: each bob's frontal area defaults to the seed's example area
     1.5e-3 m^2 (a 300 g steel cylinder of about 3 cm x 5 cm seen from the side) with c_W = 1
-    (a short cylinder in cross flow at Reynolds numbers of 1e3..1e4).
+    (a short cylinder in cross flow at Reynolds numbers of 1e3..1e4). The rod drag acts over each
+    plate's whole length ``L_rod1``, ``L_rod2`` (:class:`PendulumParameters`), centred between its
+    joints, overhangs included.
     """
 
     air_drag: bool = spec(False, "", "switch: quadratic air drag on the bobs", rule="bool")
