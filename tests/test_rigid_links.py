@@ -2,9 +2,11 @@
 
 The independent formulation (``independent_lagrangian.py``) assembles Lagrange's equations
 numerically from positions of mass points; it shares no formula with the package. The point-mass
-model is checked against results recorded before the rods existed (``data/point_mass_golden.json``,
-made with the model of commit f3d385d by the recipe in :func:`_run_golden_scene`): with
-``m_rod1 = m_rod2 = 0`` every output must be bit-identical.
+model is checked against results recorded before the rods existed (``data/point_mass_golden.json``:
+the in-process component of commit f3d385d run with the file's start values and switches, every
+model output at its output times): with ``m_rod1 = m_rod2 = 0`` every output must be bit-identical
+(:func:`_run_golden_scene` re-runs a scene; rod drag then needs plates of joint-to-joint length,
+the rod of the earlier model).
 """
 
 from __future__ import annotations
