@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from double_pendulum.model.outputs import OUTPUT_NAMES
-from double_pendulum.model.parameters import PendulumParameters
+from double_pendulum.model.parameters import SEED_RIGID_LINKS, PendulumParameters
 
 START = {"phi1_0": 1.5, "phi2_0": 1.0, "rtol": 1e-10, "atol": 1e-12}
 MECHANISMS = {
@@ -14,9 +14,14 @@ MECHANISMS = {
     "rod_drag": {"air_drag": True, "rod_drag": True},
     "bearing_friction": {"bearing_friction": True, "b_v1": 1e-5, "b_v2": 1e-5},
     "suspension": {"suspension": True},
+    "bearing_drag": {"bearing_drag": True, "tau_b1": 1e-3, "tau_b2": 1e-3},
     "all": {"air_drag": True, "rod_drag": True, "bearing_friction": True, "suspension": True},
-}
-WORK = ("W_air", "W_bearing", "W_suspension")
+    "rigid, all": {
+        **SEED_RIGID_LINKS, "air_drag": True, "rod_drag": True, "bearing_friction": True, "bearing_drag": True,
+        "tau_b1": 1e-3, "tau_b2": 1e-3, "suspension": True,
+    },
+}  # fmt: skip
+WORK = ("W_air", "W_bearing", "W_bearing_drag", "W_suspension")
 
 
 @pytest.fixture(scope="module")
@@ -49,6 +54,8 @@ def test_residual_balances_each_mechanisms_own_work(budget_runs):
     r = budget_runs["air_drag"]
     assert r["W_bearing"][-1] == 0.0 and r["W_suspension"][-1] == 0.0
     r = budget_runs["all"]
+    assert all(r[w][-1] > 0 for w in WORK if w != "W_bearing_drag") and r["W_bearing_drag"][-1] == 0.0
+    r = budget_runs["rigid, all"]
     assert all(r[w][-1] > 0 for w in WORK)
 
 
@@ -61,6 +68,7 @@ def test_switches_off_give_exactly_the_core_result_whatever_the_coefficients(run
             "rho_air": 5.0,
             "cw": 3.0,
             "c_R1": 0.5,
+            "tau_b1": 0.2,
             "r_b2": 0.1,
             "M_s": 0.01,
             "k_x": 3.0,

@@ -10,7 +10,13 @@ from scipy.integrate import quad
 
 from double_pendulum.model.dynamics import fixed_pivot_vector_field
 from double_pendulum.model.forces import bearing_torque, quadratic_drag, rod_drag_integrals
-from double_pendulum.model.parameters import AirDragParameters, BearingParameters, SuspensionParameters
+from double_pendulum.model.parameters import (
+    SEED_RIGID_LINKS,
+    AirDragParameters,
+    BearingParameters,
+    PendulumParameters,
+    SuspensionParameters,
+)
 from double_pendulum.model.vector_field import ModelConfig, build_model, energies, state_layout
 
 ALL_ON = ModelConfig(
@@ -26,6 +32,13 @@ SCENES = {
     "suspension_x": ModelConfig(suspension=SuspensionParameters(suspension=True, suspension_y=False)),
     "suspension_y": ModelConfig(suspension=SuspensionParameters(suspension=True, suspension_x=False)),
     "all": ALL_ON,
+    "bearing_drag": ModelConfig(bearing=BearingParameters(bearing_drag=True, tau_b1=1e-3, tau_b2=2e-3)),
+    "rigid, all": ModelConfig(
+        pendulum=PendulumParameters(**SEED_RIGID_LINKS),
+        air=AirDragParameters(air_drag=True, rod_drag=True),
+        bearing=BearingParameters(bearing_friction=True, b_v1=1e-4, bearing_drag=True, tau_b1=1e-3, tau_b2=1e-3),
+        suspension=SuspensionParameters(suspension=True),
+    ),
 }
 
 
@@ -54,7 +67,7 @@ def _energy(config: ModelConfig, y: list[float]) -> float:
 
 @pytest.mark.parametrize("scene", list(SCENES))
 def test_energy_rate_equals_minus_dissipated_power(scene):
-    """dE_total/dt = grad(E) . f = -(P_air + P_bearing + P_suspension) at any state."""
+    """dE_total/dt = grad(E) . f = -(P_air + P_bearing + P_bearing_drag + P_suspension) at any state."""
     config = SCENES[scene]
     model = build_model(config)
     rng = random.Random(7)
@@ -71,9 +84,9 @@ def test_energy_rate_equals_minus_dissipated_power(scene):
             term = (_energy(config, up) - _energy(config, down)) / (2 * h) * ev.dydt[k]
             rate += term
             scale += abs(term)
-        dissipated = ev.p_air + ev.p_bearing + ev.p_suspension
+        dissipated = ev.p_air + ev.p_bearing + ev.p_bearing_drag + ev.p_suspension
         assert rate == pytest.approx(-dissipated, abs=1e-7 * scale)
-        assert ev.p_air >= 0 and ev.p_bearing >= 0 and ev.p_suspension >= 0
+        assert ev.p_air >= 0 and ev.p_bearing >= 0 and ev.p_bearing_drag >= 0 and ev.p_suspension >= 0
 
 
 def test_undamped_suspension_conserves_energy_pointwise():
@@ -86,7 +99,7 @@ def test_undamped_suspension_conserves_energy_pointwise():
 def test_switched_off_scene_is_the_core_vector_field_whatever_the_coefficients():
     config = ModelConfig(
         air=AirDragParameters(rho_air=9.0, cw=3.0),
-        bearing=BearingParameters(c_R1=0.5, r_b1=0.1),
+        bearing=BearingParameters(c_R1=0.5, r_b1=0.1, tau_b1=0.3),
         suspension=SuspensionParameters(M_s=0.01, k_x=1.0),
     )
     model = build_model(config)
@@ -128,27 +141,30 @@ def test_bearing_torque_uses_the_joint_reaction_force():
         assert ev.p_bearing == pytest.approx(expected, rel=1e-12)
 
 
-def _kink(a: float, b: float, length: float) -> list[float] | None:
+def _kink(a: float, b: float, lo: float, hi: float) -> list[float] | None:
     """Where the normal velocity changes sign inside the rod (a kink of the integrand)."""
-    return [-a / b] if b and 0 < -a / b < length else None
+    return [-a / b] if b and lo < -a / b < hi else None
 
 
 @pytest.mark.parametrize(
-    ("a", "b", "length"), [(0.3, 2.0, 0.3), (0.5, -3.0, 0.3), (-0.2, 0.1, 0.2), (0.0, 5.0, 0.25)]
+    ("a", "b", "lo", "hi"),
+    [
+        (0.3, 2.0, 0.0, 0.3),
+        (0.5, -3.0, 0.0, 0.3),
+        (-0.2, 0.1, 0.0, 0.2),
+        (0.0, 5.0, 0.0, 0.25),
+        (0.0, 5.0, -0.027, 0.323),  # plate overhanging the pivot: v_n changes sign at the joint
+        (0.4, -2.0, -0.026, 0.223),
+    ],
 )
-def test_rod_drag_integrals_are_exact(a, b, length):
+def test_rod_drag_integrals_are_exact(a, b, lo, hi):
     g = lambda s: abs(a + b * s) * (a + b * s)  # noqa: E731
-    i0, i1, i3 = rod_drag_integrals(a, b, length)
-    assert i0 == pytest.approx(
-        quad(g, 0, length, points=_kink(a, b, length), limit=200)[0], rel=1e-12, abs=1e-15
-    )
-    assert i1 == pytest.approx(
-        quad(lambda s: g(s) * s, 0, length, points=_kink(a, b, length), limit=200)[0], rel=1e-12, abs=1e-15
-    )
+    i0, i1, i3 = rod_drag_integrals(a, b, lo, hi)
+    kink = _kink(a, b, lo, hi)
+    assert i0 == pytest.approx(quad(g, lo, hi, points=kink, limit=200)[0], rel=1e-12, abs=1e-15)
+    assert i1 == pytest.approx(quad(lambda s: g(s) * s, lo, hi, points=kink, limit=200)[0], rel=1e-12, abs=1e-15)
     assert i3 == pytest.approx(
-        quad(lambda s: abs(a + b * s) ** 3, 0, length, points=_kink(a, b, length), limit=200)[0],
-        rel=1e-12,
-        abs=1e-15,
+        quad(lambda s: abs(a + b * s) ** 3, lo, hi, points=kink, limit=200)[0], rel=1e-12, abs=1e-15
     )
 
 

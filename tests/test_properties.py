@@ -45,6 +45,11 @@ scenes = st.fixed_dictionaries(
         "c_R1": log_uniform(1e-5, 1e-2),
         "c_R2": log_uniform(1e-5, 1e-2),
         "omega_reg": log_uniform(1e-3, 1.0),
+        "bearing_drag": st.booleans(),
+        "tau_b_fraction": log_uniform(1e-5, 1e-2),  # drag torque as a fraction of (m1 + m2) g l1
+        "m_rod1": st.sampled_from([0.0, 0.01, 0.07, 1.0]),
+        "m_rod2": st.sampled_from([0.0, 0.01, 0.07, 1.0]),
+        "L_rod1": log_uniform(0.01, 2.0),
         "suspension": st.booleans(),
         "M_s": log_uniform(0.05, 10.0),
         "k_x": log_uniform(1e2, 1e6),
@@ -57,11 +62,14 @@ scenes = st.fixed_dictionaries(
 
 @given(scene=scenes)
 def test_random_valid_scenes_run_and_keep_the_energy_budget(scene):
+    scene = dict(scene)
+    scene["tau_b1"] = scene.pop("tau_b_fraction") * (scene["m1"] + scene["m2"]) * 9.81 * scene["l1"]
     r = simulate({**scene, "rtol": 1e-8, "atol": 1e-10}, stop_time=1.0, output_interval=0.01)
     assert r["time"][-1] == 1.0
     for name in r.dtype.names:
         assert np.all(np.isfinite(r[name])), name
-    for name in ("W_air", "W_bearing", "W_suspension"):
+    for name in ("W_air", "W_bearing", "W_bearing_drag", "W_suspension"):
         assert np.all(np.diff(r[name]) >= 0.0), name
-    scale = max(r["E_total"][0], (scene["m1"] + scene["m2"]) * 9.81 * (scene["l1"] + scene["l2"]))
+    mass = scene["m1"] + scene["m2"] + scene["m_rod1"] + scene["m_rod2"]
+    scale = max(r["E_total"][0], mass * 9.81 * (scene["l1"] + scene["l2"]))
     assert np.max(np.abs(r["energy_residual"])) <= 1e-5 * scale

@@ -7,7 +7,7 @@ vector field; nothing re-derives the equations of motion.
 :math:`v` obeys the variational equation :math:`\dot v = J(y)\,v` with :math:`J = \partial f/\partial y`.
 :math:`J v` is obtained from the vector field itself by the *complex step*
 :math:`J v = \operatorname{Im} f(y + i\varepsilon v)/\varepsilon` (:math:`\varepsilon = 10^{-20}`):
-:func:`double_pendulum.model.dynamics.angular_accelerations` is analytic (sums, products, quotients,
+:func:`double_pendulum.model.dynamics.link_accelerations` is analytic (sums, products, quotients,
 sine, cosine), so this is exact to rounding, with no cancellation, and needs no hand-written
 Jacobian. A central difference is available for vector fields that are not analytic (e.g. with
 Coulomb friction). The tangent vectors are integrated together with the trajectory and

@@ -7,7 +7,7 @@ the whole ensemble, on contiguous rows.
 
 One copy of the physics: :func:`pendulum_field` is the model's right-hand side
 :math:`\dot\varphi_i = \omega_i`, :math:`\dot\omega_i = \ddot\varphi_i` with the accelerations from
-:func:`double_pendulum.model.dynamics.angular_accelerations` called with ``sin=np.sin, cos=np.cos``;
+:func:`double_pendulum.model.dynamics.link_accelerations` called with ``sin=np.sin, cos=np.cos``;
 energies and positions come from :mod:`double_pendulum.model.energy` and
 :mod:`double_pendulum.model.kinematics` the same way. The methods use the Butcher tableaus of
 :mod:`double_pendulum.solvers.tableaus`.
@@ -42,9 +42,10 @@ from typing import Any
 
 import numpy as np
 
-from ..model.dynamics import angular_accelerations
+from ..model.dynamics import link_accelerations
 from ..model.energy import potential_energy, total_energy
 from ..model.kinematics import positions
+from ..model.links import link_coefficients
 from ..model.parameters import PendulumParameters
 from ..solvers import SolverError
 from ..solvers import tableaus as tb
@@ -79,16 +80,16 @@ def pendulum_field(params: PendulumParameters | None = None, forces: Generalised
     """Return the double pendulum's right-hand side for batches ``Y = [phi1, phi2, omega1, omega2]``.
 
     ``dY/dt = [omega1, omega2, phi1'', phi2'']`` with the accelerations [rad/s^2] of
-    :func:`double_pendulum.model.dynamics.angular_accelerations`; ``forces`` adds generalised forces
+    :func:`double_pendulum.model.dynamics.link_accelerations` (bobs and rods); ``forces`` adds generalised forces
     ``Q1, Q2`` [N m] (friction models plug in here), none by default (frictionless).
     """
     p = params if params is not None else PendulumParameters()
-    m1, m2, l1, l2, g = p.m1, p.m2, p.l1, p.l2, p.g
+    c = link_coefficients(p)
 
     def field(t: Any, y: np.ndarray) -> np.ndarray:
         q1, q2 = (0.0, 0.0) if forces is None else forces(t, y)
-        alpha1, alpha2 = angular_accelerations(
-            y[0], y[1], y[2], y[3], m1, m2, l1, l2, g, q1, q2, sin=np.sin, cos=np.cos
+        alpha1, alpha2 = link_accelerations(
+            y[0], y[1], y[2], y[3], c.j1, c.j2, c.k, c.gs1, c.gs2, q1, q2, sin=np.sin, cos=np.cos
         )
         out = np.empty_like(y)
         out[0] = y[2]

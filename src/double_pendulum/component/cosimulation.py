@@ -34,6 +34,7 @@ from dataclasses import fields
 from typing import Any
 
 from ..model.inputs import INPUT_NAMES, INPUT_UNITS, ZERO_INPUTS, InputHold, InputValues
+from ..model.links import link_coefficients
 from ..model.outputs import GROUP_OF, OUTPUT_GROUPS, OUTPUT_NAMES
 from ..model.parameters import (
     AirDragParameters,
@@ -349,14 +350,14 @@ class DoublePendulumCoSimulation:
 
         Without inputs the energy can never rise above the start energy, and with inputs
         ``E_total - W_input`` cannot. A value beyond ``ENERGY_BLOWUP_FACTOR`` times the start
-        energy plus the energy scale ``(m1 + m2) g (l1 + l2)``, or a non-finite state, can only
-        come from an unstable integration (e.g. explicit Euler with too large a step); it is
-        reported instead of returning meaningless numbers.
+        energy plus the energy scale ``M g (l1 + l2)`` (M the pendulum's mass, bobs and rods), or a
+        non-finite state, can only come from an unstable integration (e.g. explicit Euler with too
+        large a step); it is reported instead of returning meaningless numbers.
         """
         energy = outputs["E_total"] - outputs["W_input"]
         p = self.model.config.pendulum
         e0 = self.initial_energy or 0.0
-        limit = ENERGY_BLOWUP_FACTOR * (abs(e0) + (p.m1 + p.m2) * p.g * (p.l1 + p.l2))
+        limit = ENERGY_BLOWUP_FACTOR * (abs(e0) + link_coefficients(p).mass * p.g * (p.l1 + p.l2))
         if not all(math.isfinite(v) for v in y) or not abs(energy) <= limit:
             raise SolverError(
                 f"numerical instability at t = {t_end:.6g} s: E_total = {energy:.6g} J, started at "

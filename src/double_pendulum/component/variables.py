@@ -20,9 +20,9 @@ from .suspension import INPUT_START, PARAMETER_FIELDS
 
 MODEL_IDENTIFIER = "DoublePendulum"
 MODEL_DESCRIPTION = (
-    "Planar double pendulum (point masses on massless rods; fixed, moving or suspended pivot), "
-    "equations of motion from the Lagrangian; inputs: pivot motion and joint torques; FMI 2.0 "
-    "co-simulation with an integrator that persists across doStep."
+    "Planar double pendulum (bobs on rods that may carry mass; fixed, moving or suspended pivot; air "
+    "drag and bearing friction), equations of motion from the Lagrangian; inputs: pivot motion and "
+    "joint torques; FMI 2.0 co-simulation with an integrator that persists across doStep."
 )
 DEFAULT_EXPERIMENT = {"start_time": 0.0, "stop_time": 10.0, "step_size": 0.01}
 

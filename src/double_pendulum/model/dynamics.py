@@ -2,21 +2,27 @@ r"""Equations of motion of the planar double pendulum with a fixed pivot.
 
 Generalised coordinates: the rod angles :math:`\varphi_1, \varphi_2` from the downward vertical.
 With :math:`\Delta = \varphi_1 - \varphi_2`, the Lagrangian
-:math:`L = T - V` (see :mod:`double_pendulum.model.energy`) gives (seed eqs. 14/15, re-derived; the
-seed's eqs. 12 and 13 have their left-hand sides swapped and its eq. 21 is
-:math:`\ddot\varphi_2`, not :math:`\ddot\varphi_1`):
+:math:`L = T - V` (see :mod:`double_pendulum.model.energy` and, for the coefficients
+:math:`J_1, J_2, K, S_1, S_2` of bobs and rods, :mod:`double_pendulum.model.links`) gives
 
 .. math::
 
-    (m_1+m_2) l_1^2 \ddot\varphi_1 + m_2 l_1 l_2 \cos\Delta\,\ddot\varphi_2
-        = -m_2 l_1 l_2 \dot\varphi_2^2 \sin\Delta - (m_1+m_2) g l_1 \sin\varphi_1 + Q_1
+    J_1 \ddot\varphi_1 + K \cos\Delta\,\ddot\varphi_2
+        = -K \dot\varphi_2^2 \sin\Delta - g S_1 \sin\varphi_1 + Q_1
 
-    m_2 l_1 l_2 \cos\Delta\,\ddot\varphi_1 + m_2 l_2^2 \ddot\varphi_2
-        = m_2 l_1 l_2 \dot\varphi_1^2 \sin\Delta - m_2 g l_2 \sin\varphi_2 + Q_2
+    K \cos\Delta\,\ddot\varphi_1 + J_2 \ddot\varphi_2
+        = K \dot\varphi_1^2 \sin\Delta - g S_2 \sin\varphi_2 + Q_2
+
+For point masses on massless rods (:math:`J_1 = (m_1+m_2) l_1^2`, :math:`J_2 = m_2 l_2^2`,
+:math:`K = m_2 l_1 l_2`, :math:`S_1 = (m_1+m_2) l_1`, :math:`S_2 = m_2 l_2`) these are the seed's
+eqs. 14/15, re-derived; the seed's eqs. 12 and 13 have their left-hand sides swapped and its
+eq. 21 is :math:`\ddot\varphi_2`, not :math:`\ddot\varphi_1`.
 
 :math:`Q_1, Q_2` [N m] are generalised non-conservative forces (zero for the frictionless core).
-The mass matrix has determinant :math:`m_2 l_1^2 l_2^2 (m_1 + m_2 \sin^2\Delta) > 0`, so the
-2x2 system is solved in closed form (Cramer's rule).
+The mass matrix has determinant :math:`J_1 J_2 - K^2\cos^2\Delta \ge J_1 J_2 - K^2 > 0` (for point
+masses :math:`m_2 l_1^2 l_2^2 (m_1 + m_2 \sin^2\Delta)`; with rods :math:`J_1 J_2 > K^2` by the
+Cauchy-Schwarz inequality and :math:`m_1 > 0`), so the 2x2 system is solved in closed form
+(Cramer's rule).
 
 The functions take ``sin``/``cos`` as arguments so the same formula serves Python floats
 (``math``, fastest for one trajectory) and NumPy arrays (``numpy``, a whole ensemble at once).
@@ -28,7 +34,40 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from .links import link_coefficients
 from .parameters import PendulumParameters
+
+
+def link_accelerations(
+    phi1: Any,
+    phi2: Any,
+    omega1: Any,
+    omega2: Any,
+    j1: float,
+    j2: float,
+    k: float,
+    gs1: float,
+    gs2: float,
+    q1: Any = 0.0,
+    q2: Any = 0.0,
+    sin: Callable[[Any], Any] = math.sin,
+    cos: Callable[[Any], Any] = math.cos,
+) -> tuple[Any, Any]:
+    r"""Return :math:`(\ddot\varphi_1, \ddot\varphi_2)` [rad/s^2] from the equations above.
+
+    Arguments are angles [rad], angular velocities [rad/s], the coefficients :math:`J_1, J_2, K`
+    [kg m^2] and :math:`g S_1, g S_2` [N m] (:class:`~double_pendulum.model.links.LinkCoefficients`)
+    and the generalised forces ``q1, q2`` [N m].
+    """
+    delta = phi1 - phi2
+    s_d = sin(delta)
+    c_d = cos(delta)
+    # Mass matrix [[j1, a12], [a12, j2]] and right-hand side (b1, b2).
+    a12 = k * c_d
+    b1 = -k * omega2 * omega2 * s_d - gs1 * sin(phi1) + q1
+    b2 = k * omega1 * omega1 * s_d - gs2 * sin(phi2) + q2
+    det = j1 * j2 - a12 * a12
+    return (b1 * j2 - a12 * b2) / det, (j1 * b2 - a12 * b1) / det
 
 
 def angular_accelerations(
@@ -46,37 +85,32 @@ def angular_accelerations(
     sin: Callable[[Any], Any] = math.sin,
     cos: Callable[[Any], Any] = math.cos,
 ) -> tuple[Any, Any]:
-    r"""Return :math:`(\ddot\varphi_1, \ddot\varphi_2)` [rad/s^2] from the equations above.
+    r"""Return :math:`(\ddot\varphi_1, \ddot\varphi_2)` [rad/s^2] for point masses on massless rods.
 
     Arguments are angles [rad], angular velocities [rad/s], masses [kg], lengths [m],
-    gravity [m/s^2] and the generalised forces ``q1, q2`` [N m].
+    gravity [m/s^2] and the generalised forces ``q1, q2`` [N m]; :func:`link_accelerations` with
+    the point-mass coefficients.
     """
-    delta = phi1 - phi2
-    s_d = sin(delta)
-    c_d = cos(delta)
     m12 = m1 + m2
-    # Mass matrix [[a11, a12], [a12, a22]] and right-hand side (b1, b2).
-    a11 = m12 * l1 * l1
-    a12 = m2 * l1 * l2 * c_d
-    a22 = m2 * l2 * l2
-    b1 = -m2 * l1 * l2 * omega2 * omega2 * s_d - m12 * g * l1 * sin(phi1) + q1
-    b2 = m2 * l1 * l2 * omega1 * omega1 * s_d - m2 * g * l2 * sin(phi2) + q2
-    det = a11 * a22 - a12 * a12
-    return (b1 * a22 - a12 * b2) / det, (a11 * b2 - a12 * b1) / det
+    return link_accelerations(
+        phi1, phi2, omega1, omega2, m12 * l1 * l1, m2 * l2 * l2, m2 * l1 * l2, m12 * g * l1, m2 * g * l2,
+        q1, q2, sin, cos,
+    )  # fmt: skip
 
 
 def fixed_pivot_vector_field(params: PendulumParameters) -> Callable[[float, list[float]], list[float]]:
     """Return ``f(t, y) -> dy/dt`` for ``y = [phi1, phi2, omega1, omega2]`` (frictionless).
 
     Units: y in (rad, rad, rad/s, rad/s), dy/dt in (rad/s, rad/s, rad/s^2, rad/s^2).
-    The parameters are bound once so each call does no attribute look-ups.
+    The coefficients (bobs and rods) are bound once so each call does no attribute look-ups.
     """
-    m1, m2, l1, l2, g = params.m1, params.m2, params.l1, params.l2, params.g
-    accel = angular_accelerations
+    c = link_coefficients(params)
+    j1, j2, k, gs1, gs2 = c.j1, c.j2, c.k, c.gs1, c.gs2
+    accel = link_accelerations
 
     def vector_field(t: float, y: list[float]) -> list[float]:
         phi1, phi2, omega1, omega2 = y
-        alpha1, alpha2 = accel(phi1, phi2, omega1, omega2, m1, m2, l1, l2, g)
+        alpha1, alpha2 = accel(phi1, phi2, omega1, omega2, j1, j2, k, gs1, gs2)
         return [omega1, omega2, alpha1, alpha2]
 
     return vector_field
@@ -88,16 +122,17 @@ def linearised_normal_modes(
     r"""Angular frequencies [rad/s] and mode shapes of the small-angle motion.
 
     Linearising about the hanging rest state gives :math:`M_0\ddot q + K q = 0` with
-    :math:`M_0 = [[(m_1+m_2) l_1^2, m_2 l_1 l_2], [m_2 l_1 l_2, m_2 l_2^2]]` and
-    :math:`K = \mathrm{diag}((m_1+m_2) g l_1, m_2 g l_2)`. The squared frequencies solve
+    :math:`M_0 = [[J_1, K_{12}], [K_{12}, J_2]]` and :math:`K = \mathrm{diag}(g S_1, g S_2)`
+    (:math:`K_{12}` the coupling coefficient of :mod:`double_pendulum.model.links`; for point masses
+    :math:`M_0 = [[(m_1+m_2) l_1^2, m_2 l_1 l_2], [m_2 l_1 l_2, m_2 l_2^2]]`,
+    :math:`K = \mathrm{diag}((m_1+m_2) g l_1, m_2 g l_2)`). The squared frequencies solve
     :math:`\det(K - \omega^2 M_0) = 0`, a quadratic in :math:`\omega^2`. Returns
     ``((omega_slow, omega_fast), (shape_slow, shape_fast))`` with each shape
     ``(1, phi2/phi1)``.
     """
-    m1, m2, l1, l2, g = params.m1, params.m2, params.l1, params.l2, params.g
-    m12 = m1 + m2
-    a, b, c = m12 * l1 * l1, m2 * l1 * l2, m2 * l2 * l2
-    k1, k2 = m12 * g * l1, m2 * g * l2
+    co = link_coefficients(params)
+    a, b, c = co.j1, co.k, co.j2
+    k1, k2 = co.gs1, co.gs2
     # det([[k1 - w a, -w b], [-w b, k2 - w c]]) = (a c - b^2) w^2 - (k1 c + k2 a) w + k1 k2
     qa = a * c - b * b
     qb = -(k1 * c + k2 * a)

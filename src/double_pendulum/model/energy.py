@@ -1,14 +1,17 @@
-r"""Kinetic, potential and total energy of the double pendulum.
+r"""Kinetic, potential and total energy of the double pendulum (bobs and rods).
 
 .. math::
 
-    T = \tfrac12 (m_1+m_2) l_1^2 \dot\varphi_1^2 + \tfrac12 m_2 l_2^2 \dot\varphi_2^2
-        + m_2 l_1 l_2 \dot\varphi_1 \dot\varphi_2 \cos(\varphi_1-\varphi_2)
+    T = \tfrac12 J_1 \dot\varphi_1^2 + \tfrac12 J_2 \dot\varphi_2^2
+        + K \dot\varphi_1 \dot\varphi_2 \cos(\varphi_1-\varphi_2)
 
-    V = (m_1+m_2) g l_1 (1-\cos\varphi_1) + m_2 g l_2 (1-\cos\varphi_2)
+    V = g S_1 (1-\cos\varphi_1) + g S_2 (1-\cos\varphi_2)
 
-(seed eqs. 8/9, with the potential shifted so that V = 0 with both bobs hanging at rest).
-Energies in J. ``sin``/``cos`` may be NumPy's for arrays.
+with the coefficients of :mod:`double_pendulum.model.links`; for point masses on massless rods
+:math:`J_1 = (m_1+m_2) l_1^2`, :math:`J_2 = m_2 l_2^2`, :math:`K = m_2 l_1 l_2`,
+:math:`g S_1 = (m_1+m_2) g l_1`, :math:`g S_2 = m_2 g l_2` (seed eqs. 8/9, with the potential
+shifted so that V = 0 with everything hanging at rest). Energies in J. ``sin``/``cos`` may be
+NumPy's for arrays.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from .links import link_coefficients
 from .parameters import PendulumParameters
 
 
@@ -28,21 +32,17 @@ def kinetic_energy(
     params: PendulumParameters,
     cos: Callable[[Any], Any] = math.cos,
 ) -> Any:
-    """Return T [J] of both bobs."""
-    m1, m2, l1, l2 = params.m1, params.m2, params.l1, params.l2
-    return (
-        0.5 * (m1 + m2) * l1 * l1 * omega1 * omega1
-        + 0.5 * m2 * l2 * l2 * omega2 * omega2
-        + m2 * l1 * l2 * omega1 * omega2 * cos(phi1 - phi2)
-    )
+    """Return T [J] of both links (bobs and rods) about a pivot at rest."""
+    c = link_coefficients(params)
+    return 0.5 * c.j1 * omega1 * omega1 + 0.5 * c.j2 * omega2 * omega2 + c.k * omega1 * omega2 * cos(phi1 - phi2)
 
 
 def potential_energy(
     phi1: Any, phi2: Any, params: PendulumParameters, cos: Callable[[Any], Any] = math.cos
 ) -> Any:
-    """Return V [J], zero with both bobs hanging at rest below the pivot."""
-    m1, m2, l1, l2, g = params.m1, params.m2, params.l1, params.l2, params.g
-    return (m1 + m2) * g * l1 * (1.0 - cos(phi1)) + m2 * g * l2 * (1.0 - cos(phi2))
+    """Return V [J] of bobs and rods, zero with everything hanging at rest below the pivot."""
+    c = link_coefficients(params)
+    return c.gs1 * (1.0 - cos(phi1)) + c.gs2 * (1.0 - cos(phi2))
 
 
 def total_energy(
@@ -66,21 +66,23 @@ def kinetic_energy_moving_pivot(
     vys: float,
     params: PendulumParameters,
 ) -> float:
-    r"""Return the bobs' kinetic energy [J] with absolute velocities when the pivot moves at (vxs, vys) [m/s].
+    r"""Return the pendulum's kinetic energy [J] with absolute velocities when the pivot moves at (vxs, vys) [m/s].
 
-    :math:`T = T_{rel} + \tfrac12 (m_1+m_2)|\vec v_s|^2
-    + \vec v_s\cdot(m_1 \vec v_{1,rel} + m_2 \vec v_{2,rel})`,
-    which is exactly :func:`kinetic_energy` for a pivot at rest.
+    :math:`T = T_{rel} + \tfrac12 M|\vec v_s|^2
+    + \vec v_s\cdot(S_1 \dot\varphi_1 \vec n_1 + S_2 \dot\varphi_2 \vec n_2)`,
+    :math:`\vec n_i = (\cos\varphi_i, \sin\varphi_i)`, M the total mass (bobs and rods), the last
+    term the pivot velocity times the momentum relative to the pivot; exactly :func:`kinetic_energy`
+    for a pivot at rest.
     """
-    m1, m2, l1, l2 = params.m1, params.m2, params.l1, params.l2
     if vxs == 0.0 and vys == 0.0:
         return kinetic_energy(phi1, phi2, omega1, omega2, params)
-    # momentum of the bobs relative to the pivot
-    px = (m1 + m2) * l1 * omega1 * math.cos(phi1) + m2 * l2 * omega2 * math.cos(phi2)
-    py = (m1 + m2) * l1 * omega1 * math.sin(phi1) + m2 * l2 * omega2 * math.sin(phi2)
+    c = link_coefficients(params)
+    # momentum of bobs and rods relative to the pivot
+    px = c.s1 * omega1 * math.cos(phi1) + c.s2 * omega2 * math.cos(phi2)
+    py = c.s1 * omega1 * math.sin(phi1) + c.s2 * omega2 * math.sin(phi2)
     return (
         kinetic_energy(phi1, phi2, omega1, omega2, params)
-        + 0.5 * (m1 + m2) * (vxs * vxs + vys * vys)
+        + 0.5 * c.mass * (vxs * vxs + vys * vys)
         + vxs * px
         + vys * py
     )

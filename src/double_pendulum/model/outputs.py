@@ -5,9 +5,9 @@ result, in-process or through fmpy. Quantities of a mechanism that is switched o
 
 Energy bookkeeping: ``E_total = E_pendulum + E_suspension`` is conserved without dissipation;
 each mechanism's dissipated work ``W_*`` is integrated as a state, so
-``energy_residual = E_total(t) + W_air + W_bearing + W_suspension - W_input - E_total(0)`` measures
-only the integration error, ``W_input`` being the work fed in through the inputs
-(:mod:`double_pendulum.model.inputs`).
+``energy_residual = E_total(t) + W_air + W_bearing + W_bearing_drag + W_suspension - W_input -
+E_total(0)`` measures only the integration error, ``W_input`` being the work fed in through the
+inputs (:mod:`double_pendulum.model.inputs`).
 
 Every output group takes the inputs ``u`` at the output's instant (``None`` without inputs):
 the pivot's motion and the pivot force depend on them directly (see :data:`INPUT_DEPENDENCIES`).
@@ -18,6 +18,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, NamedTuple
 
 from .kinematics import positions
+from .links import link_coefficients
 from .vector_field import Model
 
 if TYPE_CHECKING:
@@ -41,24 +42,27 @@ OUTPUTS: tuple[Quantity, ...] = (
     Quantity("y1", "m", "vertical position of the upper bob (up is positive)"),
     Quantity("x2", "m", "horizontal position of the lower bob"),
     Quantity("y2", "m", "vertical position of the lower bob"),
-    Quantity("E_kin", "J", "kinetic energy of both bobs (absolute velocities)"),
-    Quantity("E_pot", "J", "potential energy of the bobs relative to the pivot, zero hanging at rest"),
+    Quantity("E_kin", "J", "kinetic energy of bobs and rods (absolute velocities)"),
+    Quantity("E_pot", "J", "potential energy of bobs and rods relative to the pivot, zero hanging at rest"),
     Quantity("E_total", "J", "total mechanical energy E_pendulum + E_suspension"),
     Quantity("xs", "m", "horizontal displacement of the pivot from its rest position"),
     Quantity("ys", "m", "vertical displacement of the pivot from its rest position"),
     Quantity("vxs", "m/s", "horizontal velocity of the pivot"),
     Quantity("vys", "m/s", "vertical velocity of the pivot"),
-    Quantity("E_pendulum", "J", "energy of the two bobs: E_kin + E_pot"),
+    Quantity("E_pendulum", "J", "energy of the pendulum (bobs and rods): E_kin + E_pot"),
     Quantity("E_suspension", "J", "suspension mass kinetic energy plus spring energy about equilibrium"),
     Quantity("W_air", "J", "work dissipated by air drag since the start"),
     Quantity("W_bearing", "J", "work dissipated by bearing friction since the start"),
+    Quantity("W_bearing_drag", "J", "work dissipated by the load-independent bearing drag torques since the start"),
     Quantity("W_suspension", "J", "work dissipated in the suspension dampers since the start"),
     Quantity(
         "P_to_suspension", "W", "power flowing from the pendulum through the pivot into the suspension (or the driver)"
     ),
     Quantity("F_pivot_x", "N", "horizontal force of the pendulum on its pivot"),
-    Quantity("F_pivot_y", "N", "vertical force of the pendulum on its pivot (-(m1+m2) g at rest)"),
-    Quantity("energy_residual", "J", "E_total(t) + W_air + W_bearing + W_suspension - W_input - E_total(0)"),
+    Quantity("F_pivot_y", "N", "vertical force of the pendulum on its pivot (-(m1+m2+m_rod1+m_rod2) g at rest)"),
+    Quantity(
+        "energy_residual", "J", "E_total(t) + W_air + W_bearing + W_bearing_drag + W_suspension - W_input - E_total(0)"
+    ),
     Quantity("W_input", "J", "work fed in through the inputs (pivot motion, joint torques) since the start"),
 )
 
@@ -71,7 +75,7 @@ SOLVER_OUTPUTS: tuple[Quantity, ...] = (
 MODEL_OUTPUT_NAMES: tuple[str, ...] = tuple(q.name for q in OUTPUTS)
 OUTPUTS = OUTPUTS + SOLVER_OUTPUTS
 OUTPUT_NAMES: tuple[str, ...] = tuple(q.name for q in OUTPUTS)
-WORK_NAMES: tuple[str, ...] = ("W_air", "W_bearing", "W_suspension")
+WORK_NAMES: tuple[str, ...] = ("W_air", "W_bearing", "W_bearing_drag", "W_suspension")
 
 
 def _pivot(model: Model, y: list[float], u: InputValues | None = None) -> tuple[float, float, float, float]:
@@ -133,7 +137,7 @@ def force_outputs(
     _, _, vxs, vys = _pivot(model, y, u)
     ev = model.evaluate(y) if u is None else model.evaluate(y, u)
     # power into the suspension: the pivot force about its static value (the preload carries the weight)
-    p_susp = ev.f_pivot_x * vxs + (ev.f_pivot_y + (p.m1 + p.m2) * p.g) * vys
+    p_susp = ev.f_pivot_x * vxs + (ev.f_pivot_y + link_coefficients(p).mass * p.g) * vys
     return {"P_to_suspension": p_susp, "F_pivot_x": ev.f_pivot_x, "F_pivot_y": ev.f_pivot_y}
 
 

@@ -14,7 +14,9 @@ l1 = 0.2964 m (scatter 0.5 mm) and the mean distance between the two masses l2 =
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, fields
+from types import MappingProxyType
 from typing import Any
 
 
@@ -71,9 +73,14 @@ class Validated:
 
 @dataclass(frozen=True)
 class PendulumParameters(Validated):
-    """Physical parameters of the planar double pendulum (point masses on massless rods).
+    """Physical parameters of the planar double pendulum: a bob on each link, optionally a rod.
 
-    Angles are measured from the downward vertical; y points up, the pivot is the origin.
+    Angles are measured from the downward vertical; y points up, the pivot is the origin. Each
+    link may carry a uniform rod (plate) of mass ``m_rod`` and length ``L_rod`` centred between its
+    two joints (:mod:`double_pendulum.model.links`); the default rod mass 0 is the point-mass
+    pendulum on massless rods. ``L_rod`` also sets the length the rod drag acts on
+    (:class:`AirDragParameters`), whatever the rod's mass. :data:`SEED_RIGID_LINKS` holds the
+    seed pendulum's plates.
     """
 
     m1: float = spec(0.301, "kg", "mass of the upper bob", rule="positive")
@@ -81,6 +88,37 @@ class PendulumParameters(Validated):
     l1: float = spec(0.2964, "m", "length of the upper rod (pivot to upper bob)", rule="positive")
     l2: float = spec(0.1971, "m", "length of the lower rod (upper bob to lower bob)", rule="positive")
     g: float = spec(9.81, "m/s2", "gravitational acceleration", rule="positive")
+    m_rod1: float = spec(0.0, "kg", "mass of the upper rod (uniform plate; 0: massless)", rule="nonnegative")
+    m_rod2: float = spec(0.0, "kg", "mass of the lower rod (uniform plate; 0: massless)", rule="nonnegative")
+    L_rod1: float = spec(
+        0.35, "m", "length of the upper rod's plate, centred between pivot and upper bob", rule="positive"
+    )
+    L_rod2: float = spec(
+        0.25, "m", "length of the lower rod's plate, centred between the two bobs", rule="positive"
+    )
+
+
+SEED_RIGID_LINKS: Mapping[str, float] = MappingProxyType(
+    {"m_rod1": 0.070, "m_rod2": 0.070, "L_rod1": 0.35, "L_rod2": 0.25}
+)
+"""Rod parameters of the seed's pendulum (section 3.1 and 4.2.3 of the report), as start values.
+
+Use ``PendulumParameters(**SEED_RIGID_LINKS)`` or pass them to the FMU with the other start
+values. Assumptions, from the report's words:
+
+* "70 g pro Stab": 70 g per *member*. The upper member is two thin plates, one on each side of
+  the pendulum (35 g each), the lower member one thicker plate: ``m_rod1 = m_rod2 = 0.070`` kg.
+  The report's total "0.7 kg including the acrylic plates" supports this reading: with the bobs'
+  0.598 kg it gives 0.738 kg, where 70 g per plate (three plates) would give 0.808 kg. The
+  rounded 0.7 kg alone would mean about 0.10 kg of acrylic: the rod mass is uncertain by about
+  +-0.03 kg a member.
+* Plate lengths 35 cm (upper) and 25 cm (lower), section 4.2.3; each plate centred between its
+  joints, so with the track's l1 = 0.2964 m and l2 = 0.1971 m it overhangs both joints by
+  2.7 cm and 2.6 cm.
+* Uniform plates, widths neglected (a plate of width w in the swing plane would add
+  m w^2 / 12 to its moment of inertia: 1.5e-5 kg m^2 for w = 5 cm, 0.03 % of J1 and 0.1 % of J2);
+  the bobs' masses m1, m2 are taken as the bobs alone, bearings and screws included.
+"""
 
 
 @dataclass(frozen=True)
@@ -92,7 +130,9 @@ class AirDragParameters(Validated):
     member is two plates 4 mm thick (frontal width 8 mm), the lower one plate 6 mm thick. The
     report gives no bob geometry: each bob's frontal area defaults to the seed's example area
     1.5e-3 m^2 (a 300 g steel cylinder of about 3 cm x 5 cm seen from the side) with c_W = 1
-    (a short cylinder in cross flow at Reynolds numbers of 1e3..1e4).
+    (a short cylinder in cross flow at Reynolds numbers of 1e3..1e4). The rod drag acts over each
+    plate's whole length ``L_rod1``, ``L_rod2`` (:class:`PendulumParameters`), centred between its
+    joints, overhangs included.
     """
 
     air_drag: bool = spec(False, "", "switch: quadratic air drag on the bobs", rule="bool")
@@ -115,6 +155,11 @@ class BearingParameters(Validated):
     function is regularised as tanh(omega / omega_reg). Defaults: c_R = 1e-3 (the seed's range
     0.5e-3 to 1e-3 for ball bearings), r_b = 4 mm (the bore radius of a 608 bearing).
     An optional viscous torque b_v * omega per joint adds to it.
+
+    Bearing drag (``bearing_drag``, its own switch): a load-independent friction torque
+    tau_b tanh(omega / omega_reg) per joint, the drag of the bearing's seals and grease (of the
+    order of 1 N mm for sealed ball bearings), with the same regularisation speed. It dissipates
+    tau_b |omega| tanh(|omega| / omega_reg), booked separately as ``W_bearing_drag``.
     """
 
     bearing_friction: bool = spec(False, "", "switch: rolling friction in both bearings", rule="bool")
@@ -127,6 +172,11 @@ class BearingParameters(Validated):
     )
     b_v1: float = spec(0.0, "N.m.s/rad", "viscous friction of the pivot bearing", rule="nonnegative")
     b_v2: float = spec(0.0, "N.m.s/rad", "viscous friction of the elbow bearing", rule="nonnegative")
+    bearing_drag: bool = spec(
+        False, "", "switch: load-independent drag torque in both bearings (seals, grease)", rule="bool"
+    )
+    tau_b1: float = spec(0.0, "N.m", "load-independent drag torque of the pivot bearing", rule="nonnegative")
+    tau_b2: float = spec(0.0, "N.m", "load-independent drag torque of the elbow bearing", rule="nonnegative")
 
 
 @dataclass(frozen=True)

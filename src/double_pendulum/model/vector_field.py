@@ -7,13 +7,17 @@ With every mechanism off the vector field *is* the frictionless core
 
 State vector: ``[phi1, phi2, omega1, omega2]``, then ``[xs, vxs]`` if the suspension moves
 horizontally, ``[ys, vys]`` if it moves vertically, then the dissipated work ``W_air``,
-``W_bearing``, ``W_suspension`` [J] of each enabled mechanism (integrated powers, so the energy
-budget closes to the integration tolerance).
+``W_bearing``, ``W_bearing_drag``, ``W_suspension`` [J] of each enabled mechanism (integrated
+powers, so the energy budget closes to the integration tolerance).
 
-Equations with the suspension (pivot displaced by ``(xs, ys)`` from its static equilibrium,
-:math:`M_t = M_s + m_1 + m_2`), from the Lagrangian with the pivot coordinates added
-(:math:`T = \tfrac12 M_s |\dot{\vec s}|^2 + \tfrac12 m_1 |\vec v_1|^2 + \tfrac12 m_2 |\vec v_2|^2`,
-:math:`V` = pendulum potential relative to the pivot + :math:`\tfrac12 k_x x_s^2 + \tfrac12 k_y y_s^2`):
+The links carry bobs and, optionally, uniform rods; their mass distribution enters only through
+the coefficients :math:`J_1, J_2, K, S_1, S_2` and the total mass :math:`M = m_1 + m_2 + m_{r1} +
+m_{r2}` of :mod:`double_pendulum.model.links`. Equations with the suspension (pivot displaced by
+``(xs, ys)`` from its static equilibrium, :math:`M_t = M_s + M`), from the Lagrangian with the
+pivot coordinates added (:math:`T = \tfrac12 M_s |\dot{\vec s}|^2 + T_{pendulum}` with the
+pendulum's kinetic energy at absolute velocities, see
+:func:`double_pendulum.model.energy.kinetic_energy_moving_pivot`; :math:`V` = pendulum potential
+relative to the pivot + :math:`\tfrac12 k_x x_s^2 + \tfrac12 k_y y_s^2`):
 
 .. math::
 
@@ -21,13 +25,23 @@ Equations with the suspension (pivot displaced by ``(xs, ys)`` from its static e
     A_{1x} & A_{2x} & M_t & 0\\ A_{1y} & A_{2y} & 0 & M_t \end{pmatrix}
     \begin{pmatrix}\ddot\varphi_1\\ \ddot\varphi_2\\ \ddot x_s\\ \ddot y_s\end{pmatrix} =
     \begin{pmatrix} b_1\\ b_2\\
-    (m_1+m_2) l_1 s_1\omega_1^2 + m_2 l_2 s_2 \omega_2^2 - k_x x_s - c_x \dot x_s + Q_x\\
-    -(m_1+m_2) l_1 c_1\omega_1^2 - m_2 l_2 c_2 \omega_2^2 - k_y y_s - c_y \dot y_s + Q_y \end{pmatrix}
+    S_1 s_1\omega_1^2 + S_2 s_2 \omega_2^2 - k_x x_s - c_x \dot x_s + Q_x\\
+    -S_1 c_1\omega_1^2 - S_2 c_2 \omega_2^2 - k_y y_s - c_y \dot y_s + Q_y \end{pmatrix}
 
-with :math:`A_{1x} = (m_1+m_2) l_1 \cos\varphi_1`, :math:`A_{1y} = (m_1+m_2) l_1 \sin\varphi_1`,
-:math:`A_{2x} = m_2 l_2 \cos\varphi_2`, :math:`A_{2y} = m_2 l_2 \sin\varphi_2`, and :math:`M_{ij}, b_i` as in
+with :math:`A_{1x} = S_1 \cos\varphi_1`, :math:`A_{1y} = S_1 \sin\varphi_1`,
+:math:`A_{2x} = S_2 \cos\varphi_2`, :math:`A_{2y} = S_2 \sin\varphi_2`, :math:`M_{11} = J_1`,
+:math:`M_{12} = K\cos\Delta`, :math:`M_{22} = J_2` and :math:`b_i` as in
 :mod:`double_pendulum.model.dynamics` (including the generalised forces :math:`Q_1, Q_2`). The pivot rows
 are eliminated (Schur complement) and the remaining 2x2 system solved in closed form.
+
+Forces on the bodies: the pivot force is the rate of change of the total momentum of bobs and
+rods minus gravity and air drag (each rod's centre accelerates as the mean of its two joints);
+the elbow carries bob 2 and rod 2. Air drag on a rod acts over its whole plate,
+``l/2 - L_rod/2 .. l/2 + L_rod/2`` from its upper joint, overhangs included (whatever the rod's
+mass). The bearing drag torques :math:`\tau_{b,i}\tanh(\omega_{rel}/\omega_{reg})` are
+generalised forces like the friction torques: :math:`Q_1 = -\tau_p + \tau_e`,
+:math:`Q_2 = -\tau_e` (pivot torque :math:`\tau_p` along :math:`\omega_1`, elbow torque
+:math:`\tau_e` along :math:`\omega_2 - \omega_1`).
 
 Bearing friction torques depend on the joint reaction forces, which depend on the accelerations:
 the coupled system is solved by fixed-point iteration (the map contracts by about
@@ -58,7 +72,8 @@ from typing import TYPE_CHECKING, NamedTuple
 
 from .dynamics import fixed_pivot_vector_field
 from .energy import kinetic_energy_moving_pivot, potential_energy, suspension_energy
-from .forces import bearing_torque, quadratic_drag, rod_drag_integrals
+from .forces import bearing_drag_torque, bearing_torque, quadratic_drag, rod_drag_integrals
+from .links import link_coefficients
 from .parameters import AirDragParameters, BearingParameters, PendulumParameters, SuspensionParameters
 
 if TYPE_CHECKING:
@@ -109,6 +124,8 @@ def state_layout(config: ModelConfig) -> StateLayout:
         names.append("W_air")
     if config.bearing.bearing_friction:
         names.append("W_bearing")
+    if config.bearing.bearing_drag:
+        names.append("W_bearing_drag")
     if s.suspension:
         names.append("W_suspension")
     if config.inputs:
@@ -129,13 +146,18 @@ class Evaluation(NamedTuple):
     p_air: float  # W
     p_bearing: float  # W
     p_suspension: float  # W, dissipated in the suspension dampers
+    p_bearing_drag: float = 0.0  # W, dissipated by the load-independent bearing drag torques
     p_input: float = 0.0  # W, power fed in through the inputs
 
 
 def is_core(config: ModelConfig) -> bool:
     """True if every mechanism is off: the scene is the frictionless fixed-pivot pendulum."""
     return not (
-        config.air.air_drag or config.bearing.bearing_friction or config.suspension.suspension or config.inputs
+        config.air.air_drag
+        or config.bearing.bearing_friction
+        or config.bearing.bearing_drag
+        or config.suspension.suspension
+        or config.inputs
     )
 
 
@@ -148,23 +170,28 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
     p, air, brg, sus = config.pendulum, config.air, config.bearing, config.suspension
     layout = state_layout(config)
     m1, m2, l1, l2, g = p.m1, p.m2, p.l1, p.l2, p.g
-    m12 = m1 + m2
+    lc = link_coefficients(p)
+    j1, j2, k12, fm1, fm2, gs1, gs2 = lc.j1, lc.j2, lc.k, lc.s1, lc.s2, lc.gs1, lc.gs2
+    hr1, hr2 = 0.5 * p.m_rod1, 0.5 * p.m_rod2  # half rod masses (a rod's centre: mean of its joints)
+    rod1_lo, rod1_hi = 0.5 * l1 - 0.5 * p.L_rod1, 0.5 * l1 + 0.5 * p.L_rod1  # plates, from upper joints
+    rod2_lo, rod2_hi = 0.5 * l2 - 0.5 * p.L_rod2, 0.5 * l2 + 0.5 * p.L_rod2
     ix, iy = layout.index("xs"), layout.index("ys")
     has_x, has_y = ix is not None, iy is not None
     has_air = air.air_drag
     has_rods = air.air_drag and air.rod_drag
     has_bearing = brg.bearing_friction
+    has_drag = brg.bearing_drag
     k_bob1 = 0.5 * air.rho_air * air.cw * air.A1
     k_bob2 = 0.5 * air.rho_air * air.cw * air.A2
     kappa1 = 0.5 * air.rho_air * air.cw_rod * air.d_rod1
     kappa2 = 0.5 * air.rho_air * air.cw_rod * air.d_rod2
-    m_t = sus.M_s + m12
+    m_t = sus.M_s + lc.mass
     k_x, k_y, c_x, c_y = sus.k_x, sus.k_y, sus.c_x, sus.c_y
     n = layout.size
-    work_slots = [layout.index(name) for name in ("W_air", "W_bearing", "W_suspension")]
+    work_slots = [layout.index(name) for name in ("W_air", "W_bearing", "W_suspension", "W_bearing_drag")]
     sin, cos, torque = math.sin, math.cos, bearing_torque
-    torque_scale_p = brg.c_R1 * brg.r_b1 * m12 * g + 1e-300
-    torque_scale_e = brg.c_R2 * brg.r_b2 * m2 * g + 1e-300
+    torque_scale_p = brg.c_R1 * brg.r_b1 * lc.mass * g + 1e-300
+    torque_scale_e = brg.c_R2 * brg.r_b2 * lc.mass2 * g + 1e-300
     input_slot = layout.index("W_input")
 
     def evaluate(y: list[float], u: InputValues | None = None) -> Evaluation:
@@ -203,7 +230,7 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
             qx, qy = fext_x, fext_y
             if has_rods:
                 # rod 1: normal n1 = (c1, s1), v_n = vs.n1 + s w1
-                i0, i1, i3 = rod_drag_integrals(vxs * c1 + vys * s1, w1, l1)
+                i0, i1, i3 = rod_drag_integrals(vxs * c1 + vys * s1, w1, rod1_lo, rod1_hi)
                 q1 -= kappa1 * i1
                 qx -= kappa1 * i0 * c1
                 qy -= kappa1 * i0 * s1
@@ -211,7 +238,7 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
                 fext_y -= kappa1 * i0 * s1
                 p_air += kappa1 * i3
                 # rod 2: normal n2 = (c2, s2), v_n = v1.n2 + s w2; dr/dphi1 . n2 = l1 cos(phi1 - phi2)
-                i0, i1, i3 = rod_drag_integrals(v1x * c2 + v1y * s2, w2, l2)
+                i0, i1, i3 = rod_drag_integrals(v1x * c2 + v1y * s2, w2, rod2_lo, rod2_hi)
                 q1 -= kappa2 * i0 * l1 * cd
                 q2 -= kappa2 * i1
                 qx -= kappa2 * i0 * c2
@@ -220,25 +247,33 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
                 fext_y -= kappa2 * i0 * s2
                 p_air += kappa2 * i3
 
+        # load-independent bearing drag: torques along omega1 (pivot) and omega2 - omega1 (elbow)
+        p_drag = 0.0
+        if has_drag:
+            drag_p = bearing_drag_torque(w1, brg.tau_b1, brg.omega_reg)
+            drag_e = bearing_drag_torque(w2 - w1, brg.tau_b2, brg.omega_reg)
+            q1 += drag_e - drag_p
+            q2 -= drag_e
+            p_drag = drag_p * w1 + drag_e * (w2 - w1)
         if u is not None:  # joint torques
             q1 += u.tau1 - u.tau2
             q2 += u.tau2
 
         # mass matrix and right-hand side of the angle equations
-        a11 = m12 * l1 * l1
-        a12 = m2 * l1 * l2 * cd
-        a22 = m2 * l2 * l2
-        b1 = -m2 * l1 * l2 * w2 * w2 * sd - m12 * g * l1 * s1 + q1
-        b2 = m2 * l1 * l2 * w1 * w1 * sd - m2 * g * l2 * s2 + q2
+        a11 = j1
+        a12 = k12 * cd
+        a22 = j2
+        b1 = -k12 * w2 * w2 * sd - gs1 * s1 + q1
+        b2 = k12 * w1 * w1 * sd - gs2 * s2 + q2
         if u is not None:  # fictitious forces of the prescribed pivot acceleration
-            b1 -= m12 * l1 * (c1 * apx + s1 * apy)
-            b2 -= m2 * l2 * (c2 * apx + s2 * apy)
+            b1 -= fm1 * (c1 * apx + s1 * apy)
+            b2 -= fm2 * (c2 * apx + s2 * apy)
         # eliminate the pivot coordinates (Schur complement)
         bx = by = 0.0
         ax1 = ax2 = ay1 = ay2 = 0.0
         if has_x:
-            ax1, ax2 = m12 * l1 * c1, m2 * l2 * c2
-            bx = m12 * l1 * s1 * w1 * w1 + m2 * l2 * s2 * w2 * w2 - k_x * xs - c_x * vxs + qx
+            ax1, ax2 = fm1 * c1, fm2 * c2
+            bx = fm1 * s1 * w1 * w1 + fm2 * s2 * w2 * w2 - k_x * xs - c_x * vxs + qx
             if u is not None:  # the spring and damper act relative to the moving base
                 bx += k_x * xb + c_x * vxb
             a11 -= ax1 * ax1 / m_t
@@ -247,8 +282,8 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
             b1 -= ax1 * bx / m_t
             b2 -= ax2 * bx / m_t
         if has_y:
-            ay1, ay2 = m12 * l1 * s1, m2 * l2 * s2
-            by = -m12 * l1 * c1 * w1 * w1 - m2 * l2 * c2 * w2 * w2 - k_y * ys - c_y * vys + qy
+            ay1, ay2 = fm1 * s1, fm2 * s2
+            by = -fm1 * c1 * w1 * w1 - fm2 * c2 * w2 * w2 - k_y * ys - c_y * vys + qy
             if u is not None:
                 by += k_y * yb + c_y * vyb
             a11 -= ay1 * ay1 / m_t
@@ -271,14 +306,14 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
             acc1y = ays + l1 * (s1 * alpha1 + c1 * w1 * w1)
             acc2x = acc1x + l2 * (c2 * alpha2 - s2 * w2 * w2)
             acc2y = acc1y + l2 * (s2 * alpha2 + c2 * w2 * w2)
-            # force of the pivot on the pendulum: sum m a - gravity - external forces
-            fp_x = m1 * acc1x + m2 * acc2x - fext_x
-            fp_y = m1 * acc1y + m2 * acc2y + m12 * g - fext_y
+            # force of the pivot on the pendulum: sum m a (bobs, rods) - gravity - external forces
+            fp_x = m1 * acc1x + m2 * acc2x + hr1 * (axs + acc1x) + hr2 * (acc1x + acc2x) - fext_x
+            fp_y = m1 * acc1y + m2 * acc2y + hr1 * (ays + acc1y) + hr2 * (acc1y + acc2y) + lc.mass * g - fext_y
             if not has_bearing:
                 break
-            # force of the elbow on the lower bob (the small drag share of rod 2 is neglected)
-            fe_x = m2 * acc2x - f2x
-            fe_y = m2 * acc2y + m2 * g - f2y
+            # force of the elbow on link 2, bob and rod (the small drag share of rod 2 is neglected)
+            fe_x = m2 * acc2x + hr2 * (acc1x + acc2x) - f2x
+            fe_y = m2 * acc2y + hr2 * (acc1y + acc2y) + lc.mass2 * g - f2y
             new_p = torque(math.hypot(fp_x, fp_y), w1, brg.c_R1, brg.r_b1, brg.omega_reg, brg.b_v1)
             new_e = torque(math.hypot(fe_x, fe_y), w2 - w1, brg.c_R2, brg.r_b2, brg.omega_reg, brg.b_v2)
             # Converged to rounding level of the torque scale c_R r_b (m1 + m2) g: near-zero loads carry
@@ -301,7 +336,7 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
         if u is not None:
             p_susp, p_input = _input_powers(
                 (has_x, xs - xb, vxs, vxb, k_x, c_x, fp_x),
-                (has_y, ys - yb, vys, vyb, k_y, c_y, fp_y - m12 * g),
+                (has_y, ys - yb, vys, vyb, k_y, c_y, fp_y - lc.mass * g),
                 u.tau1 * w1 + u.tau2 * (w2 - w1),
             )
         dydt = [0.0] * n
@@ -310,12 +345,12 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
             dydt[ix], dydt[ix + 1] = vxs, axs
         if has_y:
             dydt[iy], dydt[iy + 1] = vys, ays
-        for slot, power in zip(work_slots, (p_air, p_bearing, p_susp)):
+        for slot, power in zip(work_slots, (p_air, p_bearing, p_susp, p_drag)):
             if slot is not None:
                 dydt[slot] = power
         if input_slot is not None:
             dydt[input_slot] = p_input
-        return Evaluation(dydt, alpha1, alpha2, axs, ays, -fp_x, -fp_y, p_air, p_bearing, p_susp, p_input)
+        return Evaluation(dydt, alpha1, alpha2, axs, ays, -fp_x, -fp_y, p_air, p_bearing, p_susp, p_drag, p_input)
 
     return evaluate
 
@@ -381,7 +416,7 @@ def energies(
 ) -> tuple[float, float, float]:
     """Return ``(E_kin, E_pot, E_suspension)`` [J] of state ``y`` (inputs ``u`` at that instant).
 
-    ``E_kin``: both bobs, absolute velocities; ``E_pot``: pendulum potential relative to the pivot,
+    ``E_kin``: bobs and rods, absolute velocities; ``E_pot``: pendulum potential relative to the pivot,
     zero hanging at rest; ``E_suspension``: see :func:`double_pendulum.model.energy.suspension_energy`,
     with the springs stretched by the displacement relative to the base.
     """

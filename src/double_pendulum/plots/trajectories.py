@@ -89,7 +89,11 @@ def plot_energy_per_mechanism(runs: Mapping[str, np.ndarray], path: str | Path) 
 
 def plot_energy_budget_stacked(result: np.ndarray, path: str | Path) -> Path:
     """Where the energy went: stacked E_pendulum, E_suspension and each W_* [J] over time [s]."""
-    names = ("E_pendulum", "E_suspension", "W_air", "W_bearing", "W_suspension")
+    names = tuple(
+        n
+        for n in ("E_pendulum", "E_suspension", "W_air", "W_bearing", "W_bearing_drag", "W_suspension")
+        if n in (result.dtype.names or ())
+    )
     fig, ax = plt.subplots(figsize=(9, 5))
     ax.stackplot(result["time"], *(result[n] for n in names), labels=names, alpha=0.85)
     ax.axhline(result["E_total"][0], color="k", lw=0.8, ls="--", label="E_total(0)")
