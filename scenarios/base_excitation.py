@@ -44,7 +44,7 @@ class Plan:
 FULL = Plan(
     study.KapitzaSetup(),
     study.AchesonSetup(omegas=tuple(np.linspace(60.0, 300.0, 11)), amplitudes=tuple(np.linspace(0.0035, 0.042, 12))),
-    study.ResonanceSetup(),
+    study.ResonanceSetup(n_broad=14),
     None,
 )
 QUICK = Plan(
@@ -83,7 +83,7 @@ def draw(out: Path, kap: study.KapitzaResult, map_rows: list, examples: dict, re
     theory = study.theory_boundaries(curve)
     fig.plot_stability_map(map_rows, curve, {
         "theory, lower bound (slow mode, exact Mathieu)": theory["lower_m"],
-        "theory, averaged a^2 omega^2 = 2 g L_slow": theory["kapitza_m"],
+        "theory, averaged a^2 omega^2 = 2 g L_slow (on the solid line)": theory["kapitza_m"],
         "theory, flutter bound (fast mode, exact Mathieu)": theory["upper_m"]}, out / "acheson_map.png")
     fig.plot_upright_runs({study.example_label(a, r, plan.acheson): r for a, r in examples.items()},
                           out / "acheson_examples.png")

@@ -66,8 +66,8 @@ def plot_stability_map(
     ok = np.array([r["stable"] for r in rows])
     ax.scatter(w[ok], a[ok], s=60, marker="s", color="tab:green", label="simulated: stays upright")
     ax.scatter(w[~ok], a[~ok], s=40, marker="x", color="tab:red", label="simulated: falls over")
-    for (label, values), style in zip(boundaries.items(), ("-", "--", ":")):
-        ax.plot(omega_curve, values * 1e3, "k", ls=style, lw=1.6, label=label)
+    for (label, values), (color, style) in zip(boundaries.items(), (("k", "-"), ("tab:blue", "--"), ("k", ":"))):
+        ax.plot(omega_curve, values * 1e3, color=color, ls=style, lw=1.6, label=label)
     ax.set_xlim(omega_curve[0], omega_curve[-1])
     ax.set_ylim(0, 1.08 * a.max())
     ax.set_xlabel("vibration angular frequency omega [rad/s]")
@@ -117,5 +117,5 @@ def plot_resonance_curve(
     ax.set_ylabel("steady-state amplitude [rad]")
     ax.set_title(f"Resonance curve: pivot torque {torque * 1e3:g} mN m x sin(omega t), viscous pivot bearing"
                  " (dotted: fitted peaks)", fontsize=10)
-    ax.legend(fontsize=8, loc="lower left")
+    ax.legend(fontsize=8, loc="upper right")
     return save(fig, path)
