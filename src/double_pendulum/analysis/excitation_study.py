@@ -43,6 +43,7 @@ from .excitation_theory import (
     kapitza_amplitude,
     mathieu_lower_amplitude,
     mathieu_upper_amplitude,
+    stability_band,
     upright_stable,
     upright_start,
 )
@@ -175,6 +176,12 @@ def wedge_tip_frequency(params: PendulumParameters | None = None) -> float:
     g = params.g
     return brentq(lambda w: mathieu_lower_amplitude(w, l_slow, g) - mathieu_upper_amplitude(w, l_fast, g),
                   20.0, 2000.0)
+
+
+def distance_to_bound(a: float, omega: float, params: PendulumParameters | None = None) -> float:
+    """Relative distance of amplitude ``a`` [m] from the nearer theoretical bound at ``omega`` [rad/s]."""
+    _, lower, upper = stability_band(omega, params or PendulumParameters())
+    return min(abs(a / lower - 1.0), abs(a / upper - 1.0) if upper > 0 else math.inf)
 
 
 def measured_bands(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
