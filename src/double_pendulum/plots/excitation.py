@@ -60,7 +60,7 @@ def plot_stability_map(
 ) -> Path:
     """Upright-stable (green) and falling (red) grid points over frequency [rad/s] and amplitude [mm],
     with the theoretical boundaries (``boundaries``: label -> amplitude [m] on ``omega_curve``)."""
-    fig, ax = plt.subplots(figsize=(10.5, 6))
+    fig, ax = plt.subplots(figsize=(10, 7))
     w = np.array([r["omega_rad_per_s"] for r in rows])
     a = np.array([r["amplitude_m"] for r in rows]) * 1e3
     ok = np.array([r["stable"] for r in rows])
@@ -73,7 +73,7 @@ def plot_stability_map(
     ax.set_xlabel("vibration angular frequency omega [rad/s]")
     ax.set_ylabel("vibration amplitude a [mm]")
     ax.set_title("Inverted double pendulum on a vertically vibrated pivot: upright-stable or falling over")
-    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
     return save(fig, path)
 
 
