@@ -1,0 +1,121 @@
+"""The pendulum driven through its inputs: Kapitza's threshold, Acheson's stability map, resonance curves."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .style import save
+
+
+def _deviation(phi: np.ndarray) -> np.ndarray:
+    """Angle from upright [rad], wrapped into [-pi, pi)."""
+    return np.mod(phi, 2.0 * np.pi) - np.pi
+
+
+def plot_kapitza_threshold(
+    probes: Sequence[Mapping[str, Any]],
+    lines: Mapping[str, float],
+    runs: Mapping[str, np.ndarray],
+    growth_limit: float,
+    theta0: float,
+    path: str | Path,
+) -> Path:
+    """Left: each bisection run's largest tilt over its start tilt against the amplitude [mm], with the
+    threshold lines (``lines``: label -> amplitude [m]). Right: the upper rod's tilt [rad] over time [s]
+    for the runs at the final bracket ends (``runs``: label -> result)."""
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.8))
+    a = np.array([p["amplitude_m"] for p in probes]) * 1e3
+    growth = np.array([p["growth"] for p in probes])
+    stable = np.array([p["stable"] for p in probes])
+    ax.semilogy(a[stable], growth[stable], "o", color="tab:green", label="stayed upright")
+    ax.semilogy(a[~stable], growth[~stable], "x", color="tab:red", ms=8, label="fell over")
+    ax.axhline(growth_limit, color="0.4", lw=0.8, ls=":", label=f"criterion: {growth_limit:g} x start tilt")
+    for (label, value), style in zip(lines.items(), ("--", "-.", "-")):
+        ax.axvline(value * 1e3, color="k", ls=style, lw=1.0, label=f"{label}: {value * 1e3:.3f} mm")
+    ax.set_xlabel("vibration amplitude a [mm]")
+    ax.set_ylabel("largest tilt / start tilt")
+    ax.set_title("Bisection runs through the FMU")
+    ax.legend(fontsize=7.5, loc="upper right", framealpha=0.95)
+    for label, result in runs.items():
+        bx.plot(result["time"], _deviation(result["phi1"]) / theta0, lw=0.8, label=label)
+    bx.set_xlabel("time [s]")
+    bx.set_ylabel("upper rod tilt from upright / start tilt")
+    bx.set_ylim(-2.0, 3 * growth_limit)
+    bx.set_title("Upper rod at the final bracket ends")
+    bx.legend(fontsize=8, loc="upper left")
+    fig.suptitle("Kapitza's inverted pendulum (single-pendulum limit): stability threshold of the upright position")
+    return save(fig, path)
+
+
+def plot_stability_map(
+    rows: Sequence[Mapping[str, Any]],
+    omega_curve: np.ndarray,
+    boundaries: Mapping[str, np.ndarray],
+    path: str | Path,
+) -> Path:
+    """Upright-stable (green) and falling (red) grid points over frequency [rad/s] and amplitude [mm],
+    with the theoretical boundaries (``boundaries``: label -> amplitude [m] on ``omega_curve``)."""
+    fig, ax = plt.subplots(figsize=(10, 7))
+    w = np.array([r["omega_rad_per_s"] for r in rows])
+    a = np.array([r["amplitude_m"] for r in rows]) * 1e3
+    ok = np.array([r["stable"] for r in rows])
+    ax.scatter(w[ok], a[ok], s=60, marker="s", color="tab:green", label="simulated: stays upright")
+    ax.scatter(w[~ok], a[~ok], s=40, marker="x", color="tab:red", label="simulated: falls over")
+    for (label, values), (color, style) in zip(boundaries.items(), (("k", "-"), ("tab:blue", "--"), ("k", ":"))):
+        ax.plot(omega_curve, values * 1e3, color=color, ls=style, lw=1.6, label=label)
+    ax.set_xlim(omega_curve[0], omega_curve[-1])
+    ax.set_ylim(0, 1.08 * a.max())
+    ax.set_xlabel("vibration angular frequency omega [rad/s]")
+    ax.set_ylabel("vibration amplitude a [mm]")
+    ax.set_title("Inverted double pendulum on a vertically vibrated pivot: upright-stable or falling over")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
+    return save(fig, path)
+
+
+def plot_upright_runs(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
+    """Both rods' tilt from upright [rad] over time [s] for a few runs (``runs``: label -> result)."""
+    fig, axes = plt.subplots(len(runs), 1, figsize=(10, 2.4 * len(runs)), sharex=True, squeeze=False)
+    for ax, (label, result) in zip(axes[:, 0], runs.items()):
+        ax.plot(result["time"], _deviation(result["phi1"]), lw=0.8, label="upper rod")
+        ax.plot(result["time"], _deviation(result["phi2"]), lw=0.8, label="lower rod")
+        ax.set_ylabel("tilt [rad]")
+        ax.set_title(label, fontsize=9)
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    axes[-1, 0].set_xlabel("time [s]")
+    fig.suptitle("Inverted double pendulum on a vibrated pivot: tilt from upright (through the FMU)")
+    return save(fig, path)
+
+
+def plot_resonance_curve(
+    rows: Sequence[Mapping[str, Any]],
+    modes: Sequence[float],
+    peaks: Sequence[Mapping[str, Any]],
+    torque: float,
+    path: str | Path,
+) -> Path:
+    """Steady-state amplitudes of both angles [rad] against the drive frequency [rad/s], the
+    small-angle normal modes (vertical lines) and the fitted peaks."""
+    fig, ax = plt.subplots(figsize=(10.5, 5))
+    rows = sorted(rows, key=lambda r: r["omega_rad_per_s"])
+    w = np.array([r["omega_rad_per_s"] for r in rows])
+    for angle, color, label in (("phi1", "tab:blue", "upper rod phi1"), ("phi2", "tab:orange", "lower rod phi2")):
+        ax.semilogy(w, [r[f"{angle}_amplitude_rad"] for r in rows], "o-", ms=3, color=color, label=label)
+    for mode, name in zip(modes, ("slow", "fast")):
+        ax.axvline(mode, color="k", ls="--", lw=0.8)
+        ax.annotate(f"{name} normal mode\n{mode:.3f} rad/s", (mode, 1.0), xycoords=("data", "axes fraction"),
+                    xytext=(4, -28), textcoords="offset points", fontsize=8)
+    for p in peaks:
+        if np.isfinite(p["peak_rad_per_s"]):
+            ax.axvline(p["peak_rad_per_s"], color="tab:blue" if p["angle"] == "phi1" else "tab:orange",
+                       ls=":", lw=0.8)
+    ax.set_xlabel("drive angular frequency omega [rad/s]")
+    ax.set_ylabel("steady-state amplitude [rad]")
+    ax.set_title(f"Resonance curve: pivot torque {torque * 1e3:g} mN m x sin(omega t), viscous pivot bearing"
+                 " (dotted: fitted peaks)", fontsize=10)
+    ax.legend(fontsize=8, loc="upper right")
+    return save(fig, path)
