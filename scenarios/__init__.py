@@ -14,4 +14,5 @@ SCENARIOS: tuple[str, ...] = (
     "work_precision",
     "stability",
     "chaos",
+    "cosimulation",
 )

@@ -16,11 +16,11 @@ import pytest
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.fmu.build import build_fmu, build_systems
 from double_pendulum.fmu.container import write_container
-from double_pendulum.fmu.coupling import FmuSlave, run_jacobi, split_values
+from double_pendulum.fmu.coupling import FmuSlave, run_coupled, split_values
 from double_pendulum.fmu.hosts import simulate_container, simulate_ssp_with_libcosim
 from double_pendulum.fmu.ssp import write_ssp
 
-START = {"phi1_0": 1.0, "phi2_0": 1.0}  # the defaults: see the init-mode note in docs/coupling.md
+START = {"phi1_0": 1.2, "phi2_0": 0.8}
 STOP = 0.2
 STEPS = (4e-3, 2e-3, 1e-3)
 
@@ -56,7 +56,7 @@ def test_build_systems_writes_an_ssp_and_a_container_that_validates(fmus, tmp_pa
 
     for fmu in fmus:
         assert validate_fmu(str(fmu)) == []
-    ssp, container = build_systems(fmus[0].parent)
+    ssp, container = build_systems(fmus[0])
     assert validate_fmu(str(container)) == []
     with zipfile.ZipFile(ssp) as archive:
         names = set(archive.namelist())
@@ -102,24 +102,26 @@ def test_parameters_reach_the_components_on_both_engines(fmus, tmp_path):
         assert rows["phi2"][-1] == pytest.approx(-0.2, abs=1e-3)
 
 
-def test_engines_agree_with_run_jacobi_to_the_coupling_error(fmus, tmp_path):
-    """Same macro step, same Jacobi stepping; the order in which a transfer sets the inputs and the
-    transfers while initialising differ (docs/coupling.md), so agreement is to O(h), not bit-for-bit."""
+def test_engines_step_like_run_coupled_jacobi_sequential(fmus, tmp_path):
+    """Same macro step, same stepping: both engines step the FMUs side by side, then transfer the
+    force first and the motion after it (``jacobi_sequential``). The container equals it to
+    rounding; libcosim's transfers in Initialization Mode differ, so it agrees to about 1e-5 rad,
+    far below the coupling error (1e-3 rad at h = 1 ms). Compared: states (angles, suspension
+    position); direct-feedthrough outputs are read after the engines' transfer."""
     from fmpy import extract, read_model_description
 
-    h = 1e-3
-    pv, sv = split_values(START)
+    h, stop, values = 1e-3, 0.05, {"phi1_0": 0.7, "phi2_0": 1.2}
+    pv, sv = split_values(values)
     slaves = [FmuSlave(extract(str(f)), read_model_description(str(f)), v) for f, v in zip(fmus, (pv, sv))]
     try:
-        jacobi = run_jacobi(*slaves, stop_time=STOP, macro_step=h)
+        sequential = run_coupled(*slaves, stop_time=stop, macro_step=h, scheme="jacobi_sequential")
     finally:
         for slave in slaves:
             slave.close()
-    ssp = write_ssp(tmp_path / "j.ssp", *fmus, START, macro_step=h)
-    container = write_container(tmp_path / "j.fmu", *fmus, START, macro_step=h)
-    libcosim = simulate_ssp_with_libcosim(ssp, stop_time=STOP, macro_step=h)
-    fmpy_rows = simulate_container(container, stop_time=STOP, macro_step=h)
-    for rows in (libcosim, fmpy_rows[1:]):
-        for name in ("phi1", "phi2"):
-            np.testing.assert_allclose(rows[name], jacobi[name][1:], atol=3e-3, err_msg=name)
-        assert np.isfinite(rows["y"]).all()
+    container = write_container(tmp_path / "j.fmu", *fmus, values, macro_step=h)
+    in_container = simulate_container(container, stop_time=stop, macro_step=h)
+    libcosim = simulate_ssp_with_libcosim(write_ssp(tmp_path / "j.ssp", *fmus, values, macro_step=h),
+                                          stop_time=stop, macro_step=h)
+    for name in ("phi1", "phi2", "x", "y"):
+        np.testing.assert_allclose(in_container[name], sequential[name], rtol=0, atol=1e-11, err_msg=name)
+        np.testing.assert_allclose(libcosim[name], sequential[name][1:], rtol=0, atol=2e-5, err_msg=name)

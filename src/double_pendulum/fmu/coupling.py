@@ -18,6 +18,12 @@ steps the two slaves with a fixed macro step ``h`` [s] under one of three scheme
     communication point, which were computed with the inputs of the step before: a delay of one
     macro step on each side. First order in h; unstable for (m1 + m2) / M_s above about 1
     (the added-mass instability, see docs/coupling.md).
+``jacobi_sequential``
+    the slaves still step side by side with held inputs, but the exchange passes the force first
+    and then the suspension's motion, read after the new force was set (its acceleration
+    follows the force at once): the suspension side's delay is gone, the pendulum's remains.
+    This is the order of fmpy's container FMU (connections in the order listed, the force
+    first) and of libcosim here.
 ``extrapolation``
     as ``jacobi``, but each held input is extrapolated linearly from the last two communication
     points to the middle of the step, u = u_n + (u_n - u_{n-1}) / 2 (a second-order hold
@@ -47,7 +53,7 @@ MOTION_CONNECTIONS: tuple[tuple[str, str], ...] = (
     ("x", "pivot_x"), ("y", "pivot_y"), ("vx", "pivot_vx"), ("vy", "pivot_vy"), ("ax", "pivot_ax"), ("ay", "pivot_ay"),
 )  # fmt: skip
 SUSPENSION_PARAMETERS = ("M_s", "k_x", "k_y", "c_x", "c_y")
-SCHEMES = ("jacobi", "extrapolation", "iterative")
+SCHEMES = ("jacobi", "jacobi_sequential", "extrapolation", "iterative")
 PENDULUM_OUTPUTS = ("phi1", "phi2", "E_pendulum", "W_input", "F_pivot_x", "F_pivot_y")
 SUSPENSION_OUTPUTS = ("x", "y", "vx", "vy", "ax", "ay", "E_suspension", "W_suspension", "W_in", "P_in")
 BLOWUP_FACTOR = 1e3
@@ -112,6 +118,12 @@ def write_interface(pendulum: Slave, suspension: Slave, forces: Sequence[float],
         suspension.set_input(target, value)
     for (_, target), value in zip(MOTION_CONNECTIONS, motion):
         pendulum.set_input(target, value)
+
+
+def sequential_exchange(pendulum: Slave, suspension: Slave) -> None:
+    """Pass the pendulum's force to the suspension, then the suspension's motion (now following it) back."""
+    write_interface(pendulum, suspension, read_interface(pendulum, suspension)[0], [])
+    write_interface(pendulum, suspension, [], read_interface(pendulum, suspension)[1])
 
 
 def _extrapolated(now: Sequence[float], before: Sequence[float] | None) -> list[float]:
@@ -226,6 +238,12 @@ def _jacobi_step(pendulum: Slave, suspension: Slave, t: float, h: float) -> None
     suspension.do_step(t, h)
 
 
+def _sequential_step(pendulum: Slave, suspension: Slave, t: float, h: float) -> None:
+    sequential_exchange(pendulum, suspension)
+    pendulum.do_step(t, h)
+    suspension.do_step(t, h)
+
+
 def coupling_energy(row: Mapping[str, float] | np.void) -> float:
     """Energy the coupling has created [J]: W_input (work received by the pendulum) + W_in (done on the mass).
 
@@ -258,7 +276,8 @@ def run_coupled(
         raise ValueError(f"unknown coupling scheme {scheme!r}; choose one of {SCHEMES}")
     names = column_names(pendulum_outputs, suspension_outputs)
     dtype = [("time", np.float64)] + [(n, np.float64) for n in names]
-    stepper = {"jacobi": _jacobi_step, "extrapolation": _Extrapolation().step, "iterative": _Iterative().step}[scheme]
+    stepper = {"jacobi": _jacobi_step, "jacobi_sequential": _sequential_step,
+               "extrapolation": _Extrapolation().step, "iterative": _Iterative().step}[scheme]
     watch_energy = "W_input" in names and "W_in" in names
 
     def row(t: float) -> tuple[float, ...]:

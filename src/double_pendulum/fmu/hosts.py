@@ -115,25 +115,44 @@ def simulate_container(
 ) -> np.ndarray:
     """Run the container FMU (:mod:`double_pendulum.fmu.container`) in fmpy; rows at t = 0, h, 2h, ...
 
-    ``macro_step`` [s] must be the container's fixed step (or a multiple of it). The columns are
-    those of :func:`~double_pendulum.fmu.coupling.run_coupled`. A run that blows up ends in
-    :class:`~double_pendulum.fmu.coupling.CouplingError` with the rows up to the first
-    non-finite or runaway row (fmpy gives back no rows when the container itself fails).
+    The container is an ordinary FMI 2.0 co-simulation FMU to fmpy (``FMU2Slave``); it is stepped
+    with ``doStep(n h, h)``, ``macro_step`` [s] the container's fixed step (or a multiple of it).
+    The columns are those of :func:`~double_pendulum.fmu.coupling.run_coupled`; a failed step or
+    a run that blows up ends in :class:`~double_pendulum.fmu.coupling.CouplingError` with the
+    rows so far.
     """
-    from fmpy import simulate_fmu
+    import shutil
 
-    wanted = [f"DoublePendulum.{n}" for n in pendulum_outputs] + [f"Suspension.{n}" for n in suspension_outputs]
-    try:
-        result = simulate_fmu(str(container_fmu), stop_time=stop_time, output_interval=macro_step, output=wanted)
-    except Exception as error:
-        names = column_names(pendulum_outputs, suspension_outputs)
-        empty = np.zeros(0, dtype=[("time", np.float64)] + [(n, np.float64) for n in names])
-        raise CouplingError(f"container FMU, h = {macro_step:g} s: the run failed: {error}", empty) from error
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(container_fmu))
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    wanted = [refs[f"DoublePendulum.{n}"] for n in pendulum_outputs]
+    wanted += [refs[f"Suspension.{n}"] for n in suspension_outputs]
     names = column_names(pendulum_outputs, suspension_outputs)
     dtype = [("time", np.float64)] + [(n, np.float64) for n in names]
-    rows: list[tuple[float, ...]] = []
     watch = "W_input" in names and "W_in" in names
-    for record in result:
-        rows.append((float(record["time"]), *(float(record[w]) for w in wanted)))
-        check_row(rows, dtype, "container FMU", macro_step, watch, energy_scale)
+    unzipdir = extract(str(container_fmu))
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName="PendulumOnSuspension")
+    rows: list[tuple[float, ...]] = []
+    try:
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        rows.append((0.0, *fmu.getReal(wanted)))
+        for n in range(int(round(stop_time / macro_step))):
+            try:
+                fmu.doStep(currentCommunicationPoint=n * macro_step, communicationStepSize=macro_step)
+            except Exception as error:
+                raise CouplingError(f"container FMU, h = {macro_step:g} s: the step at t = {n * macro_step:.6g} s "
+                                    f"failed: {error}", np.array(rows, dtype=dtype)) from error
+            rows.append(((n + 1) * macro_step, *fmu.getReal(wanted)))
+            check_row(rows, dtype, "container FMU", macro_step, watch, energy_scale)
+        fmu.terminate()
+    finally:
+        fmu.freeInstance()
+        shutil.rmtree(unzipdir, ignore_errors=True)
     return np.array(rows, dtype=dtype)
