@@ -34,7 +34,7 @@ SUSPENSIONS: dict[str, dict[str, float]] = {
     "default": {},  # M_s = 2 kg, k = 2e4 N/m, c = 20 N s/m: omega = 100 rad/s, mu = 0.30
     "light stiff": {"M_s": 0.8, "k_x": 1e5, "k_y": 1e5, "c_x": 28.3, "c_y": 28.3},  # omega = 354 rad/s, mu = 0.75
 }
-IN_PROCESS = ("jacobi", "extrapolation", "iterative")
+IN_PROCESS = ("jacobi", "jacobi_sequential", "extrapolation", "iterative")
 ENGINES = ("libcosim", "container")
 METHODS = IN_PROCESS + ENGINES
 
@@ -113,8 +113,8 @@ def add_errors(rows: list[dict[str, Any]], references: Mapping[tuple[str, str], 
 
 
 def fitted_order(steps: Sequence[float], errors: Sequence[float], floor: float = 1e-12) -> float:
-    """Slope of log(error) over log(h) (least squares), from the finite errors above ``floor``."""
-    pairs = [(h, e) for h, e in zip(steps, errors) if math.isfinite(e) and e > floor]
+    """Slope of log|error| over log(h) (least squares), from the finite |errors| above ``floor``."""
+    pairs = [(h, abs(e)) for h, e in zip(steps, errors) if math.isfinite(e) and abs(e) > floor]
     if len(pairs) < 3:
         return math.nan
     x, y = np.log([p[0] for p in pairs]), np.log([p[1] for p in pairs])
@@ -131,8 +131,8 @@ def orders(rows: list[dict[str, Any]], quantity: str, max_step: float = 5e-3) ->
     return result
 
 
-def stability_run(item: tuple[float, float, float, int]) -> dict[str, Any]:
-    """One point of the stability map ``(mu, h omega, zeta, steps)``: Jacobi in-process, bounded or not.
+def stability_run(item: tuple[float, float, float, int, str]) -> dict[str, Any]:
+    """One point of the stability map ``(mu, h omega, zeta, steps, scheme)``: in-process, bounded or not.
 
     The suspension has omega = 100 rad/s and damping ratio zeta in both axes, M_s = (m1 + m2) / mu;
     the pendulum starts hanging nearly straight (phi1 = 0.1 rad). Unstable: the run blew up
@@ -141,7 +141,7 @@ def stability_run(item: tuple[float, float, float, int]) -> dict[str, Any]:
     """
     from ..model.parameters import PendulumParameters
 
-    mu, h_omega, zeta, steps = item
+    mu, h_omega, zeta, steps, scheme = item
     p = PendulumParameters()
     omega = 100.0
     m_s = (p.m1 + p.m2) / mu
@@ -149,20 +149,22 @@ def stability_run(item: tuple[float, float, float, int]) -> dict[str, Any]:
     values = {"phi1_0": 0.1, "phi2_0": 0.0, "M_s": m_s, "k_x": k, "k_y": k, "c_x": c, "c_y": c}
     h = h_omega / omega
     try:
-        rows = _in_process(values, steps * h, h, "jacobi")
+        rows = _in_process(values, steps * h, h, scheme)
         a = np.hypot(rows["ax"], rows["ay"])
         third = max(1, len(a) // 3)
         growth = float(a[-third:].max() / max(a[:third].max(), 1e-300))
         stable, message = growth < 10.0, ""
     except CouplingError as error:
         growth, stable, message = math.inf, False, str(error)
-    return {"mass_ratio": mu, "h_omega": h_omega, "zeta": zeta, "stable": stable, "growth": growth,
-            "derived_critical_mass_ratio": critical_mass_ratio(h_omega, zeta), "message": message}
+    return {"scheme": scheme, "mass_ratio": mu, "h_omega": h_omega, "zeta": zeta, "stable": stable,
+            "growth": growth, "derived_critical_mass_ratio": critical_mass_ratio(h_omega, zeta, scheme),
+            "message": message}
 
 
-def measured_limit(points: list[dict[str, Any]]) -> dict[float, float]:
+def measured_limit(points: list[dict[str, Any]], scheme: str) -> dict[float, float]:
     """Per h omega, the geometric mean of the largest stable and the smallest unstable mass ratio."""
     result = {}
+    points = [p for p in points if p["scheme"] == scheme]
     for hw in sorted({p["h_omega"] for p in points}):
         col = [p for p in points if p["h_omega"] == hw]
         stable = [p["mass_ratio"] for p in col if p["stable"]]

@@ -33,10 +33,11 @@ def _remedy_table(rows: list[dict[str, Any]]) -> list[str]:
 
 def report_text(summary: dict[str, Any], rows: list[dict[str, Any]]) -> str:
     """Markdown report of one run of the scenario."""
-    st = summary["stability"]
-    limit = ["| h omega | derived mu_c | measured mu_c (between last bounded and first unbounded) |", "|---|---|---|"]
-    for hw, mu_c in st["derived_limit"].items():
-        limit.append(f"| {hw:g} | {_fmt(mu_c)} | {_fmt(st['measured_limit'].get(hw, math.nan))} |")
+    limit = ["| scheme | h omega | derived mu_c | measured mu_c (between last bounded and first unbounded) |",
+             "|---|---|---|---|"]
+    for scheme, st in summary["stability"].items():
+        for hw, mu_c in st["derived_limit"].items():
+            limit.append(f"| {scheme} | {hw:g} | {_fmt(mu_c)} | {_fmt(st['measured_limit'].get(hw, math.nan))} |")
     parts = [
         "# Co-simulation of the pendulum on its suspension",
         "",
