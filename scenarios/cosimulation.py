@@ -37,7 +37,8 @@ FULL = {
     "steps": (1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2),
     "min_step": {"jacobi": 0.0, "jacobi_sequential": 1e-3, "extrapolation": 2e-4, "iterative": 1e-3,
                  "libcosim": 1e-3, "container": 1e-3},
-    "mass_ratios": (0.5, 0.8, 1.25, 2.0), "h_omegas": (0.1, 0.5, 1.0, 2.0), "map_steps": 120, "zeta": 0.05,
+    "mass_ratios": (0.25, 0.4, 0.6, 0.8, 0.9, 1.1, 1.25, 2.0), "h_omegas": (0.1, 0.5, 1.0, 1.5, 2.0),
+    "map_steps": 120, "zeta": 0.05,
 }
 QUICK = {
     "stop": 0.1, "starts": ("regular",), "suspensions": ("default",), "steps": (1e-3, 2e-3, 5e-3),

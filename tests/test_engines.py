@@ -125,3 +125,12 @@ def test_engines_step_like_run_coupled_jacobi_sequential(fmus, tmp_path):
     for name in ("phi1", "phi2", "x", "y"):
         np.testing.assert_allclose(in_container[name], sequential[name], rtol=0, atol=1e-11, err_msg=name)
         np.testing.assert_allclose(libcosim[name], sequential[name][1:], rtol=0, atol=2e-5, err_msg=name)
+
+
+def test_container_parameters_can_be_changed_by_the_host(fmus, tmp_path):
+    from fmpy import simulate_fmu
+
+    container = write_container(tmp_path / "d.fmu", *fmus, macro_step=1e-3)
+    rows = simulate_fmu(str(container), stop_time=2e-3, output_interval=1e-3,
+                        start_values={"DoublePendulum.phi1_0": 2.0, "Suspension.M_s": 3.0})
+    assert rows["DoublePendulum.phi1"][0] == 2.0

@@ -13,10 +13,10 @@ coupling, fixed when the container is written); for each of these steps it passe
 connection's source value to its destination and then steps every component (one after the
 other, or on threads with ``parallelDoStep``): inputs held over the step, Jacobi.
 
-The container exposes, as flat variables named ``<component>.<variable>``, the monolith's start
-values split by :func:`~double_pendulum.fmu.coupling.split_values` as parameters (their values are
-its start values, set on the components at instantiation) and the coupling and energy outputs of
-both components.
+The container exposes, as flat variables named ``<component>.<variable>``, parameters (the
+pendulum's initial state, the suspension's ``M_s, k, c, F_static_y``, and whatever else the
+monolith's start values split by :func:`~double_pendulum.fmu.coupling.split_values` set; their
+start values are those values) and the coupling and energy outputs of both components.
 
 fmpy 0.3.32 writes a connection's ``variableType`` as the FMI 2 type name ("Real") where the
 binary expects FMI 3 names ("Float64", as it writes for variables); :func:`write_container`
@@ -39,6 +39,11 @@ from .coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, S
 SYSTEM_NAME = "PendulumOnSuspension"
 PENDULUM, SUSPENSION = "DoublePendulum", "Suspension"
 FMI3_TYPES = {"Real": "Float64", "Integer": "Int32"}
+EXPOSED_PARAMETERS = {
+    PENDULUM: ("phi1_0", "phi2_0", "omega1_0", "omega2_0"),
+    SUSPENSION: ("M_s", "k_x", "k_y", "c_x", "c_y", "F_static_y"),
+}
+"""Parameters the container always exposes (start: the value given, else the component's own start)."""
 
 
 def _component(fmu: Path) -> Any:
@@ -113,8 +118,9 @@ def configuration(
     pendulum_values, suspension_values = split_values(values)
     for component, start, outputs in ((pendulum, pendulum_values, pendulum_outputs),
                                       (suspension, suspension_values, suspension_outputs)):
-        for name, value in start.items():
-            _expose(md, mappings, component, name, value)
+        own = _variables(component)
+        for name in dict.fromkeys([*EXPOSED_PARAMETERS[component.name], *start]):
+            _expose(md, mappings, component, name, start.get(name, own[name].start))
         for name in outputs:
             _expose(md, mappings, component, name)
     p_vars, s_vars = _variables(pendulum), _variables(suspension)
