@@ -12,7 +12,8 @@ steps the two slaves with a fixed macro step ``h`` [s] under one of three scheme
 (:data:`SCHEMES`):
 
 ``jacobi``
-    what libcosim and fmpy's container FMU do: at t_n both slaves read the other's outputs of
+    what libcosim does (it reads all outputs right after the step, then sets the inputs; plus
+    two more exchanges while initialising: ``initial_exchanges=2``): at t_n both slaves read the other's outputs of
     t_n and step side by side with them held (zero-order hold of the force; the pendulum's own
     second-order hold of the pivot motion). The loop is broken by the outputs of the last
     communication point, which were computed with the inputs of the step before: a delay of one
@@ -22,8 +23,8 @@ steps the two slaves with a fixed macro step ``h`` [s] under one of three scheme
     the slaves still step side by side with held inputs, but the exchange passes the force first
     and then the suspension's motion, read after the new force was set (its acceleration
     follows the force at once): the suspension side's delay is gone, the pendulum's remains.
-    This is the order of fmpy's container FMU (connections in the order listed, the force
-    first) and of libcosim here.
+    This is what fmpy's container FMU does (connections passed in the order listed, the force
+    first, each read when it is passed).
 ``extrapolation``
     as ``jacobi``, but each held input is extrapolated linearly from the last two communication
     points to the middle of the step, u = u_n + (u_n - u_{n-1}) / 2 (a second-order hold
@@ -264,6 +265,7 @@ def run_coupled(
     pendulum_outputs: Sequence[str] = PENDULUM_OUTPUTS,
     suspension_outputs: Sequence[str] = SUSPENSION_OUTPUTS,
     energy_scale: float = 1.0,
+    initial_exchanges: int = 0,
 ) -> np.ndarray:
     """Step two initialised slaves with a fixed macro step [s]; return the rows at each communication point.
 
@@ -271,6 +273,8 @@ def run_coupled(
     (message, rows so far) when a slave fails, a value is not finite, or the coupling energy
     :func:`coupling_energy` exceeds ``BLOWUP_FACTOR * energy_scale`` [J] (when ``W_input`` and
     ``W_in`` are among the outputs): an unstable coupling never ends in silent NaN.
+    ``initial_exchanges``: exchanges of the scheme's kind before the first step's own, as a
+    master may do while initialising (libcosim: 2 with ``jacobi``).
     """
     if scheme not in SCHEMES:
         raise ValueError(f"unknown coupling scheme {scheme!r}; choose one of {SCHEMES}")
@@ -278,6 +282,8 @@ def run_coupled(
     dtype = [("time", np.float64)] + [(n, np.float64) for n in names]
     stepper = {"jacobi": _jacobi_step, "jacobi_sequential": _sequential_step,
                "extrapolation": _Extrapolation().step, "iterative": _Iterative().step}[scheme]
+    for _ in range(initial_exchanges):
+        (sequential_exchange if scheme == "jacobi_sequential" else exchange)(pendulum, suspension)
     watch_energy = "W_input" in names and "W_in" in names
 
     def row(t: float) -> tuple[float, ...]:

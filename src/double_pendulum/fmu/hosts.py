@@ -67,8 +67,10 @@ def simulate_ssp_with_libcosim(
 ) -> np.ndarray:
     """Run the SSP system (:mod:`double_pendulum.fmu.ssp`) in libcosim; return its rows at t = h, 2h, ...
 
-    libcosim's fixed-step algorithm steps both FMUs side by side and then passes the outputs on
-    (Jacobi, inputs held over the step). The columns are those of
+    libcosim's fixed-step algorithm steps both FMUs side by side, reads their outputs and then
+    sets the inputs (Jacobi, inputs held over the step; two more exchanges while initialising):
+    :func:`~double_pendulum.fmu.coupling.run_coupled` with ``scheme="jacobi"`` and
+    ``initial_exchanges=2`` gives the same numbers. The columns are those of
     :func:`~double_pendulum.fmu.coupling.run_coupled`; a run that blows up ends in
     :class:`~double_pendulum.fmu.coupling.CouplingError` with the rows so far.
     """
