@@ -78,6 +78,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict[str, A
         "order_pivot": study.orders(rows, "pivot_error_m"),
         "order_energy": study.orders(rows, "energy_error_J"),
         "order_coupling_energy": study.orders(rows, "coupling_energy_J"),
+        "cheapest_to_1e-4_rad": study.cheapest(rows, 1e-4),
         "unstable_runs": [r["message"] for r in rows if not r["stable"]],
         "stability": {scheme: {"zeta": plan["zeta"], "measured_limit": study.measured_limit(points, scheme),
                                "derived_limit": {hw: critical_mass_ratio(hw, plan["zeta"], scheme)

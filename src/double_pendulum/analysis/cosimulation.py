@@ -172,3 +172,15 @@ def measured_limit(points: list[dict[str, Any]], scheme: str) -> dict[float, flo
         if stable and unstable:
             result[hw] = math.sqrt(max(stable) * min(unstable))
     return result
+
+
+def cheapest(rows: list[dict[str, Any]], target: float = 1e-4) -> dict[str, dict[str, Any]]:
+    """Per case, the stable run with the least CPU time whose angle error is <= ``target`` [rad]."""
+    result = {}
+    for case in sorted({(r["start"], r["suspension"]) for r in rows}):
+        good = [r for r in rows if (r["start"], r["suspension"]) == case and r["stable"]
+                and r["angle_error_rad"] <= target]
+        if good:
+            best = min(good, key=lambda r: r["cpu_s"])
+            result[" / ".join(case)] = {k: best[k] for k in ("method", "macro_step_s", "angle_error_rad", "cpu_s")}
+    return result
