@@ -14,6 +14,7 @@ Outputs in ``results/cosimulation/``: ``runs.csv``, ``stability_map.csv``, ``err
 from __future__ import annotations
 
 import itertools
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -52,7 +53,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict[str, A
     wall = time.perf_counter()
     out_dir = Path(out_dir)
     plan = QUICK if quick else FULL
-    fmus = (str(runner.fmu_path), str(build_fmu(out_dir / "fmus" / "Suspension.fmu", "Suspension")))
+    fmu_dir = tempfile.TemporaryDirectory(prefix="dp_cosimulation_")
+    fmus = (str(runner.fmu_path), str(build_fmu(Path(fmu_dir.name) / "Suspension.fmu", "Suspension")))
 
     # split runs and the monolith per case
     items = [(s, u, m, h, plan["stop"], fmus)
@@ -101,4 +103,5 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict[str, A
     summary["wall_s"] = time.perf_counter() - wall
     write_json(out_dir / "summary.json", summary)
     write_text(out_dir / "report.md", report_text(summary, rows))
+    fmu_dir.cleanup()
     return summary

@@ -75,3 +75,17 @@ def test_measured_stability_agrees_with_the_derived_limit():
 
 def test_fitted_order_ignores_non_finite_and_tiny_errors():
     assert fitted_order((1.0, 2.0, 4.0, 8.0), (1.0, 4.0, 16.0, math.nan)) == pytest.approx(2.0)
+
+
+@pytest.mark.slow
+def test_quick_scenario_writes_csv_plots_summary_and_report(runner, tmp_path):
+    from double_pendulum.scenarios import cosimulation
+
+    summary = cosimulation.run(runner, tmp_path, quick=True)
+    for name in ("runs.csv", "stability_map.csv", "summary.json", "report.md", "error_vs_macro_step.png",
+                 "error_vs_cpu_time.png", "coupling_energy.png", "stability_map.png"):
+        assert (tmp_path / name).is_file(), name
+    assert 1.7 < summary["order_angles"]["regular / default / iterative"] < 2.3
+    for engine in ("jacobi", "libcosim", "container"):
+        assert 0.8 < summary["order_angles"][f"regular / default / {engine}"] < 1.3
+    assert not (tmp_path / "fmus").exists()
