@@ -89,3 +89,15 @@ def test_quick_scenario_writes_csv_plots_summary_and_report(runner, tmp_path):
     for engine in ("jacobi", "libcosim", "container"):
         assert 0.8 < summary["order_angles"][f"regular / default / {engine}"] < 1.3
     assert not (tmp_path / "fmus").exists()
+
+
+def test_libcosim_is_skipped_with_a_reason_when_libcosimpy_is_missing(monkeypatch):
+    import importlib.util
+
+    from double_pendulum.analysis import cosimulation
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "libcosimpy" else real(name, *a))
+    methods, missing = cosimulation.available_methods()
+    assert "libcosim" not in methods and "container" in methods
+    assert "libcosimpy" in missing["libcosim"]

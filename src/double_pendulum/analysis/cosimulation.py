@@ -39,6 +39,16 @@ ENGINES = ("libcosim", "container")
 METHODS = IN_PROCESS + ENGINES
 
 
+def available_methods() -> tuple[list[str], dict[str, str]]:
+    """The methods this installation can run, and why the others cannot (libcosim needs libcosimpy)."""
+    import importlib.util
+
+    if importlib.util.find_spec("libcosimpy") is None:
+        reason = "libcosimpy is not installed (pip install libcosimpy, or the package's [test] extra)"
+        return [m for m in METHODS if m != "libcosim"], {"libcosim": reason}
+    return list(METHODS), {}
+
+
 def case_values(start: str, suspension: str) -> dict[str, float]:
     """The monolith's start values of one case (``suspension`` added by the runs)."""
     return {**STARTS[start], **SUSPENSIONS[suspension]}
