@@ -8,13 +8,13 @@ Connections (no glue: the two FMUs' variables are meant for each other)::
 (the pendulum with its own ``suspension`` off, the suspension's ``F_static_y`` the pendulum's
 weight ``-(m1 + m2) g``: :func:`split_values`). ``F_pivot`` depends directly on ``pivot_a*`` and
 the suspension's acceleration directly on the force: an algebraic loop. :func:`run_coupled`
-steps the two slaves with a fixed macro step ``h`` [s] under one of three schemes
+steps the two slaves with a fixed macro step ``h`` [s] under one of four schemes
 (:data:`SCHEMES`):
 
 ``jacobi``
     what libcosim does (it reads all outputs right after the step, then sets the inputs; plus
-    two more exchanges while initialising: ``initial_exchanges=2``): at t_n both slaves read the other's outputs of
-    t_n and step side by side with them held (zero-order hold of the force; the pendulum's own
+    two more exchanges while initialising: ``initial_exchanges=2``): at t_n both slaves read
+    the other's outputs of t_n and step side by side with them held (zero-order hold of the force; the pendulum's own
     second-order hold of the pivot motion). The loop is broken by the outputs of the last
     communication point, which were computed with the inputs of the step before: a delay of one
     macro step on each side. First order in h; unstable for (m1 + m2) / M_s above about 1
@@ -27,14 +27,16 @@ steps the two slaves with a fixed macro step ``h`` [s] under one of three scheme
     first, each read when it is passed).
 ``extrapolation``
     as ``jacobi``, but each held input is extrapolated linearly from the last two communication
-    points to the middle of the step, u = u_n + (u_n - u_{n-1}) / 2 (a second-order hold
-    estimate of the step's mean at no extra cost).
+    points to the middle of the step, u = u_n + (u_n - u_{n-1}) / 2 (an estimate of the step's
+    mean at no extra cost; the pivot position and velocity stay as sent). Measured: no gain in
+    accuracy, a lower added-mass limit (docs/coupling.md).
 ``iterative``
     implicit coupling: each step is repeated, both slaves rolled back with their FMU state
     (``get_state``/``set_state``, fmi2GetFMUstate/fmi2SetFMUstate), until the suspension's
     acceleration at the end of the step is consistent with the force it produced; the held
     values are the means of the step's start and end values (trapezoidal), the iteration is
-    relaxed with Aitken's factor. Second order; no added-mass limit; costs a few steps a step.
+    relaxed with Aitken's factor. Second order; stable beyond the added-mass limit; costs a few
+    slave steps a macro step (plus the state copies).
 
 The slaves are anything with ``set_input(name, value)``, ``get(name)`` and ``do_step(t, h)``
 (plus ``get_state``/``set_state`` for ``iterative``): the in-process components, or FMUs
