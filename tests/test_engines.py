@@ -137,3 +137,21 @@ def test_container_parameters_can_be_changed_by_the_host(fmus, tmp_path):
     rows = simulate_fmu(str(container), stop_time=2e-3, output_interval=1e-3,
                         start_values={"DoublePendulum.phi1_0": 2.0, "Suspension.M_s": 3.0})
     assert rows["DoublePendulum.phi1"][0] == 2.0
+
+
+def test_an_unstable_split_system_ends_with_a_message_and_its_rows_on_both_engines(fmus, tmp_path):
+    """A suspension lighter than the pendulum ((m1 + m2) / M_s = 2) blows up under Jacobi coupling."""
+    from double_pendulum.fmu.coupling import CouplingError
+
+    light = {"phi1_0": 0.2, "phi2_0": 0.0, "M_s": 0.3, "k_x": 3e3, "k_y": 3e3, "c_x": 0.0, "c_y": 0.0}
+    runs = (
+        lambda: simulate_ssp_with_libcosim(write_ssp(tmp_path / "u.ssp", *fmus, light, macro_step=1e-3),
+                                           stop_time=1.0, macro_step=1e-3),
+        lambda: simulate_container(write_container(tmp_path / "u.fmu", *fmus, light, macro_step=1e-3),
+                                   stop_time=1.0, macro_step=1e-3),
+    )
+    for run in runs:
+        with pytest.raises(CouplingError, match="unstable") as info:
+            run()
+        rows = info.value.rows
+        assert 5 < len(rows) < 1000 and np.isfinite(rows["phi1"]).all()
