@@ -171,8 +171,8 @@ def stability_run(item: tuple[float, float, float, int, str]) -> dict[str, Any]:
             "message": message}
 
 
-def measured_limit(points: list[dict[str, Any]], scheme: str) -> dict[float, float]:
-    """Per h omega, the geometric mean of the largest stable and the smallest unstable mass ratio."""
+def measured_limit(points: list[dict[str, Any]], scheme: str) -> dict[float, tuple[float, float]]:
+    """Per h omega, the bracket of the limit: (largest bounded, smallest unbounded mass ratio above it)."""
     result = {}
     points = [p for p in points if p["scheme"] == scheme]
     for hw in sorted({p["h_omega"] for p in points}):
@@ -180,7 +180,7 @@ def measured_limit(points: list[dict[str, Any]], scheme: str) -> dict[float, flo
         stable = [p["mass_ratio"] for p in col if p["stable"]]
         unstable = [p["mass_ratio"] for p in col if not p["stable"] and p["mass_ratio"] > max(stable, default=0)]
         if stable and unstable:
-            result[hw] = math.sqrt(max(stable) * min(unstable))
+            result[hw] = (max(stable), min(unstable))
     return result
 
 

@@ -37,7 +37,9 @@ def report_text(summary: dict[str, Any], rows: list[dict[str, Any]]) -> str:
              "|---|---|---|---|"]
     for scheme, st in summary["stability"].items():
         for hw, mu_c in st["derived_limit"].items():
-            limit.append(f"| {scheme} | {hw:g} | {_fmt(mu_c)} | {_fmt(st['measured_limit'].get(hw, math.nan))} |")
+            bracket = st["measured_limit"].get(hw)
+            measured = f"{bracket[0]:g} - {bracket[1]:g}" if bracket else "-"
+            limit.append(f"| {scheme} | {hw:g} | {_fmt(mu_c)} | {measured} |")
     parts = [
         "# Co-simulation of the pendulum on its suspension",
         "",
