@@ -114,9 +114,33 @@ class ComponentSlave(Fmi2Slave):
                 causality=Fmi2Causality.output,
                 variability=Fmi2Variability.continuous,
                 description=var.description,
-                getter=lambda: self._sim.outputs[name],
+                getter=lambda: self._output(name),
             )
         self.register_variable(variable)
+
+    def _output(self, name: str) -> float:
+        """Output ``name``; before fmi2ExitInitializationMode from the parameters and inputs set so far.
+
+        FMI 2.0 lets a master read outputs in Initialization Mode (libcosim and fmpy's container
+        FMU pass them on to other FMUs there); they must then follow the start values already
+        set, not the defaults. A throwaway component initialised with those values gives them.
+        """
+        if self._sim.initialised:
+            return self._sim.outputs[name]
+        return self._preview().outputs[name]
+
+    def _preview(self):
+        key = repr((sorted(self._sim.values.items()), sorted(self._sim.inputs.items()), self._sim.time))
+        if getattr(self, "_preview_key", None) != key:
+            preview = self.make_component()
+            for parameter, value in self._sim.values.items():
+                preview.set(parameter, value)
+            preview.set_start_time(self._sim.time)
+            preview.initialise()
+            for input_name, value in self._sim.inputs.items():
+                preview.set_input(input_name, value)
+            self._preview_key, self._preview_sim = key, preview
+        return self._preview_sim
 
     def setup_experiment(self, start_time, stop_time=None, tolerance=None):
         self._guarded(self._sim.set_start_time, start_time)

@@ -14,5 +14,6 @@ SCENARIOS: tuple[str, ...] = (
     "work_precision",
     "stability",
     "chaos",
+    "cosimulation",
     "base_excitation",
 )

@@ -26,6 +26,8 @@ def test_build_writes_the_fmu(tmp_path):
     assert main(["build", "-o", str(target)]) == 0
     assert target.is_file()
     assert (target.parent / "Suspension.fmu").is_file()  # every FMU, next to DoublePendulum
+    assert (target.parent / "PendulumOnSuspension.ssp").is_file()  # and the coupled system
+    assert (target.parent / "PendulumOnSuspension.fmu").is_file()
 
 
 def test_run_free_swing_writes_csv_plots_and_summary(fmu_path, tmp_path):

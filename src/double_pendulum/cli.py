@@ -191,8 +191,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p_build = sub.add_parser("build", help="build DoublePendulum.fmu and, next to it, Suspension.fmu",
-                             description="Build DoublePendulum.fmu and, next to it, Suspension.fmu.")
+    p_build = sub.add_parser("build", help="build DoublePendulum.fmu, Suspension.fmu and the coupled system",
+                             description="Build DoublePendulum.fmu and, next to it, Suspension.fmu, "
+                             "PendulumOnSuspension.ssp (SSP, for libcosim) and PendulumOnSuspension.fmu "
+                             "(fmpy's container FMU).")
     p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="DoublePendulum FMU path or folder")
     p_build.set_defaults(func=cmd_build)
 

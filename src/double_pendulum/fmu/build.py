@@ -217,11 +217,31 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
 
 
 def build_all(dest: str | Path = DEFAULT_FMU_PATH) -> list[Path]:
-    """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it."""
+    """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it,
+    then the coupled system (:func:`build_systems`)."""
     dest = Path(dest)
     first = build_fmu(dest, MODEL_IDENTIFIER)
     others = [build_fmu(first.parent / f"{name}.fmu", name) for name in INTERFACES if name != MODEL_IDENTIFIER]
-    return [first, *others]
+    return [first, *others, *build_systems(first)]
+
+
+def build_systems(
+    pendulum_fmu: str | Path, values: dict | None = None, macro_step: float = 1e-3
+) -> list[Path]:
+    """Write the coupled system next to the built FMUs: ``PendulumOnSuspension.ssp`` (SSP, for libcosim)
+    and ``PendulumOnSuspension.fmu`` (fmpy's container FMU, FMI 2.0), macro step ``macro_step`` [s].
+
+    ``pendulum_fmu``: the DoublePendulum FMU; ``Suspension.fmu`` is expected next to it.
+    """
+    from .container import write_container
+    from .ssp import write_ssp
+
+    folder = Path(pendulum_fmu).parent
+    fmus = (Path(pendulum_fmu), folder / "Suspension.fmu")
+    return [
+        write_ssp(folder / "PendulumOnSuspension.ssp", *fmus, values, macro_step=macro_step),
+        write_container(folder / "PendulumOnSuspension.fmu", *fmus, values, macro_step=macro_step),
+    ]
 
 
 def fmu_is_current(fmu_path: str | Path, model_identifier: str = MODEL_IDENTIFIER) -> bool:

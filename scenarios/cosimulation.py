@@ -1,0 +1,109 @@
+"""Scenario ``cosimulation``: the pendulum on its suspension, monolithic against split into two FMUs.
+
+Runs the monolith (reference) and the split system (in-process Jacobi, linear extrapolation,
+iterative coupling with rollback; libcosim on the SSP file; fmpy's container FMU) over macro steps
+from 1e-4 s to 2e-2 s for a regular and a chaotic start and two suspensions, and maps where Jacobi
+coupling stays bounded over mass ratio and h omega against the derived added-mass limit
+(analysis: :mod:`~double_pendulum.analysis.cosimulation`,
+:mod:`~double_pendulum.analysis.coupling_stability`; figures: :mod:`~double_pendulum.plots.coupling`).
+
+Outputs in ``results/cosimulation/``: ``runs.csv``, ``stability_map.csv``, ``error_vs_macro_step.png``,
+``error_vs_cpu_time.png``, ``coupling_energy.png``, ``stability_map.png``, ``summary.json``, ``report.md``.
+"""
+
+from __future__ import annotations
+
+import itertools
+import tempfile
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from double_pendulum.analysis import cosimulation as study
+from double_pendulum.analysis.cosimulation_report import report_text
+from double_pendulum.analysis.coupling_stability import critical_mass_ratio
+from double_pendulum.analysis.sweep import parallel_map
+from double_pendulum.fmu.build import build_fmu
+from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.plots import coupling as plots
+from double_pendulum.results_io import write_json, write_table_csv, write_text
+
+MAP_SCHEMES = ("jacobi", "jacobi_sequential")
+DESCRIPTION = "pendulum on suspension split into two FMUs: coupling error, energy and added-mass stability"
+
+FULL = {
+    "stop": 0.3, "starts": tuple(study.STARTS), "suspensions": tuple(study.SUSPENSIONS),
+    "steps": (1e-4, 2e-4, 5e-4, 1e-3, 2e-3, 5e-3, 1e-2, 2e-2),
+    "min_step": {"jacobi": 0.0, "jacobi_sequential": 1e-3, "extrapolation": 2e-4, "iterative": 1e-3,
+                 "libcosim": 1e-3, "container": 1e-3},
+    "mass_ratios": (0.25, 0.4, 0.6, 0.8, 0.9, 1.1, 1.25, 2.0), "h_omegas": (0.1, 0.5, 1.0, 1.5, 2.0),
+    "map_steps": 120, "zeta": 0.05,
+}
+QUICK = {
+    "stop": 0.1, "starts": ("regular",), "suspensions": ("default",), "steps": (1e-3, 2e-3, 5e-3),
+    "min_step": {m: 0.0 for m in study.METHODS},
+    "mass_ratios": (0.7, 1.4), "h_omegas": (0.3,), "map_steps": 60, "zeta": 0.05,
+}
+
+
+def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict[str, Any]:
+    """Run the plan, write CSVs, figures, summary and report (see the module docstring)."""
+    wall = time.perf_counter()
+    out_dir = Path(out_dir)
+    plan = QUICK if quick else FULL
+    fmu_dir = tempfile.TemporaryDirectory(prefix="dp_cosimulation_")
+    fmus = (str(runner.fmu_path), str(build_fmu(Path(fmu_dir.name) / "Suspension.fmu", "Suspension")))
+
+    # split runs and the monolith per case
+    methods, missing = study.available_methods()
+    items = [(s, u, m, h, plan["stop"], fmus)
+             for s, u, m, h in itertools.product(plan["starts"], plan["suspensions"], methods, plan["steps"])
+             if h >= plan["min_step"][m]]
+    rows, workers = parallel_map(study.split_run, items, label="cosimulation", max_workers=None if not quick else 1)
+    references = {(s, u): study.monolith(study.case_values(s, u), plan["stop"])
+                  for s, u in itertools.product(plan["starts"], plan["suspensions"])}
+    study.add_errors(rows, references)
+
+    # stability map against the derived limit
+    map_items = [(mu, hw, plan["zeta"], plan["map_steps"], scheme) for scheme, mu, hw in
+                 itertools.product(MAP_SCHEMES, plan["mass_ratios"], plan["h_omegas"])]
+    points, _ = parallel_map(study.stability_run, map_items, label="stability map",
+                             max_workers=None if not quick else 1)
+    h_omega = np.geomspace(0.03, 3.0, 40)
+    curves = {scheme: (h_omega, np.array([critical_mass_ratio(hw, plan["zeta"], scheme) for hw in h_omega]))
+              for scheme in MAP_SCHEMES}
+
+    summary = {
+        "scenario": "cosimulation", "quick": quick, "stop_time_s": plan["stop"], "workers": workers,
+        "skipped_methods": missing,
+        "order_angles": study.orders(rows, "angle_error_rad"),
+        "order_pivot": study.orders(rows, "pivot_error_m"),
+        "order_energy": study.orders(rows, "energy_error_J"),
+        "order_coupling_energy": study.orders(rows, "coupling_energy_J"),
+        "cheapest_to_1e-4_rad": study.cheapest(rows, 1e-4),
+        "unstable_runs": [r["message"] for r in rows if not r["stable"]],
+        "stability": {scheme: {"zeta": plan["zeta"], "measured_limit": study.measured_limit(points, scheme),
+                               "derived_limit": {hw: critical_mass_ratio(hw, plan["zeta"], scheme)
+                                                 for hw in plan["h_omegas"]},
+                               "derived_limit_small_step": 1.0} for scheme in MAP_SCHEMES},
+        "cpu_s_by_method": {m: sum(r["cpu_s"] for r in rows if r["method"] == m) for m in methods},
+    }
+    write_table_csv(out_dir / "runs.csv", rows)
+    write_table_csv(out_dir / "stability_map.csv", points)
+    plots.plot_against(rows, "macro_step_s", "angle_error_rad", out_dir / "error_vs_macro_step.png",
+                       xlabel="macro step h [s]", ylabel="angle error at the stop time [rad]",
+                       title="Coupling error against macro step (reference: monolithic FMU)")
+    plots.plot_against(rows, "cpu_s", "angle_error_rad", out_dir / "error_vs_cpu_time.png",
+                       xlabel="CPU time of the run [s]", ylabel="angle error at the stop time [rad]",
+                       title="Coupling error against CPU time")
+    plots.plot_against(rows, "macro_step_s", "coupling_energy_J", out_dir / "coupling_energy.png",
+                       xlabel="macro step h [s]", ylabel="|energy created by the coupling| W_input + W_in [J]",
+                       title="Energy the coupling creates or destroys")
+    plots.plot_stability_map(points, curves, out_dir / "stability_map.png")
+    summary["wall_s"] = time.perf_counter() - wall
+    write_json(out_dir / "summary.json", summary)
+    write_text(out_dir / "report.md", report_text(summary, rows))
+    fmu_dir.cleanup()
+    return summary

@@ -1,0 +1,63 @@
+"""Figures of the ``cosimulation`` scenario: coupling error, cost, energy, stability map."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .style import save
+
+MARKERS = {"jacobi": "o", "jacobi_sequential": "v", "extrapolation": "s", "iterative": "^", "libcosim": "x",
+           "container": "+"}
+
+
+def _cases(rows: list[dict[str, Any]]) -> list[tuple[str, str]]:
+    return sorted({(r["start"], r["suspension"]) for r in rows})
+
+
+def plot_against(rows: list[dict[str, Any]], x: str, y: str, path: str | Path, *, xlabel: str, ylabel: str,
+                 title: str) -> Path:
+    """One panel per case: ``y`` over ``x`` (log-log) for every method, stable runs only."""
+    cases = _cases(rows)
+    ncols = min(2, len(cases))
+    nrows = (len(cases) + ncols - 1) // ncols
+    fig, axes = plt.subplots(nrows, ncols, figsize=(5.0 * ncols + 2.0, 3.8 * nrows + 0.6), squeeze=False)
+    axes = [list(axes.flat)]
+    for ax, case in zip(axes[0], cases):
+        for method, marker in MARKERS.items():
+            sel = sorted((r[x], abs(r[y])) for r in rows if (r["start"], r["suspension"]) == case
+                         and r["method"] == method and r["stable"] and abs(r[y]) > 0)
+            if sel:
+                ax.loglog(*zip(*sel), marker=marker, label=method)
+        ax.set_title(f"{case[0]} start, {case[1]} suspension", fontsize=9)
+        ax.set_xlabel(xlabel)
+        ax.grid(True, which="both", alpha=0.3)
+    for ax in axes[0][::ncols]:
+        ax.set_ylabel(ylabel)
+    axes[0][ncols - 1].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    fig.suptitle(title)
+    return save(fig, path)
+
+
+def plot_stability_map(points: list[dict[str, Any]], curves: dict[str, tuple[np.ndarray, np.ndarray]],
+                       path: str | Path) -> Path:
+    """Per scheme: bounded (dots) and blown-up (crosses) runs over h omega and mass ratio, with the derived limit."""
+    fig, axes = plt.subplots(1, len(curves), figsize=(5.0 * len(curves) + 1.5, 4.5), squeeze=False, sharey=True)
+    for ax, (scheme, curve) in zip(axes[0], curves.items()):
+        for stable, marker, color, label in ((True, "o", "tab:green", "bounded"), (False, "x", "tab:red", "blows up")):
+            sel = [(p["h_omega"], p["mass_ratio"]) for p in points if p["stable"] == stable and p["scheme"] == scheme]
+            if sel:
+                ax.scatter(*zip(*sel), marker=marker, color=color, label=f"measured: {label}")
+        ax.plot(*curve, color="k", label="derived limit (rigid vertical load)")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("macro step x suspension frequency, h omega [1]")
+        ax.set_title(f"{scheme} (zero-order hold)", fontsize=10)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0][0].set_ylabel("mass ratio (m1 + m2) / M_s [1]")
+    axes[0][-1].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    fig.suptitle("Added-mass stability of explicit coupling (damping ratio 0.05)")
+    return save(fig, path)
