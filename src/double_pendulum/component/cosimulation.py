@@ -156,7 +156,8 @@ class DoublePendulumCoSimulation:
         self.initialised = False
         self.integrator: Integrator | None = None
         self.model: Model = build_model(ModelConfig())
-        self.outputs: Mapping[str, float] = {}
+        self._outputs: Mapping[str, float] = {}
+        self._outputs_stale = False
         self.initial_energy: float | None = None
         self.inputs: dict[str, float] = dict.fromkeys(INPUT_NAMES, 0.0)
         self.driven = False  # the model with inputs is running (from the first non-zero input on)
@@ -196,9 +197,22 @@ class DoublePendulumCoSimulation:
         if self.initialised:
             if not self.driven:
                 self._start_driving()
+            self._outputs_stale = True  # recomputed when read: a host sets several inputs per step
+
+    @property
+    def outputs(self) -> Mapping[str, float]:
+        """The outputs at the current communication point, with the inputs as now set."""
+        if self._outputs_stale:
+            self._outputs_stale = False
             new = self._input_values()
             y = self._with_jump_work(self._y, self._hold.at(self.time), new)  # as it will be booked
-            self.outputs = self._outputs_at(y, new)
+            self._outputs = self._outputs_at(y, new)
+        return self._outputs
+
+    @outputs.setter
+    def outputs(self, values: Mapping[str, float]) -> None:
+        self._outputs = values
+        self._outputs_stale = False
 
     def _input_values(self) -> InputValues:
         return InputValues(**self.inputs)
