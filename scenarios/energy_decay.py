@@ -49,7 +49,7 @@ DESCRIPTION = "energy decay of the real pendulum from the seed's camera track (T
 def _plots(rec: Reconstruction, m: np.ndarray, sigma: np.ndarray, fits: list[FitResult], out_dir: Path) -> None:
     """``energy_decay.png`` (energy with errors ``sigma`` on the fitted frames ``m``, fitted curves) and
     ``circle_fit.png``."""
-    t_curve, curves, exp_label = decay_curves(fits, float(rec.t[-1]))
+    t_curve, curves, best_label = decay_curves(fits, float(rec.t[-1]))
     plots.plot_energy_decay(
         rec.t,
         rec.energy,
@@ -58,7 +58,7 @@ def _plots(rec: Reconstruction, m: np.ndarray, sigma: np.ndarray, fits: list[Fit
         t_curve,
         out_dir / "energy_decay.png",
         used=m,
-        residual_curve=exp_label,
+        residual_curve=best_label,
     )
     g = rec.geometry
     plots.plot_circle_fit(

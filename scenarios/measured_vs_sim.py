@@ -59,6 +59,7 @@ from double_pendulum.analysis.track_comparison import (
     reconstructed_state,
     rod_floor_summary,
     rod_length_floor,
+    run_title,
     simulated_coordinates,
     start_fit_summary,
     window_sensitivity,
@@ -92,8 +93,9 @@ def _plots(
 ) -> None:
     """``coordinates.png`` (track and runs in the track's coordinates) and ``prediction_error.png``."""
     t, measured = measured_coordinates(rec, i0, n_frames)
-    runs = {p.label: simulated_coordinates(rec, p) for p in predictions}
-    plots.plot_track_comparison(t, measured, runs, out_dir / "coordinates.png", starts={"t0": float(rec.t[i0])})
+    runs = {run_title(p.label): simulated_coordinates(rec, p) for p in predictions}
+    starts = {"start time t0 of the predictions": float(rec.t[i0])}
+    plots.plot_track_comparison(t, measured, runs, out_dir / "coordinates.png", starts=starts)
     plots.plot_prediction_errors(
         error_curves(predictions, spread),
         list(THRESHOLDS_M),
