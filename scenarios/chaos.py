@@ -127,7 +127,7 @@ def lyapunov(out: Path, plan: Plan, params: PendulumParameters) -> dict:
     cmp = lyapunov_study.compare_integrations(pendulum_field(params), starts, plan.lyap_t_end, METHODS, renorm=RENORM)
     write_results_csv(out / "lyapunov_convergence.csv", *lyapunov_study.convergence_table(cmp))
     curves = lyapunov_study.convergence_curves(cmp, "starts within 5 mm")
-    plots.plot_lyapunov_convergence(curves, out / "lyapunov_convergence.png", title="largest exponent, default start")
+    plots.plot_lyapunov_convergence(curves, out / "lyapunov_convergence.png", title="default start")
     return lyapunov_study.largest_exponent_summary(cmp, "dop853", "starts within 5 mm")
 
 

@@ -93,6 +93,8 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
         "model_comparison": comparison_table(fits),
         "weighting_variants": weighting_variants(rec, m),
         "seed": seed_comparison(main),
+        "null_means": {"chi2_red": "not defined for this fit: its errors are relative weights (scaled to the "
+                                   "scatter), not absolute errors"},
     }
     write_results_csv(out_dir / "track.csv", track_table(rec, on_all_frames(errors.sigma, m)), TRACK_CSV_UNITS)
     _plots(rec, m, errors.sigma, fits, out_dir)

@@ -55,6 +55,7 @@ from double_pendulum.analysis.track_comparison import (
     model_summary,
     model_values,
     nearest_frame,
+    null_means,
     predict,
     reconstructed_state,
     rod_floor_summary,
@@ -140,6 +141,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "ensemble_size": ensemble_size,
         "track_rod_length_floor": rod_floor_summary(rec, i0, n_frames),
         "rms_error_first_second_m": {p.label: {"lower_bob": p.rms_lower_bob_error(1.0)} for p in predictions},
+        "null_means": null_means((n_frames - 1) * FRAME_INTERVAL),
     }
     if not quick:
         summary["fit_window_sensitivity"] = window_sensitivity(runner, rec, i0, values, n_frames, WINDOW_SENSITIVITY)

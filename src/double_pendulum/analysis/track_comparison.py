@@ -188,8 +188,15 @@ def chaos_spread(
 
 
 def chaos_horizons(spread: tuple[np.ndarray, np.ndarray]) -> dict[str, float | None]:
-    """First time [s] the ensemble's spread exceeds each of :data:`THRESHOLDS_M` (None: never)."""
-    return {f"{100 * th:g}cm": horizon(*spread, th) for th in THRESHOLDS_M}
+    """First time [s] the ensemble's spread of the lower bob exceeds each of :data:`THRESHOLDS_M`, keyed like
+    ``lower_bob_1cm_s`` (None: not within the prediction window, see :func:`null_means`)."""
+    return {f"lower_bob_{100 * th:g}cm_s": horizon(*spread, th) for th in THRESHOLDS_M}
+
+
+def null_means(prediction_s: float) -> dict[str, str]:
+    """What a null horizon in the summary means, by summary key."""
+    never = f"the error or spread did not exceed the threshold within the {prediction_s:.1f} s prediction window"
+    return {"horizons_s": never, "chaos_horizons_s": never, "fit_window_sensitivity": never}
 
 
 def window_sensitivity(
