@@ -45,9 +45,9 @@ def plot_lower_mass_traces(
     for ax in axes[n + 1:]:
         ax.set_visible(False)
     for ax in grid[-1]:
-        ax.set_xlabel("x2 [m]")
+        ax.set_xlabel("lower bob x2 [m]")
     for ax in grid[:, 0]:
-        ax.set_ylabel("y2 [m]")
+        ax.set_ylabel("lower bob y2 [m]")
     if title:
         fig.suptitle(f"paths of the lower bob: {title}")
     return save(fig, path)
@@ -71,9 +71,9 @@ def plot_ensemble_clouds(
     for ax in axes[n:]:
         ax.set_visible(False)
     for ax in grid[-1]:
-        ax.set_xlabel("x2 [m]")
+        ax.set_xlabel("lower bob x2 [m]")
     for ax in grid[:, 0]:
-        ax.set_ylabel("y2 [m]")
+        ax.set_ylabel("lower bob y2 [m]")
     fig.suptitle(f"lower bob of every ensemble member at a few times: {title}" if title
                  else "lower bob of every ensemble member at a few times")
     return save(fig, path)

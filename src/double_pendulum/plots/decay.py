@@ -262,7 +262,8 @@ def plot_force_spectrum(
         ax.set_xlabel("angular frequency omega [rad/s]")
         ax.grid(alpha=0.3, which="both")
     axes[0].set(ylabel="force power spectral density S_F [N^2 s/rad]", title="pivot force spectrum (fixed pivot)")
-    axes[1].set(ylabel="omega^2 S_F [N^2/(s rad)]", title="spectrum of dF/dt (what a stiff damper sees)")
+    axes[1].set(ylabel="spectral density of dF/dt, omega^2 S_F [N^2/(s rad)]",
+                title="spectrum of dF/dt (what a stiff damper sees)")
     legend_below(fig, *axes[0].get_legend_handles_labels(), ncols=2)
     for ax in axes:
         top = max(float(np.max(line.get_ydata())) for line in ax.get_lines() if len(line.get_ydata()) > 2)

@@ -29,7 +29,8 @@ def plot_track_comparison(
             ax.plot(ts, coords[name], lw=1.2, label=f"simulated: {label}")
         for label, t0 in (starts or {}).items():
             ax.axvline(t0, color="0.5", ls=":", lw=0.8, label=label)
-        ax.set(ylabel=f"{name} [m]")
+        bob = {"1": "upper", "2": "lower"}.get(name[-1:])
+        ax.set(ylabel=f"{bob} bob {name} [m]" if bob else f"{name} [m]")
         ax.grid(alpha=0.3)
     axes[0, 0].set_title("bob coordinates: measured track and FMU predictions from the same start time")
     axes[-1, 0].set_xlabel("t [s]")
