@@ -99,9 +99,9 @@ def plot_energy_per_mechanism(runs: Mapping[str, np.ndarray], path: str | Path) 
     """E_total [J] over time [s] for each run, log scale (straight lines mean exponential decay)."""
     fig, ax = plt.subplots(figsize=(9, 5))
     for label, r in runs.items():
-        ax.semilogy(r["time"], r["E_total"], label=label)
+        ax.semilogy(r["time"], r["E_total"], label=label.replace("_", " "))
     ax.set(xlabel="t [s]", ylabel="total energy E_total [J]",
-           title="energy of the pendulum and its suspension, one loss mechanism at a time")
+           title="energy of the pendulum and its suspension: each loss mechanism alone, and all together")
     legend_outside(ax)
     ax.grid(alpha=0.3, which="both")
     return save(fig, path)
