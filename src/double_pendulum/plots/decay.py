@@ -77,8 +77,9 @@ def plot_circle_fit(
     ax = axes[0]
     phi = np.arctan2(x1[valid], -y1[valid])
     ang = np.linspace(phi.min() - 0.3, phi.max() + 0.3, 200)
-    ax.plot(x2[valid], y2[valid], ".", ms=1.5, alpha=0.5, label="lower bob")
-    ax.plot(x1[valid], y1[valid], ".", ms=1.5, label="upper bob")
+    for x, y, label, alpha in ((x2, y2, "lower bob", 0.5), (x1, y1, "upper bob", 1.0)):
+        dots = ax.plot(x[valid], y[valid], ".", ms=1.5, alpha=alpha)[0]
+        ax.plot([], [], ".", ms=7, color=dots.get_color(), label=label)  # a legend marker large enough to see
     ax.plot(l1 * np.sin(ang), -l1 * np.cos(ang), "k-", lw=0.6, label=f"fit, l1 = {1e3 * l1:.1f} mm")
     if not valid.all():
         ax.plot(x1[~valid], y1[~valid], "rx", ms=5, label=f"flagged frames ({np.count_nonzero(~valid)})")

@@ -35,13 +35,14 @@ def legend_outside(ax: plt.Axes, *, fontsize: float = 8, **kwargs) -> Legend | N
 
 
 def legend_below(
-    fig: plt.Figure, handles: Sequence[Artist], labels: Sequence[str], *, ncols: int = 3, fontsize: float = 9
+    fig: plt.Figure, handles: Sequence[Artist], labels: Sequence[str], *, ncols: int = 3, fontsize: float = 9,
+    **kwargs,
 ) -> Legend | None:
     """One legend for the whole figure, centred under its axes (``save`` crops to include it)."""
     if not handles:
         return None
     return fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncols=ncols,
-                      fontsize=fontsize, frameon=False)
+                      fontsize=fontsize, frameon=False, **kwargs)
 
 
 def running_mean(values: np.ndarray, width: int) -> np.ndarray:
