@@ -10,7 +10,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import patheffects
 from matplotlib.colors import Normalize
-from scipy.interpolate import RegularGridInterpolator
+from scipy.interpolate import PchipInterpolator, interp1d
 
 from .style import legend_below, legend_outside, running_mean, save
 
@@ -109,18 +109,24 @@ def smooth_log_field(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``b`` (shape (len(k), len(c))) interpolated on an ``n`` x ``n`` grid, logarithmic in k and c, for display.
 
-    The interpolation runs over (log k, log c), on log(-b) where every b is negative (decay), else on b;
-    piecewise cubic monotone (PCHIP) with at least 4 points per axis, otherwise linear, so the field has no
-    overshoots. Returns the display k, c (1-D) and the field (n, n).
+    The interpolation runs over (log k, log c), on log(-b) where every b is negative (decay), else on b:
+    piecewise cubic monotone (PCHIP, no overshoots) along log k, then along log c (a tensor product,
+    vectorised); linear along an axis with fewer than 3 points. Returns the display k, c (1-D) and the
+    field (n, n).
     """
     lk, lc, b = np.log(np.asarray(k, float)), np.log(np.asarray(c, float)), np.asarray(b, float)
     decaying = bool(np.all(b < 0.0))
     values = np.log(-b) if decaying else b
-    method = "pchip" if min(lk.size, lc.size) >= 4 else "linear"
-    interp = RegularGridInterpolator((lk, lc), values, method=method)
     gk, gc = np.linspace(lk[0], lk[-1], n), np.linspace(lc[0], lc[-1], n)
-    field = interp(np.stack(np.meshgrid(gk, gc, indexing="ij"), axis=-1))
+    field = _interp_axis(_interp_axis(values, lk, gk, axis=0), lc, gc, axis=1)
     return np.exp(gk), np.exp(gc), -np.exp(field) if decaying else field
+
+
+def _interp_axis(values: np.ndarray, x: np.ndarray, x_new: np.ndarray, axis: int) -> np.ndarray:
+    """``values`` interpolated along ``axis`` from ``x`` to ``x_new``: PCHIP with 3 or more points, else linear."""
+    if x.size >= 3:
+        return PchipInterpolator(x, values, axis=axis)(x_new)
+    return interp1d(x, values, axis=axis)(x_new)
 
 
 def _panel_order(panels: Mapping[str, Mapping[str, np.ndarray]]) -> list[str]:
