@@ -173,7 +173,7 @@ def _mark_points(
         ax.plot(ks, c0 * (ks / k0) ** 2, color="orange", lw=1.4, label="c ~ k^2 through the identified point "
                 "(stiff limit)")
     for (label, (k, c)), marker in zip((points or {}).items(), "o^sDv"):
-        ax.plot([k], [c], marker, color="r", mec="k", ms=8, label=label)
+        ax.plot([k], [c], marker, color="r", mec="k", ms=8, label=label, clip_on=False, zorder=5)
 
 
 def _unique_handles(axes) -> tuple[list, list[str]]:
