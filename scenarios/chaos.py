@@ -88,12 +88,13 @@ def fmu_runs(runner: FmuRunner, out: Path, plan: Plan, params: PendulumParameter
     wall = time.perf_counter() - start
     for label, result in zip(releases, results):
         write_results_csv(out / f"{label}.csv", result, runner.units)
-    drawn = {f"{k} (phi1_0 = {releases[k]['phi1_0']:.4f} rad)": r for k, r in zip(list(releases)[1:], results[1:4])}
+    drawn = {f"{k.replace('_', ' ')} (phi1_0 = {releases[k]['phi1_0']:.4f} rad)": r
+             for k, r in zip(list(releases)[1:], results[1:4])}
     t_part, where = predictability.lower_bob_parting(list(drawn.values()), THRESHOLDS[0])
     t_show = min(t_part + 3.0, plan.fmu_stop)
     plots.plot_lower_mass_traces(
         predictability.lower_bob_traces(drawn, t_show), out / "release_traces.png", diverge=where,
-        title=f"three releases drawn with sigma = 5 mm: traces until {t_show:.1f} s; arrow: 1 cm apart",
+        title=f"three releases drawn with sigma = 5 mm, until {t_show:.1f} s; red arrow: where they part by 1 cm",
     )
     portraits = {"regular (phi1 = phi2 = 0.5 rad)": results[4], "chaotic (default start)": results[0]}
     plots.plot_phase_portraits(portraits, out / "phase_portraits.png")
@@ -113,7 +114,7 @@ def ensembles(out: Path, plan: Plan, params: PendulumParameters, lyapunov: float
     spreads = {f"sigma = {s * 1e3:g} mm": res.spread.spread[:, j] for j, s in enumerate(res.sigmas)}
     plots.plot_ensemble_spread(res.spread.times, spreads, THRESHOLDS, out / "ensemble_spread.png")
     plots.plot_ensemble_clouds(res.spread.snapshots, out / "ensemble_clouds.png", title=f"{plan.members} releases, "
-                               f"upper bob uncertain by sigma = {START_UNCERTAINTY * 1e3:g} mm: lower bob")
+                               f"upper bob's start uncertain by sigma = {START_UNCERTAINTY * 1e3:g} mm")
     horizons = {f"spread > {d * 100:g} cm": res.horizons[d] for d in THRESHOLDS}
     plots.plot_predictability(res.sigmas, horizons, lyapunov, out / "predictability.png")
     return predictability.predictability_summary(res, lyapunov)
@@ -126,7 +127,7 @@ def lyapunov(out: Path, plan: Plan, params: PendulumParameters) -> dict:
     cmp = lyapunov_study.compare_integrations(pendulum_field(params), starts, plan.lyap_t_end, METHODS, renorm=RENORM)
     write_results_csv(out / "lyapunov_convergence.csv", *lyapunov_study.convergence_table(cmp))
     curves = lyapunov_study.convergence_curves(cmp, "starts within 5 mm")
-    plots.plot_lyapunov_convergence(curves, out / "lyapunov_convergence.png", title="largest exponent, default start")
+    plots.plot_lyapunov_convergence(curves, out / "lyapunov_convergence.png", title="default start")
     return lyapunov_study.largest_exponent_summary(cmp, "dop853", "starts within 5 mm")
 
 
@@ -172,7 +173,8 @@ def flip_map(out: Path, plan: Plan, params: PendulumParameters) -> dict:
 
 def poincare(out: Path, plan: Plan, params: PendulumParameters) -> dict:
     """Sections phi1 = 0, omega1 > 0 at a regular energy and at the default start's energy."""
-    releases = {"regular: E of phi1 = phi2 = 0.5 rad": (0.5, 0.5), "chaotic: E of the default start": PHI0}
+    releases = {"regular, energy of a rest start at phi1 = phi2 = 0.5 rad": (0.5, 0.5),
+                "chaotic, energy of the default start": PHI0}
     sections = {label: phase_space.poincare_at_energy(pendulum_field(params), phase_space.rest_energy(*phi, params),
                                                       plan.poincare_starts, params, t_end=plan.poincare_t_end, h=H)
                 for label, phi in releases.items()}

@@ -49,7 +49,7 @@ DESCRIPTION = "energy decay of the real pendulum from the seed's camera track (T
 def _plots(rec: Reconstruction, m: np.ndarray, sigma: np.ndarray, fits: list[FitResult], out_dir: Path) -> None:
     """``energy_decay.png`` (energy with errors ``sigma`` on the fitted frames ``m``, fitted curves) and
     ``circle_fit.png``."""
-    t_curve, curves, exp_label = decay_curves(fits, float(rec.t[-1]))
+    t_curve, curves, best_label = decay_curves(fits, float(rec.t[-1]))
     plots.plot_energy_decay(
         rec.t,
         rec.energy,
@@ -58,7 +58,7 @@ def _plots(rec: Reconstruction, m: np.ndarray, sigma: np.ndarray, fits: list[Fit
         t_curve,
         out_dir / "energy_decay.png",
         used=m,
-        residual_curve=exp_label,
+        residual_curve=best_label,
     )
     g = rec.geometry
     plots.plot_circle_fit(
@@ -93,6 +93,8 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
         "model_comparison": comparison_table(fits),
         "weighting_variants": weighting_variants(rec, m),
         "seed": seed_comparison(main),
+        "null_means": {"chi2_red": "not defined for this fit: its errors are relative weights (scaled to the "
+                                   "scatter), not absolute errors"},
     }
     write_results_csv(out_dir / "track.csv", track_table(rec, on_all_frames(errors.sigma, m)), TRACK_CSV_UNITS)
     _plots(rec, m, errors.sigma, fits, out_dir)

@@ -55,10 +55,12 @@ from double_pendulum.analysis.track_comparison import (
     model_summary,
     model_values,
     nearest_frame,
+    null_means,
     predict,
     reconstructed_state,
     rod_floor_summary,
     rod_length_floor,
+    run_title,
     simulated_coordinates,
     start_fit_summary,
     window_sensitivity,
@@ -92,8 +94,9 @@ def _plots(
 ) -> None:
     """``coordinates.png`` (track and runs in the track's coordinates) and ``prediction_error.png``."""
     t, measured = measured_coordinates(rec, i0, n_frames)
-    runs = {p.label: simulated_coordinates(rec, p) for p in predictions}
-    plots.plot_track_comparison(t, measured, runs, out_dir / "coordinates.png", starts={"t0": float(rec.t[i0])})
+    runs = {run_title(p.label): simulated_coordinates(rec, p) for p in predictions}
+    starts = {"start time t0 of the predictions": float(rec.t[i0])}
+    plots.plot_track_comparison(t, measured, runs, out_dir / "coordinates.png", starts=starts)
     plots.plot_prediction_errors(
         error_curves(predictions, spread),
         list(THRESHOLDS_M),
@@ -138,6 +141,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "ensemble_size": ensemble_size,
         "track_rod_length_floor": rod_floor_summary(rec, i0, n_frames),
         "rms_error_first_second_m": {p.label: {"lower_bob": p.rms_lower_bob_error(1.0)} for p in predictions},
+        "null_means": null_means((n_frames - 1) * FRAME_INTERVAL),
     }
     if not quick:
         summary["fit_window_sensitivity"] = window_sensitivity(runner, rec, i0, values, n_frames, WINDOW_SENSITIVITY)

@@ -32,6 +32,7 @@ from double_pendulum.analysis.stability_cases import (
     new_row,
     report,
     run_length,
+    summary_rows,
     worst_passing,
 )
 from double_pendulum.fmu.runner import FmuRunError, FmuRunner
@@ -77,7 +78,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "quick": quick,
         "cases": len(rows),
         "passed": sum(r["passed"] for r in rows),
-        "rows": rows,
+        "rows": summary_rows(rows),
     }
     write_json(out_dir / "summary.json", summary)
     return summary

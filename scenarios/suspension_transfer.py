@@ -78,6 +78,18 @@ class Plan:
     max_workers: int | None
 
 
+NULL_MEANS = {
+    "resonant_end": "not traced: the quick run skips the valley, or the measured b is not crossed at the map's "
+                    "smallest c",
+    "k_range_within_N_per_m": "no map cell within the tolerance",
+    "c_range_within_N_s_per_m": "no map cell within the tolerance",
+    "largest_share_within_per_s": "no map cell within the tolerance",
+    "ratio_fmu_to_prediction": "the prediction is zero or undefined in that cell",
+    "stiffest_k_reaching_N_per_m": "no k on the map reaches the measured b",
+}
+"""What a null in ``summary.json`` means, by key (write_json writes non-finite numbers and None as null)."""
+
+
 def _k_grid(exponents: Sequence[int]) -> tuple[float, ...]:
     """Stiffnesses 2e4 * 10^(n/5) N/m: the default k and steps of 1.585 around it."""
     return tuple(DEFAULT_SUSPENSION.k_x * 10.0 ** (n / 5.0) for n in exponents)
@@ -161,6 +173,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "energy_flow": {label: energy_flow_summary(f) for label, f in flows.items()},
         "map_runs": int(sum(d.b.size + 1 for d in maps)),
         "map_wall_time_s": map_wall,
+        "null_means": NULL_MEANS,
     }
 
     write_results_csv(out_dir / "decay_rate_map.csv", study.map_table(maps, spectrum.m12), MAP_UNITS)

@@ -72,10 +72,10 @@ def test_decay_curves_start_at_the_fitted_and_the_seeds_energy():
     t = np.arange(300) * FRAME_INTERVAL
     e = 0.7 * np.exp(-0.03 * t) * (1 + 0.01 * np.sin(7 * t))
     fits = fit_all(t, e, np.full(t.size, 0.005), absolute_sigma=True)
-    t_curve, curves, exp_label = ds.decay_curves(fits, 10.0)
+    t_curve, curves, best_label = ds.decay_curves(fits, 10.0)
     assert t_curve[0] == 0.0 and t_curve[-1] == 10.0 and len(t_curve) == ds.CURVE_POINTS
-    assert exp_label.startswith("exponential (dAIC ")
-    assert next(iter(curves)).endswith("(dAIC 0.0)")  # the best model first
+    assert best_label == next(iter(curves)) and best_label.endswith("(dAIC 0.0)")  # residuals against the best
+    exp_label = next(k for k in curves if k.startswith("exponential (dAIC "))
     assert curves[exp_label][0] == pytest.approx(0.7, rel=0.01)
     seed = curves["seed: 0.813 J exp(-0.024 t)"]
     assert seed[0] == SEED_FIT["a_J"] and seed[-1] == pytest.approx(0.813 * math.exp(-0.24))

@@ -20,7 +20,8 @@ METHODS = {"dop853": chaos.Integration("dop853", rtol=1e-10, atol=1e-12), "rk4_h
 def test_checkpoints_take_the_running_estimate_at_the_nearest_renormalisation_time():
     times = 0.5 * np.arange(1, 41)  # up to 20 s
     running = 1.0 / times
-    assert lyapunov_study.convergence_checkpoints(times, running) == {"5": 0.2, "10": 0.1, "20": 0.05}
+    assert lyapunov_study.convergence_checkpoints(times, running) == {
+        "lambda_per_s_after_5_s": 0.2, "lambda_per_s_after_10_s": 0.1, "lambda_per_s_after_20_s": 0.05}
 
 
 def test_standard_error_is_the_sample_deviation_over_root_n():

@@ -76,12 +76,12 @@ def test_chaos_horizons_and_error_curves():
     t = np.arange(5) * FRAME_INTERVAL
     spread = (t, np.array([1e-4, 1e-3, 0.02, 0.04, 0.2]))
     assert tc.chaos_horizons(spread) == {
-        "1cm": pytest.approx(2 * FRAME_INTERVAL),
-        "5cm": pytest.approx(4 * FRAME_INTERVAL),
+        "lower_bob_1cm_s": pytest.approx(2 * FRAME_INTERVAL),
+        "lower_bob_5cm_s": pytest.approx(4 * FRAME_INTERVAL),
     }
     runs = [_prediction([0.0], [0.0], "a"), _prediction([0.0], [0.0], "b")]
     curves = tc.error_curves(runs, spread)
-    assert list(curves)[:3] == ["a: lower bob", "b: lower bob", "b: both (larger)"]  # both bobs for the last run only
+    assert list(curves)[:3] == ["a: lower bob", "b: lower bob", "b: larger of both bobs"]  # both: last run only
     assert curves[list(curves)[-1]] is spread
     assert tc.errors_units(runs)["e2_b"] == "m"
 
@@ -139,7 +139,7 @@ def _cause_summary(observed, chaos):
             "seed_start_identified": same,
             "seed_start_frictionless": {"lower_bob_5cm_s": 1.25},
         },
-        "chaos_horizons_s": {"5cm": chaos},
+        "chaos_horizons_s": {"lower_bob_5cm_s": chaos},
     }
 
 
@@ -148,6 +148,9 @@ def test_cause_is_model_error_when_chaos_allows_more_than_twice_the_observed_hor
     assert "about 0.2 kg of acrylic rods" in cause_text(_cause_summary(0.4, None))
     assert "start's uncertainty limits it" in cause_text(_cause_summary(0.6, 1.0))
     assert cause_text(_cause_summary(0.6, 1.0)).endswith("by at most 0.25 s.")
+    same = _cause_summary(0.6, 1.0)
+    same["horizons_s"]["seed_start_frictionless"] = {"lower_bob_5cm_s": 1.0}
+    assert cause_text(same).endswith("leave the seed-start horizons unchanged (to the frame).")  # not "0.00 s"
     assert fmt_horizon(None, 2.0) == "> 2.0" and fmt_horizon(0.123, 2.0) == "0.12"
 
 

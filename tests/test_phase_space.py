@@ -61,4 +61,4 @@ def test_poincare_section_at_an_energy_starts_and_stays_on_that_energy_surface()
     assert summary["start_energy_relative_error"] < 1e-14
     np.testing.assert_allclose(section.points[:, 0], 0.0, atol=1e-12)
     label, (phi2, omega2, owner) = next(iter(phase_space.section_points({"regular": section}).items()))
-    assert label == f"regular = {energy:.3f} J" and phi2.shape == omega2.shape == owner.shape
+    assert label == f"regular: E = {energy:.3f} J" and phi2.shape == omega2.shape == owner.shape

@@ -9,7 +9,13 @@ import numpy as np
 import pytest
 
 from double_pendulum import results_io
-from double_pendulum.results_io import read_results_csv, write_json, write_results_csv
+from double_pendulum.results_io import (
+    read_results_csv,
+    read_table_csv,
+    write_json,
+    write_results_csv,
+    write_table_csv,
+)
 
 
 def _result():
@@ -60,3 +66,13 @@ def test_table_from_columns_flattens_grids_into_float_columns_that_round_trip(tm
     back = read_results_csv(tmp_path / "t.csv")
     assert back.dtype.names == table.dtype.names
     np.testing.assert_array_equal(back["E_0"], table["E_0"])
+
+
+def test_record_table_round_trip_types_the_cells(tmp_path):
+    rows = [{"case": "a, b", "solver": "rk4", "fixed_step": 0.01, "steps": 3, "passed": True, "message": ""},
+            {"case": "c", "solver": "dop853", "rtol": 1e-8, "steps": 7, "passed": False, "message": "x: y"}]
+    path = write_table_csv(tmp_path / "table.csv", rows)
+    back = read_table_csv(path)
+    assert back[0] == {"case": "a, b", "solver": "rk4", "fixed_step": 0.01, "steps": 3, "passed": True,
+                       "message": None, "rtol": None}
+    assert back[1]["rtol"] == 1e-8 and back[1]["fixed_step"] is None and back[1]["passed"] is False

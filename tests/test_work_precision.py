@@ -73,7 +73,8 @@ def test_timing_and_failure_columns():
     assert wp.timing_columns([0.0]) == {"cpu_time_s": 0.0, "cpu_spread": 0.0}
     unstable = wp.failure_columns(RuntimeError("doStep failed. FMU says: numerical instability at t = 1 s"))
     assert unstable == {"status": "unstable", "message": "numerical instability at t = 1 s"}
-    assert wp.failure_columns(RuntimeError("x" * 300)) == {"status": "failed", "message": "x" * 200}
+    long = "doStep failed: " + "word " * 60
+    assert wp.failure_columns(RuntimeError(long)) == {"status": "failed", "message": "word " * 60}  # never cut
 
 
 def test_best_per_band_takes_the_fastest_run_within_each_bound_above_the_floor():
@@ -88,10 +89,13 @@ def test_best_per_band_takes_the_fastest_run_within_each_bound_above_the_floor()
         {"case": "other", "status": "ok", "solver": "rk4", "max_error": 0.0, "cpu_time_s": 0.0},
     ]
     best = wp.best_per_band(rows, "r", floor=1e-11)
-    assert [None if b is None else b["solver"] for b in best.values()] == ["rk4", "dop853", "dop853"]
-    assert best["1e-06"]["rtol"] == 1e-8 and best["1e-09"]["rtol"] == 1e-10
-    assert wp.best_per_band(rows, "r", floor=1e-8)["1e-09"] is None  # below the reference floor
+    assert list(best) == ["max_error_le_1e-3", "max_error_le_1e-6", "max_error_le_1e-9"]
+    assert [b["solver"] for b in best.values()] == ["rk4", "dop853", "dop853"]
+    assert best["max_error_le_1e-6"]["rtol"] == 1e-8 and best["max_error_le_1e-9"]["rtol"] == 1e-10
+    assert best["max_error_le_1e-3"]["fixed_step_s"] == 0.01 and "rtol" not in best["max_error_le_1e-3"]
+    below = wp.best_per_band(rows, "r", floor=1e-8)["max_error_le_1e-9"]
+    assert below == {"reached": False, "reason": "below the reference error floor 1.0e-08"}
     text = wp.report(rows, {"r": wp.best_per_band(rows, "r", floor=1e-8)}, {"r": 1e-8}, quick=True)
-    assert "| 0.001 | rk4 | h 0.01 s | 0.01 | 5.0e-04 | 0.010 |" in text
-    assert "| 1e-09 | (none reached it, or below the reference floor) | | | | |" in text
-    assert "- euler 0.01: unstable: " in text
+    assert "| 1e-3 | rk4 | h 0.01 s | 0.01 | 5.0e-04 | 0.010 |" in text
+    assert "| 1e-9 | none: below the reference error floor 1.0e-08 | - | - | - | - |" in text
+    assert "| euler | h 0.01 s | 0.01 | unstable |" in text

@@ -106,7 +106,13 @@ def write_text(path: str | Path, text: str) -> Path:
 
 
 def write_table_csv(path: str | Path, rows: list[Mapping[str, Any]]) -> Path:
-    """Write a list of records as CSV (columns: the union of the keys, in first-seen order)."""
+    """Write a list of records as CSV (columns: the union of the keys, in first-seen order).
+
+    A record table, not a time series: it has text columns (case, solver, status, message), booleans
+    (``True``/``False``) and empty cells where a column does not apply (e.g. ``rtol`` of a fixed-step
+    solver). Read it back with :func:`read_table_csv` or ``pandas.read_csv``; ``fmpy.util.read_csv``
+    and :func:`read_results_csv` read only the numeric CSVs of :func:`write_results_csv`.
+    """
     import csv
     import io
 
@@ -121,3 +127,26 @@ def write_table_csv(path: str | Path, rows: list[Mapping[str, Any]]) -> Path:
     path = Path(path)
     _atomic_write_text(path, buffer.getvalue())
     return path
+
+
+def _table_value(text: str) -> Any:
+    """A cell of :func:`write_table_csv` as a value: None (empty), bool, int, float or the text itself."""
+    if text == "":
+        return None
+    if text in ("True", "False"):
+        return text == "True"
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def read_table_csv(path: str | Path) -> list[dict[str, Any]]:
+    """Read a record table written by :func:`write_table_csv`: one dict per row, cells typed
+    (:func:`_table_value`), empty cells as None."""
+    import csv
+
+    with open(path, newline="") as fh:
+        return [{k: _table_value(v) for k, v in row.items()} for row in csv.DictReader(fh)]

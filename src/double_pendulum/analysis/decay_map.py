@@ -254,7 +254,7 @@ def monotonic_rows(dmap: DecayMap) -> dict[str, Any]:
     for i, k in enumerate(dmap.k):
         j_peak = int(np.argmin(dmap.b[i]))
         rising = bool(np.all(np.diff(dmap.b[i, : j_peak + 1]) < 0.0))
-        out[f"{k:.0f}"] = {"c_at_largest_loss": float(dmap.c[j_peak]), "monotonic_below_it": rising}
+        out[k_key(k)] = {"c_at_largest_loss": float(dmap.c[j_peak]), "monotonic_below_it": rising}
     return out
 
 
@@ -290,6 +290,16 @@ def contour_points_at(dmap: DecayMap, k: float, level: float) -> list[tuple[floa
     return row_crossings(dmap.c, (1.0 - f) * dmap.b[i] + f * dmap.b[i + 1], level)
 
 
+def k_key(k: float) -> str:
+    """Summary key of a per-stiffness entry: 20000 N/m -> ``"k_20000_N_per_m"``."""
+    return f"k_{k:.0f}_N_per_m"
+
+
+def k_of_key(key: str) -> float:
+    """The stiffness [N/m] of a :func:`k_key`."""
+    return float(key.removeprefix("k_").removesuffix("_N_per_m"))
+
+
 # --- checks of the map against the physics -------------------------------------------------------
 
 
@@ -316,7 +326,7 @@ def law_agreement(
         "k_range_within_N_per_m": [float(k[ki].min()), float(k[ki].max())] if ok.any() else None,
         "c_range_within_N_s_per_m": [float(c[ci].min()), float(c[ci].max())] if ok.any() else None,
         "largest_share_within_per_s": float(np.max(-share[ok])) if ok.any() else None,
-        "rows_within": {f"{kk:.0f}": [float(cc) for cc, o in zip(c, row) if o] for kk, row in zip(k, ok)},
+        "rows_within": {k_key(kk): [float(cc) for cc, o in zip(c, row) if o] for kk, row in zip(k, ok)},
     }
 
 
@@ -325,8 +335,8 @@ def reach(dmap: DecayMap, level: float) -> dict[str, Any]:
     best = dmap.b.min(axis=1)
     reached = dmap.k[best <= level]
     return {
-        "most_negative_b_per_k": {f"{k:.0f}": float(b) for k, b in zip(dmap.k, best)},
-        "c_of_most_negative_b": {f"{k:.0f}": float(dmap.c[j]) for k, j in zip(dmap.k, dmap.b.argmin(axis=1))},
+        "most_negative_b_per_k": {k_key(k): float(b) for k, b in zip(dmap.k, best)},
+        "c_of_most_negative_b": {k_key(k): float(dmap.c[j]) for k, j in zip(dmap.k, dmap.b.argmin(axis=1))},
         "stiffest_k_reaching_N_per_m": float(reached.max()) if reached.size else None,
     }
 

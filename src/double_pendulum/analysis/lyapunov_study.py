@@ -29,8 +29,10 @@ CHECKPOINTS = (5, 10, 20, 50, 100, 200)  # s, averaging times at which convergen
 
 
 def convergence_checkpoints(times: np.ndarray, running: np.ndarray) -> dict[str, float]:
-    """The running estimate [1/s] at the renormalisation time nearest each of :data:`CHECKPOINTS` reached."""
-    return {f"{t:g}": float(running[np.argmin(np.abs(times - t))]) for t in CHECKPOINTS if t <= times[-1]}
+    """The running estimate [1/s] at the renormalisation time nearest each of :data:`CHECKPOINTS` reached,
+    keyed by the averaging time (``"lambda_per_s_after_5_s"``)."""
+    return {f"lambda_per_s_after_{t:g}_s": float(running[np.argmin(np.abs(times - t))])
+            for t in CHECKPOINTS if t <= times[-1]}
 
 
 def standard_error(values: np.ndarray) -> float:

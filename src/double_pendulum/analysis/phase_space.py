@@ -115,4 +115,5 @@ def section_summary(section: Section, params: PendulumParameters) -> dict:
 
 def section_points(sections: Mapping[str, Section]) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
     """``(phi2 [rad], omega2 [rad/s], owner)`` of each labelled section, labelled with its energy, for plotting."""
-    return {f"{label} = {s.energy:.3f} J": (s.points[:, 1], s.points[:, 3], s.owner) for label, s in sections.items()}
+    return {f"{label}: E = {s.energy:.3f} J": (s.points[:, 1], s.points[:, 3], s.owner)
+            for label, s in sections.items()}

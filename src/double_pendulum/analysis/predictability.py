@@ -196,4 +196,14 @@ def predictability_summary(result: Predictability, lyapunov: float) -> dict:
         "horizon_slope_per_ln_sigma_s": horizon_slopes(result.sigmas, result.horizons),
         "one_over_lyapunov_s": 1.0 / lyapunov if lyapunov > 0 else None,
         "wall_time_s": result.wall_time,
+        "null_means": predictability_null_means(float(result.spread.times[-1])),
     }
+
+
+def predictability_null_means(t_end: float) -> dict[str, str]:
+    """What a null in :func:`predictability_summary` means, by key (``t_end``: the ensembles' length [s])."""
+    never = f"the spread did not reach the threshold within the {t_end:g} s of the ensemble runs"
+    keys = ("horizon_1cm_s", "horizon_10cm_s", "horizon_1cm_at_5mm_s", "horizon_10cm_at_5mm_s")
+    return {**dict.fromkeys(keys, never),
+            "horizon_slope_per_ln_sigma_s": "fewer than two uncertainties reached the threshold",
+            "one_over_lyapunov_s": "the largest Lyapunov exponent is not positive"}

@@ -74,7 +74,7 @@ def cause_text(s: Mapping[str, Any]) -> str:
     """Model error or chaos? Compare the observed 5 cm horizon with the ensemble's, and the two seed runs."""
     span = s["prediction_s"]
     observed = s["horizons_s"]["lsq_start_identified"]["lower_bob_5cm_s"]
-    chaos = s["chaos_horizons_s"]["5cm"]
+    chaos = s["chaos_horizons_s"]["lower_bob_5cm_s"]
     seed = s["horizons_s"]
     d_friction = max(
         abs((seed["seed_start_identified"][k] or span) - (seed["seed_start_frictionless"][k] or span))
@@ -90,6 +90,8 @@ def cause_text(s: Mapping[str, Any]) -> str:
         )
     else:
         cause = "The observed 5 cm horizon is comparable with the chaos horizon: the start's uncertainty limits it."
+    if d_friction < 0.005:
+        return f"{cause} The identified losses leave the seed-start horizons unchanged (to the frame)."
     return f"{cause} The identified losses change the seed-start horizons by at most {d_friction:.2f} s."
 
 
@@ -116,7 +118,7 @@ c = {sus["c_N_s_per_m"]:.1f} +- {sus["c_stderr"]:.1f} N s/m).
 
 ## Start states
 
-| | seed start (angles, Savitzky-Golay rates of frame t0) | least squares over {lsq["n_frames"]} frames |
+| start value | seed start (angles, Savitzky-Golay rates of frame t0) | least squares over {lsq["n_frames"]} frames |
 |---|---|---|
 {state_rows(s)}
 
@@ -137,8 +139,8 @@ Time after t0 at which the position error first exceeds 1 cm and 5 cm (``predict
 by {1e3 * floor["rms_m"]:.1f} mm rms and up to {1e3 * floor["max_m"]:.1f} mm in this window (correlation of the
 signed deviation with omega2^2: {floor["correlation_with_omega2_squared"]:+.2f}), so an error of 1 cm is at the
 data's own resolution. (2) Chaos: {s["ensemble_size"]} runs from start states drawn from the least-squares
-covariance part from the central run by 1 cm after {fmt_horizon(chaos["1cm"], span)} s and by 5 cm after
-{fmt_horizon(chaos["5cm"], span)} s (median distance of the lower bob). {cause_text(s)}
+covariance part from the central run by 1 cm after {fmt_horizon(chaos["lower_bob_1cm_s"], span)} s and by 5 cm
+after {fmt_horizon(chaos["lower_bob_5cm_s"], span)} s (median distance of the lower bob). {cause_text(s)}
 
 Fit window of the least-squares start (more frames: a better average over the track's errors, but more
 model error inside the window):

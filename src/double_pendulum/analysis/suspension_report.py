@@ -16,6 +16,8 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from .decay_map import k_of_key
+
 
 def _format_or_dash(value: float | None, fmt: str = ".4g") -> str:
     """``value`` formatted with ``fmt``, "-" for None (a quantity that does not exist on this grid)."""
@@ -64,8 +66,8 @@ def _map_section(s: Mapping[str, Any]) -> str:
     lr, qs, stiff = main["linear_response"], main["quasi_static_c_over_k2"], main["stiff_region"]
     needed = s["measured"]["b_per_s"] - main["b_base_no_suspension_per_s"]
     mono = main["monotonic_in_c"]
-    mono_rows = ", ".join(
-        f"{k} ({'yes' if v['monotonic_below_it'] else 'no'}, peak at c = {v['c_at_largest_loss']:.3g})"
+    mono_rows = "\n".join(
+        f"| {k_of_key(k):.3g} | {'yes' if v['monotonic_below_it'] else 'no'} | {v['c_at_largest_loss']:.3g} |"
         for k, v in mono.items()
     )
     qs_share = _format_or_dash(qs["largest_share_within_per_s"], ".2g")
@@ -93,20 +95,31 @@ b of E_pendulum and of E_total differ by at most {main["max_abs_b_E_pendulum_min
 **Shape check.** The stiff-suspension law (dissipated power c <|dF/dt|^2> / k^2, so b - b0 ~ c/k^2 and
 iso-b curves c ~ k^2) is checked where the suspension is much stiffer than the pendulum (natural
 frequencies and k/c at least {stiff["natural_frequency_over_force_frequency"]:g} times the force's rms
-frequency, {stiff["n_cells"]} cells): it holds within {100 * qs["tolerance"]:.0f} % in {qs["n_cells_within"]} of them,
-per k at c = {_c_values_per_k(qs["rows_within"])}; elsewhere in that region the c-independent resonant loss
+frequency, {stiff["n_cells"]} cells): it holds within {100 * qs["tolerance"]:.0f} % in {qs["n_cells_within"]} of them:
+
+{_c_table(qs["rows_within"], f"the law holds within {100 * qs['tolerance']:.0f} %")}
+
+Elsewhere in that region the c-independent resonant loss
 still adds (small c). The largest suspension share where the law holds is {qs_share} 1/s, against the
 {-needed:.4f} 1/s needed{verdict}. Along the measured curve the local slope of the valley is
 d ln c / d ln k = {fisher["valley_slope_dlnc_dlnk"]:.1f} (c ~ k^2 would be 2). The full linear response
 (``double_pendulum.analysis.suspension_response``, from one fixed-pivot run's force spectrum; dotted in the map)
 agrees with the FMU within
-{100 * lr["tolerance"]:.0f} % in {lr["n_cells_within"]} of {lr["n_cells"]} cells, per k at c =
-{_c_values_per_k(lr["rows_within"])}: it
-fails where the suspension drains the pendulum so fast that its motion (and force spectrum) changes,
+{100 * lr["tolerance"]:.0f} % in {lr["n_cells_within"]} of {lr["n_cells"]} cells:
+
+{_c_table(lr["rows_within"], f"the linear response agrees within {100 * lr['tolerance']:.0f} %")}
+
+It fails where the suspension drains the pendulum so fast that its motion (and force spectrum) changes,
 i.e. at soft, lightly damped suspensions, and in the chaotic resonance floor. See ``decay_rate_cuts.png``.
 
-**Monotonic in c?** Per k [N/m]: whether |b| grows monotonically with c up to its largest loss:
-{mono_rows}. Where it does not, the lightly damped end wiggles: the resonant loss depends on the chaotic
+**Monotonic in c?** Per k: whether |b| grows monotonically with c up to its largest loss, and the c of
+that largest loss:
+
+| k [N/m] | monotonic up to the peak | c at the largest loss [N s/m] |
+|---|---|---|
+{mono_rows}
+
+Where it does not, the lightly damped end wiggles: the resonant loss depends on the chaotic
 trajectory's spectrum near omega_n, which changes from run to run.
 """
 
@@ -136,11 +149,11 @@ def _branches_text(s: Mapping[str, Any]) -> str:
     if falling:
         out.append(f"Overdamped branch ({len(falling)} crossings): the damper clamps the pivot, b ~ 1/c.")
     stiffest = reach["stiffest_k_reaching_N_per_m"]
-    c_best = ", ".join(f"{k}: {c:.3g}" for k, c in reach["c_of_most_negative_b"].items())
     out.append(
         f"No c on the grid reaches the measured b above k = {_format_or_dash(stiffest, '.3g')} N/m: "
         "at fixed k the loss peaks at "
-        f"c ~ k/omega (c of the largest loss per k: {c_best}) and that peak falls with k. The stiffest k that still "
+        "c ~ k/omega (the c of the largest loss per k is in the table *Monotonic in c?* below) and that peak falls "
+        "with k. The stiffest k that still "
         f"reaches it per suspension mass: "
         + ", ".join(
             f"{m['M_s_kg']:g} kg: {_format_or_dash(m['reach_measured_b']['stiffest_k_reaching_N_per_m'], '.3g')} N/m"
@@ -151,10 +164,12 @@ def _branches_text(s: Mapping[str, Any]) -> str:
     return " ".join(out)
 
 
-def _c_values_per_k(rows: Mapping[str, Sequence[float]]) -> str:
-    """The c values [N s/m] listed per k [N/m] ("k: c1, c2; ..."), "none" if every list is empty."""
-    parts = [f"{k}: {', '.join(f'{c:.3g}' for c in cs)}" for k, cs in rows.items() if cs]
-    return "; ".join(parts) if parts else "none"
+def _c_table(rows: Mapping[str, Sequence[float]], what: str) -> str:
+    """Markdown table of the c values [N s/m] per k [N/m] where ``what`` is true; a sentence if there are none."""
+    lines = [f"| {k_of_key(k):.3g} | {', '.join(f'{c:.3g}' for c in cs)} |" for k, cs in rows.items() if cs]
+    if not lines:
+        return f"(no cell where {what})"
+    return "\n".join([f"| k [N/m] | c [N s/m] where {what} |", "|---|---|", *lines])
 
 
 def _identification_section(s: Mapping[str, Any]) -> str:

@@ -177,7 +177,7 @@ def map_panels(maps: Sequence[DecayMap], spectrum: ForceSpectrum, n_fine: int) -
         kf, cf, bf = linear_response_grid(
             spectrum, dmap.b_base, (dmap.k[0], dmap.k[-1]), (dmap.c[0], dmap.c[-1]), dmap.m_s, n_fine
         )
-        panel = {"k": dmap.k, "c": dmap.c, "b": dmap.b, "k_fine": kf, "c_fine": cf, "b_fine": bf}
+        panel = {"k": dmap.k, "c": dmap.c, "b": dmap.b, "m_s": dmap.m_s, "k_fine": kf, "c_fine": cf, "b_fine": bf}
         panels[f"M_s = {dmap.m_s:g} kg"] = panel
     return panels
 

@@ -46,6 +46,19 @@ ENSEMBLE_SEED = 20240611
 """Seed of the random start states of :func:`chaos_spread`."""
 RUN_OUTPUTS: tuple[str, ...] = (*POSITION_OUTPUTS, "phi1", "phi2", "omega1", "omega2", "E_pendulum")
 """FMU outputs recorded for each prediction (positions [m], angles [rad], rates [rad/s], energy [J])."""
+RUN_TITLES = {
+    "seed_start_frictionless": "seed's start, frictionless model",
+    "seed_start_identified": "seed's start, identified model (losses, suspension)",
+    "lsq_start_identified": "least-squares start, identified model",
+}
+"""Plain words for the prediction labels (which also name their CSV files) in figures."""
+
+
+def run_title(label: str) -> str:
+    """The plain-words title of a prediction ``label`` (:data:`RUN_TITLES`), else the label itself."""
+    return RUN_TITLES.get(label, label.replace("_", " "))
+
+
 ERROR_UNITS = {"t_since_t0": "s", "frame": "1", "x1": "m", "y1": "m", "x2": "m", "y2": "m", "rod2_deviation": "m"}
 """Units of :func:`errors_table`; the error columns ``e1_*``, ``e2_*`` are in m (:func:`errors_units`)."""
 
@@ -175,8 +188,15 @@ def chaos_spread(
 
 
 def chaos_horizons(spread: tuple[np.ndarray, np.ndarray]) -> dict[str, float | None]:
-    """First time [s] the ensemble's spread exceeds each of :data:`THRESHOLDS_M` (None: never)."""
-    return {f"{100 * th:g}cm": horizon(*spread, th) for th in THRESHOLDS_M}
+    """First time [s] the ensemble's spread of the lower bob exceeds each of :data:`THRESHOLDS_M`, keyed like
+    ``lower_bob_1cm_s`` (None: not within the prediction window, see :func:`null_means`)."""
+    return {f"lower_bob_{100 * th:g}cm_s": horizon(*spread, th) for th in THRESHOLDS_M}
+
+
+def null_means(prediction_s: float) -> dict[str, str]:
+    """What a null horizon in the summary means, by summary key."""
+    never = f"the error or spread did not exceed the threshold within the {prediction_s:.1f} s prediction window"
+    return {"horizons_s": never, "chaos_horizons_s": never, "fit_window_sensitivity": never}
 
 
 def window_sensitivity(
@@ -299,7 +319,7 @@ def error_curves(
 ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Curves (t [s] since t0, error [m]) for the error plot: each run's lower bob, the last run's
     both bobs, and the chaos spread."""
-    curves = {f"{p.label}: lower bob": (p.t, p.e2) for p in predictions}
-    curves.update({f"{p.label}: both (larger)": (p.t, p.e_both) for p in predictions[-1:]})
+    curves = {f"{run_title(p.label)}: lower bob": (p.t, p.e2) for p in predictions}
+    curves.update({f"{run_title(p.label)}: larger of both bobs": (p.t, p.e_both) for p in predictions[-1:]})
     curves["chaos: spread of runs from the fitted start's uncertainty (median)"] = spread
     return curves

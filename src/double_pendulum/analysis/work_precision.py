@@ -11,6 +11,7 @@ each band of :data:`BANDS`.
 
 from __future__ import annotations
 
+import math
 import statistics
 from dataclasses import dataclass
 from typing import Any
@@ -98,9 +99,20 @@ def timing_columns(cpu: list[float]) -> dict[str, float]:
 
 
 def failure_columns(error: Exception) -> dict[str, str]:
-    """``status`` (``unstable`` if the FMU reported an instability, else ``failed``) and its ``message``."""
-    msg = str(error).split("FMU says: ")[-1]
-    return {"status": "unstable" if "instability" in msg else "failed", "message": msg[:200]}
+    """``status`` (``unstable`` if the FMU reported an instability, else ``failed``) and its whole ``message``
+    (without the ``doStep failed:`` prefix, which every failure shares)."""
+    msg = str(error).split("FMU says: ")[-1].removeprefix("doStep failed: ")
+    return {"status": "unstable" if "instability" in msg else "failed", "message": msg}
+
+
+def band_key(bound: float) -> str:
+    """Summary key of a max-error band: ``1e-3`` -> ``"max_error_le_1e-3"`` (the bound on max_t e(t))."""
+    return f"max_error_le_1e{round(math.log10(bound))}"
+
+
+def setting_text(row: dict[str, Any]) -> str:
+    """A run's solver setting in words: ``rtol 1e-08`` (adaptive) or ``h 0.005 s`` (fixed step)."""
+    return f"rtol {row['rtol']:g}" if row.get("rtol") is not None else f"h {row['fixed_step']:g} s"
 
 
 def accuracy_columns(result: np.ndarray, case: Case, ref: Reference, comm: float) -> dict[str, Any]:
@@ -118,18 +130,22 @@ def accuracy_columns(result: np.ndarray, case: Case, ref: Reference, comm: float
 def best_per_band(rows: list[dict[str, Any]], case: str, floor: float) -> dict[str, Any]:
     """The fastest ok configuration of ``case`` (least CPU time) whose max error is within each band's bound.
 
-    Keyed by the bound (``"0.001"``); None where no run reached it or the bound is below the reference's
-    error floor ``floor`` (errors that small cannot be resolved).
+    Keyed by :func:`band_key` (``"max_error_le_1e-3"``). A reached band gives ``reached: true``, the solver,
+    its setting (``rtol`` for adaptive solvers, ``fixed_step_s`` for fixed-step ones), ``comm_step_s``,
+    ``max_error`` and ``cpu_time_s``; otherwise ``reached: false`` and the ``reason``: no run reached it,
+    or the bound lies below the reference's error floor ``floor`` (errors that small cannot be resolved).
     """
-    out = {}
+    out: dict[str, Any] = {}
     for bound in BANDS:
         if bound < floor:
-            out[f"{bound:g}"] = None
+            out[band_key(bound)] = {"reached": False, "reason": f"below the reference error floor {floor:.1e}"}
             continue
         ok = [r for r in rows if r["case"] == case and r["status"] == "ok" and r["max_error"] <= bound]
         best = min(ok, key=lambda r: r["cpu_time_s"], default=None)
-        out[f"{bound:g}"] = None if best is None else {k: best.get(k) for k in (
-            "solver", "rtol", "fixed_step", "comm_step_s", "max_error", "cpu_time_s")}
+        out[band_key(bound)] = {"reached": False, "reason": "no configuration reached it"} if best is None else {
+            "reached": True, "solver": best["solver"],
+            **({"rtol": best["rtol"]} if best.get("rtol") is not None else {"fixed_step_s": best["fixed_step"]}),
+            **{k: best[k] for k in ("comm_step_s", "max_error", "cpu_time_s")}}
     return out
 
 
@@ -142,22 +158,37 @@ def report(
              "Error: max over phi1, phi2, omega1, omega2 against a DOP853 rtol 1e-13 reference "
              "(cross-checked with SciPy Radau: the floor below). CPU: median over repeats, through fmpy.", ""]
     for case, floor in floors.items():
-        lines += [f"## {case}", "", f"Reference error floor: {floor:.1e}", "",
-                  "| max error <= | fastest method | setting | comm step [s] | max error | CPU [s] |",
-                  "|---|---|---|---|---|---|"]
-        for bound, b in best[case].items():
-            if b is None:
-                lines.append(f"| {bound} | (none reached it, or below the reference floor) | | | | |")
-            else:
-                setting = f"rtol {b['rtol']:g}" if b.get("rtol") is not None else f"h {b['fixed_step']:g} s"
-                lines.append(f"| {bound} | {b['solver']} | {setting} | {b['comm_step_s']:g} | "
-                             f"{b['max_error']:.1e} | {b['cpu_time_s']:.3f} |")
-        bad = [r for r in rows if r["case"] == case and r["status"] != "ok"]
-        if bad:
-            lines += ["", "Failed or unstable configurations:", ""]
-            lines += [f"- {r['solver']} {r.get('rtol') or r.get('fixed_step')}: {r['status']}: {r.get('message', '')}"
-                      for r in bad]
+        lines += [f"## {case}", "", f"Reference error floor: {floor:.1e}", ""]
+        lines += band_lines(best[case])
+        lines += failure_lines([r for r in rows if r["case"] == case and r["status"] != "ok"])
         lines.append("")
     return "\n".join(lines)
+
+
+def band_lines(best: dict[str, Any]) -> list[str]:
+    """Markdown table: per band the fastest method, or why none is given."""
+    lines = ["| max error <= | fastest method | setting | comm step [s] | max error | CPU [s] |",
+             "|---|---|---|---|---|---|"]
+    for key, b in best.items():
+        bound = key.removeprefix("max_error_le_")
+        if not b["reached"]:
+            lines.append(f"| {bound} | none: {b['reason']} | - | - | - | - |")
+            continue
+        setting = f"rtol {b['rtol']:g}" if "rtol" in b else f"h {b['fixed_step_s']:g} s"
+        lines.append(f"| {bound} | {b['solver']} | {setting} | {b['comm_step_s']:g} | "
+                     f"{b['max_error']:.1e} | {b['cpu_time_s']:.3f} |")
+    return lines
+
+
+def failure_lines(bad: list[dict[str, Any]]) -> list[str]:
+    """Markdown table of the failed or unstable configurations, each with its communication step and the
+    FMU's whole message (expected: too-large steps and non-stiff methods on the stiff case)."""
+    if not bad:
+        return []
+    lines = ["", "Failed or unstable configurations (expected where the step is too large for the motion):", "",
+             "| solver | setting | comm step [s] | status | FMU message |", "|---|---|---|---|---|"]
+    lines += [f"| {r['solver']} | {setting_text(r)} | {r['comm_step_s']:g} | {r['status']} | "
+              f"{r.get('message', '').replace('|', '/')} |" for r in bad]
+    return lines
 
 

@@ -8,8 +8,11 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib import patheffects
+from matplotlib.colors import Normalize
+from scipy.interpolate import PchipInterpolator, interp1d
 
-from .style import running_mean, save
+from .style import legend_below, legend_outside, running_mean, save
 
 
 def plot_energy_decay(
@@ -30,7 +33,7 @@ def plot_energy_decay(
     """
     used = np.isfinite(energy) if used is None else used & np.isfinite(energy)
     rows = 2 if residual_curve else 1
-    fig, axes = plt.subplots(rows, 1, figsize=(10, 4 + 2.5 * (rows - 1)), squeeze=False, sharex=True)
+    fig, axes = plt.subplots(rows, 1, figsize=(11, 4 + 2.5 * (rows - 1)), squeeze=False, sharex=True)
     ax = axes[0, 0]
     ax.errorbar(t[used], energy[used], yerr=sigma[used], fmt=".", ms=2, lw=0.5, alpha=0.6, label="measured")
     skip = ~used & np.isfinite(energy)
@@ -38,15 +41,16 @@ def plot_energy_decay(
         ax.plot(t[skip], energy[skip], "x", color="0.5", ms=4, label="not fitted")
     for label, values in curves.items():
         ax.plot(t_curve, values, lw=1.5, label=label)
-    ax.set(ylabel="E [J]", title="energy of the measured pendulum")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.set(ylabel="energy E [J]", title="energy of the measured pendulum with fitted decay curves")
+    legend_outside(ax)
     ax.grid(alpha=0.3)
     if residual_curve:
         ax_r = axes[1, 0]
         model = np.interp(t[used], t_curve, curves[residual_curve])
         ax_r.plot(t[used], (energy[used] - model) / sigma[used], ".", ms=2)
         ax_r.axhline(0.0, color="k", lw=0.8)
-        ax_r.set(ylabel=f"(E - {residual_curve}) / sigma", title="normalised residuals")
+        ax_r.set(ylabel="(E - fit) / sigma [-]",
+                 title=f"normalised residuals against {residual_curve}")
         ax_r.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("t [s]")
     return save(fig, path)
@@ -73,14 +77,16 @@ def plot_circle_fit(
     ax = axes[0]
     phi = np.arctan2(x1[valid], -y1[valid])
     ang = np.linspace(phi.min() - 0.3, phi.max() + 0.3, 200)
-    ax.plot(x2[valid], y2[valid], ".", ms=1.5, alpha=0.5, label="lower bob")
-    ax.plot(x1[valid], y1[valid], ".", ms=1.5, label="upper bob")
+    for x, y, label, alpha in ((x2, y2, "lower bob", 0.5), (x1, y1, "upper bob", 1.0)):
+        dots = ax.plot(x[valid], y[valid], ".", ms=1.5, alpha=alpha)[0]
+        ax.plot([], [], ".", ms=7, color=dots.get_color(), label=label)  # a legend marker large enough to see
     ax.plot(l1 * np.sin(ang), -l1 * np.cos(ang), "k-", lw=0.6, label=f"fit, l1 = {1e3 * l1:.1f} mm")
-    ax.plot(x1[~valid], y1[~valid], "rx", ms=5, label="flagged")
-    ax.plot([0.0], [0.0], "k+", ms=10, label="fitted pivot")
+    if not valid.all():
+        ax.plot(x1[~valid], y1[~valid], "rx", ms=5, label=f"flagged frames ({np.count_nonzero(~valid)})")
+    ax.plot([0.0], [0.0], "k+", ms=12, mew=1.5, label="fitted pivot")
     ax.set(xlabel="x [m]", ylabel="y [m]", aspect="equal", title="track relative to the fitted pivot")
-    ax.legend(loc="upper center", fontsize=7, ncols=2)
     ax.grid(alpha=0.3)
+    legend_below(fig, *ax.get_legend_handles_labels(), ncols=5)
     for ax, r, length, name in (
         (axes[1], np.hypot(x1, y1), l1, "r1 - l1 (upper bob to pivot)"),
         (axes[2], np.hypot(x2 - x1, y2 - y1), l2, "|r2 - r1| - l2 (between the bobs)"),
@@ -88,9 +94,95 @@ def plot_circle_fit(
         ax.plot(t[valid], 1e3 * (r[valid] - length), ".", ms=2)
         ax.plot(t[~valid], 1e3 * (r[~valid] - length), "rx", ms=5)
         ax.axhline(0.0, color="k", lw=0.8)
-        ax.set(xlabel="t [s]", ylabel="residual [mm]", title=name)
+        ax.set(xlabel="t [s]", ylabel="rod-length residual [mm]", title=name)
         ax.grid(alpha=0.3)
     return save(fig, path)
+
+
+MAP_CMAP = "viridis"
+DISPLAY_POINTS = 160  # display grid per axis of the interpolated decay-rate field
+_OUTLINE = [patheffects.withStroke(linewidth=3.2, foreground="k")]  # white contour lines, visible on any colour
+
+
+def smooth_log_field(
+    k: np.ndarray, c: np.ndarray, b: np.ndarray, n: int = DISPLAY_POINTS
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``b`` (shape (len(k), len(c))) interpolated on an ``n`` x ``n`` grid, logarithmic in k and c, for display.
+
+    The interpolation runs over (log k, log c), on log(-b) where every b is negative (decay), else on b:
+    piecewise cubic monotone (PCHIP, no overshoots) along log k, then along log c (a tensor product,
+    vectorised); linear along an axis with fewer than 3 points. Returns the display k, c (1-D) and the
+    field (n, n).
+    """
+    lk, lc, b = np.log(np.asarray(k, float)), np.log(np.asarray(c, float)), np.asarray(b, float)
+    decaying = bool(np.all(b < 0.0))
+    values = np.log(-b) if decaying else b
+    gk, gc = np.linspace(lk[0], lk[-1], n), np.linspace(lc[0], lc[-1], n)
+    field = _interp_axis(_interp_axis(values, lk, gk, axis=0), lc, gc, axis=1)
+    return np.exp(gk), np.exp(gc), -np.exp(field) if decaying else field
+
+
+def _interp_axis(values: np.ndarray, x: np.ndarray, x_new: np.ndarray, axis: int) -> np.ndarray:
+    """``values`` interpolated along ``axis`` from ``x`` to ``x_new``: PCHIP with 3 or more points, else linear."""
+    if x.size >= 3:
+        return PchipInterpolator(x, values, axis=axis)(x_new)
+    return interp1d(x, values, axis=axis)(x_new)
+
+
+def _panel_order(panels: Mapping[str, Mapping[str, np.ndarray]]) -> list[str]:
+    """Panel titles ordered by the suspension mass ``m_s`` [kg] where the panels give it, else as given."""
+    return sorted(panels, key=lambda title: float(panels[title].get("m_s", 0.0)))
+
+
+def _iso_b(ax: plt.Axes, k: np.ndarray, c: np.ndarray, b: np.ndarray, level: float, **style) -> bool:
+    """Draw the iso-line b = ``level`` of ``b`` (shape (len(k), len(c))) if it crosses the panel."""
+    if not np.nanmin(b) < level < np.nanmax(b):
+        return False
+    ax.contour(k, c, np.asarray(b).T, levels=[level], **style)
+    return True
+
+
+def _decay_panel(ax: plt.Axes, p: Mapping[str, np.ndarray], levels: Mapping[str, float], norm: Normalize):
+    """One mass: the interpolated field, the simulated grid, the iso-b contours and the linear response."""
+    kd, cd, bd = smooth_log_field(p["k"], p["c"], p["b"])
+    mesh = ax.pcolormesh(kd, cd, bd.T, shading="gouraud", cmap=MAP_CMAP, norm=norm, rasterized=True)
+    kk, cc = np.meshgrid(p["k"], p["c"], indexing="ij")
+    ax.plot(kk.ravel(), cc.ravel(), ".", color="0.85", ms=2.5, label="simulated (k, c) (FMU runs)")
+    for (label, level), ls in zip(levels.items(), ("-", "--", "-.")):
+        if _iso_b(ax, kd, cd, bd, level, colors="w", linestyles=ls, linewidths=1.6):
+            ax.collections[-1].set_path_effects(_OUTLINE)
+        ax.plot([], [], color="w", ls=ls, lw=1.6, path_effects=_OUTLINE, label=f"{label}: b = {level:.4f} 1/s")
+    if "b_fine" in p and levels:
+        first = next(iter(levels))
+        _iso_b(ax, p["k_fine"], p["c_fine"], p["b_fine"], levels[first], colors="r", linestyles=":", linewidths=1.4)
+        ax.plot([], [], "r:", lw=1.4, label=f"{first}, linear-response prediction (fixed-pivot force spectrum)")
+    ax.set(xscale="log", yscale="log", xlabel="suspension stiffness k [N/m]")
+    ax.set_xlim(kd[0], kd[-1])
+    ax.set_ylim(cd[0], cd[-1])
+    return mesh
+
+
+def _mark_points(
+    ax: plt.Axes, k_range: np.ndarray, points: Mapping[str, tuple[float, float]] | None,
+    slope_through: tuple[float, float] | None,
+) -> None:
+    """The stiff-limit line c ~ k^2 through ``slope_through`` and the labelled (k, c) ``points``."""
+    if slope_through is not None:
+        k0, c0 = slope_through
+        ks = np.geomspace(np.min(k_range), np.max(k_range), 50)
+        ax.plot(ks, c0 * (ks / k0) ** 2, color="orange", lw=1.4, label="c ~ k^2 through the identified point "
+                "(stiff limit)")
+    for (label, (k, c)), marker in zip((points or {}).items(), "o^sDv"):
+        ax.plot([k], [c], marker, color="r", mec="k", ms=8, label=label, clip_on=False, zorder=5)
+
+
+def _unique_handles(axes) -> tuple[list, list[str]]:
+    """Legend handles and labels of all ``axes``, each label once."""
+    seen: dict[str, object] = {}
+    for ax in axes:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            seen.setdefault(label, handle)
+    return list(seen.values()), list(seen)
 
 
 def plot_decay_rate_map(
@@ -101,42 +193,33 @@ def plot_decay_rate_map(
     points: Mapping[str, tuple[float, float]] | None = None,
     slope_through: tuple[float, float] | None = None,
 ) -> Path:
-    """Decay rate b [1/s] over suspension stiffness k [N/m] and damping c [N s/m], one panel per map.
+    """Decay rate b [1/s] over suspension stiffness k [N/m] and damping c [N s/m], one panel per mass.
 
-    Each panel maps ``k``, ``c`` (1-D) and ``b`` (shape (len(k), len(c))), optionally a finer
-    prediction ``k_fine``, ``c_fine``, ``b_fine`` drawn as dotted contours. ``levels`` label the
-    solid/dashed iso-b contours; ``points`` mark (k, c) pairs and ``slope_through`` draws c ~ k^2
-    through a point (the stiff-suspension law), both on the first panel only.
+    Each panel maps ``k``, ``c`` (1-D), ``b`` (shape (len(k), len(c))) and optionally the suspension
+    mass ``m_s`` [kg] (panels are ordered by it) and a finer linear-response prediction ``k_fine``,
+    ``c_fine``, ``b_fine`` (its contour for the first of ``levels``, red dotted). The simulated b is shown
+    interpolated smoothly in log b over log k, log c (:func:`smooth_log_field`) on one colour scale with
+    a shared colour bar; the grey dots are the simulated grid. ``levels`` label the iso-b contours drawn
+    on the interpolated field; ``points`` and ``slope_through`` (the c ~ k^2 stiff limit) belong to the
+    first panel given. The legend sits under the panels.
     """
-    n = len(panels)
-    fig, axes = plt.subplots(1, n, figsize=(6.2 * n, 5.2), squeeze=False)
-    styles = ("-", "--", "-.", ":")
+    main = next(iter(panels))
+    order = _panel_order(panels)
     all_b = np.concatenate([np.ravel(p["b"]) for p in panels.values()])
-    vmin, vmax = float(np.min(all_b)), float(np.max(all_b))
-    for ax, (title, p) in zip(axes[0], panels.items()):
-        b = np.asarray(p["b"]).T
-        mesh = ax.pcolormesh(p["k"], p["c"], b, shading="nearest", cmap="viridis", vmin=vmin, vmax=vmax)
-        for (label, level), ls in zip(levels.items(), styles):
-            if np.min(p["b"]) < level < np.max(p["b"]):
-                ax.contour(p["k"], p["c"], np.asarray(p["b"]).T, levels=[level], colors="w", linestyles=ls)
-                ax.plot([], [], color="k", ls=ls, label=f"{label}: b = {level:.4f} 1/s")
-            if "b_fine" in p and np.min(p["b_fine"]) < level < np.max(p["b_fine"]):
-                b_fine = np.asarray(p["b_fine"]).T
-                ax.contour(p["k_fine"], p["c_fine"], b_fine, levels=[level], colors="r", linestyles=":")
-        if "b_fine" in p:
-            ax.plot([], [], "r:", label="linear response (fixed-pivot force spectrum)")
-        first = ax is axes[0, 0]
-        if slope_through is not None and first:
-            k0, c0 = slope_through
-            ks = np.asarray(p["k"], dtype=float)
-            ax.plot(ks, c0 * (ks / k0) ** 2, color="orange", lw=1.0, label="c ~ k^2 (stiff limit)")
-        for (label, (k, c)), marker in zip((points or {}).items() if first else (), "o^sDv"):
-            ax.plot([k], [c], marker, color="r", mec="k", ms=7, label=label)
-        ax.set(xscale="log", yscale="log", xlabel="k [N/m]", ylabel="c [N s/m]", title=title)
-        ax.set_xlim(np.min(p["k"]) / 1.2, np.max(p["k"]) * 1.2)
-        ax.set_ylim(np.min(p["c"]) / 1.5, np.max(p["c"]) * 1.5)
-        ax.legend(loc="upper right", fontsize=6)
-        fig.colorbar(mesh, ax=ax, label="b [1/s] of E_pendulum")
+    norm = Normalize(float(np.nanmin(all_b)), float(np.nanmax(all_b)))
+    n = len(order)
+    fig, axes = plt.subplots(1, n, figsize=(4.6 * n + 1.4, 5.0), squeeze=False, sharey=True, layout="constrained")
+    for ax, title in zip(axes[0], order):
+        mesh = _decay_panel(ax, panels[title], levels, norm)
+        if title == main:
+            _mark_points(ax, panels[title]["k"], points, slope_through)
+            title += " (identified suspension mass)" if points else ""
+        ax.set_title(title)
+    axes[0, 0].set_ylabel("suspension damping c [N s/m]")
+    fig.colorbar(mesh, ax=axes[0].tolist(), label="decay rate b of the pendulum energy, E ~ exp(b t) [1/s]",
+                 shrink=0.95, pad=0.02)
+    fig.suptitle("decay rate of the pendulum energy over the suspension's stiffness and damping, by suspension mass")
+    legend_below(fig, *_unique_handles(axes[0]), ncols=2)
     return save(fig, path)
 
 
@@ -162,9 +245,11 @@ def plot_decay_rate_cuts(
     finite = -b_suspension[np.isfinite(b_suspension) & (b_suspension < 0)]
     if finite.size:
         ax.set_ylim(max(finite.min() / 3.0, 1e-6), finite.max() * 3.0)
-    ax.set(xlabel="c [N s/m]", ylabel="-(b - b0) [1/s]", title="suspension share of the decay rate (FMU: markers; "
-           "linear response: lines; stiff limit: dashed)")
-    ax.legend(fontsize=7, ncols=2)
+    ax.plot([], [], "-", color="0.4", lw=1.0, label="linear response (lines)")
+    ax.plot([], [], "--", color="0.4", lw=0.7, label="stiff limit (dashed)")
+    ax.set(xlabel="suspension damping c [N s/m]", ylabel="suspension share of the decay rate -(b - b0) [1/s]",
+           title="suspension share of the decay rate at fixed stiffness k (FMU: markers)")
+    legend_outside(ax)
     ax.grid(alpha=0.3, which="both")
     return save(fig, path)
 
@@ -181,11 +266,12 @@ def plot_force_spectrum(
     for ax in axes:
         for (label, w), ls in zip(marks.items(), ("--", ":", "-.", "-")):
             ax.axvline(w, color="k", ls=ls, lw=0.8, label=label)
-        ax.set_xlabel("omega [rad/s]")
+        ax.set_xlabel("angular frequency omega [rad/s]")
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=7)
-    axes[0].set(ylabel="S_F [N^2 s/rad]", title="pivot force spectrum (fixed pivot)")
-    axes[1].set(ylabel="omega^2 S_F [N^2/(s rad)]", title="spectrum of dF/dt (what a stiff damper sees)")
+    axes[0].set(ylabel="force power spectral density S_F [N^2 s/rad]", title="pivot force spectrum (fixed pivot)")
+    axes[1].set(ylabel="spectral density of dF/dt, omega^2 S_F [N^2/(s rad)]",
+                title="spectrum of dF/dt (what a stiff damper sees)")
+    legend_below(fig, *axes[0].get_legend_handles_labels(), ncols=2)
     for ax in axes:
         top = max(float(np.max(line.get_ydata())) for line in ax.get_lines() if len(line.get_ydata()) > 2)
         ax.set_ylim(top * 1e-8, top * 3.0)
@@ -198,7 +284,7 @@ def plot_energy_flow(
     """How the pendulum's energy reaches the suspension: P_to_suspension [W] averaged over ``smooth_s``
     and unaveraged over the first ``zoom_s`` seconds, E_suspension [J], and the cumulative budget:
     pendulum energy lost, W_suspension, W_air + W_bearing and E_suspension + W_suspension [J]."""
-    fig, axes = plt.subplots(4, 1, figsize=(11, 13))
+    fig, axes = plt.subplots(4, 1, figsize=(12, 13))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     for (label, r), col in zip(runs.items(), colours):
         t = r["time"]
@@ -214,12 +300,14 @@ def plot_energy_flow(
         axes[3].plot(t, r["W_suspension"], color=col, ls="--", label=f"{label}: W_suspension")
         axes[3].plot(t, r["W_air"] + r["W_bearing"], color=col, ls=":", label=f"{label}: W_air + W_bearing")
         axes[3].plot(t, r["E_suspension"] + r["W_suspension"], color=col, lw=0.6, alpha=0.6)
-    axes[0].set(ylabel="P_to_suspension [W]", title=f"power from the pendulum into the suspension, {smooth_s:g} s mean")
-    axes[1].set(ylabel="P_to_suspension [W]", title=f"first {zoom_s:g} s, unaveraged: energy pumped in and taken back")
-    axes[2].set(ylabel="E_suspension [J]", title="energy stored in the suspension")
+    axes[0].set(ylabel="power into the suspension [W]",
+                title=f"power from the pendulum into the suspension (P_to_suspension), {smooth_s:g} s mean")
+    axes[1].set(ylabel="power into the suspension [W]",
+                title=f"first {zoom_s:g} s, unaveraged: energy pumped in and taken back")
+    axes[2].set(ylabel="stored energy E_suspension [J]", title="energy stored in the suspension")
     axes[3].set(xlabel="t [s]", ylabel="energy [J]", title="cumulative: lost by the pendulum, dissipated "
                 "(thin: E_suspension + W_suspension = integral of P_to_suspension)")
     for ax in axes:
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper left")
+        legend_outside(ax, fontsize=7)
     return save(fig, path)

@@ -1,7 +1,8 @@
-"""Shared figure handling: the headless Agg backend, saving PNG files, small helpers."""
+"""Shared figure handling: the headless Agg backend, saving PNG files, legends outside the data, small helpers."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 import matplotlib
@@ -9,15 +10,39 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.artist import Artist  # noqa: E402
+from matplotlib.legend import Legend  # noqa: E402
 
 
 def save(fig: plt.Figure, path: str | Path) -> Path:
+    """Write ``fig`` as a PNG (120 dpi) cropped to its content, legends outside the axes included; close it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    if fig.get_layout_engine() is None:
+        fig.tight_layout()
+    fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
+
+
+def legend_outside(ax: plt.Axes, *, fontsize: float = 8, **kwargs) -> Legend | None:
+    """Legend of ``ax`` to the right of its axes, so it never covers data; None if nothing is labelled."""
+    handles, labels = ax.get_legend_handles_labels()
+    if not handles:
+        return None
+    return ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0,
+                     fontsize=fontsize, **kwargs)
+
+
+def legend_below(
+    fig: plt.Figure, handles: Sequence[Artist], labels: Sequence[str], *, ncols: int = 3, fontsize: float = 9,
+    **kwargs,
+) -> Legend | None:
+    """One legend for the whole figure, centred under its axes (``save`` crops to include it)."""
+    if not handles:
+        return None
+    return fig.legend(handles, labels, loc="upper center", bbox_to_anchor=(0.5, 0.0), ncols=ncols,
+                      fontsize=fontsize, frameon=False, **kwargs)
 
 
 def running_mean(values: np.ndarray, width: int) -> np.ndarray:

@@ -8,7 +8,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .style import save
+from .style import legend_below, legend_outside, save
 
 
 def plot_track_comparison(
@@ -20,19 +20,21 @@ def plot_track_comparison(
     starts: Mapping[str, float] | None = None,
 ) -> Path:
     """Measured coordinates (dots) and simulated ones (lines) over time [s], one panel per coordinate [m]
-    (the seed's figs. 11-14); ``starts`` marks start times [s]."""
+    (the seed's figs. 11-14); ``starts`` marks start times [s] by label. One legend under the panels."""
     names = list(measured)
     fig, axes = plt.subplots(len(names), 1, figsize=(11, 2.6 * len(names)), sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
-        ax.plot(t, measured[name], ".", color="k", ms=3, label="track")
+        ax.plot(t, measured[name], ".", color="k", ms=3, label="measured track")
         for label, (ts, coords) in runs.items():
-            ax.plot(ts, coords[name], lw=1.2, label=label)
-        for t0 in (starts or {}).values():
-            ax.axvline(t0, color="0.5", ls=":", lw=0.8)
-        ax.set(ylabel=f"{name} [m]")
+            ax.plot(ts, coords[name], lw=1.2, label=f"simulated: {label}")
+        for label, t0 in (starts or {}).items():
+            ax.axvline(t0, color="0.5", ls=":", lw=0.8, label=label)
+        bob = {"1": "upper", "2": "lower"}.get(name[-1:])
+        ax.set(ylabel=f"{bob} bob {name} [m]" if bob else f"{name} [m]")
         ax.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=7, ncols=2, loc="upper right")
+    axes[0, 0].set_title("bob coordinates: measured track and FMU predictions from the same start time")
     axes[-1, 0].set_xlabel("t [s]")
+    legend_below(fig, *axes[0, 0].get_legend_handles_labels(), ncols=2)
     return save(fig, path)
 
 
@@ -53,7 +55,8 @@ def plot_prediction_errors(
         ax.semilogy(floor[0], np.maximum(floor[1], 1e-5), ".", color="0.6", ms=2, label=label)
     for th, ls in zip(thresholds, ("--", "-.", ":")):
         ax.axhline(th, color="k", ls=ls, lw=0.9, label=f"{100 * th:g} cm")
-    ax.set(xlabel="t - t0 [s]", ylabel="position error [m]", title="simulated minus measured bob position")
-    ax.legend(fontsize=7, ncols=2)
+    ax.set(xlabel="time since the start t - t0 [s]", ylabel="position error [m]",
+           title="distance between the simulated and the measured bob position")
+    legend_outside(ax)
     ax.grid(alpha=0.3, which="both")
     return save(fig, path)

@@ -8,17 +8,17 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .style import save
+from .style import legend_below, legend_outside, save
 
 
 def plot_angles(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
     """Angles phi1, phi2 [rad] over time, one panel per run."""
     fig, axes = plt.subplots(len(runs), 1, figsize=(9, 3 * len(runs)), squeeze=False)
     for ax, (label, r) in zip(axes[:, 0], runs.items()):
-        ax.plot(r["time"], r["phi1"], label="phi1")
-        ax.plot(r["time"], r["phi2"], label="phi2")
-        ax.set(title=label, xlabel="t [s]", ylabel="angle [rad]")
-        ax.legend(loc="upper right")
+        ax.plot(r["time"], r["phi1"], label="phi1 (upper rod)")
+        ax.plot(r["time"], r["phi2"], label="phi2 (lower rod)")
+        ax.set(title=f"{label}: rod angles from the vertical", xlabel="t [s]", ylabel="angle [rad]")
+        legend_outside(ax)
         ax.grid(alpha=0.3)
     return save(fig, path)
 
@@ -29,10 +29,10 @@ def plot_traces(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
     for ax, (label, r) in zip(axes[0], runs.items()):
         ax.plot(r["x2"], r["y2"], lw=0.6, label="lower bob")
         ax.plot(r["x1"], r["y1"], lw=0.8, label="upper bob")
-        ax.plot([0], [0], "k+", ms=10)
-        ax.set(title=label, xlabel="x [m]", ylabel="y [m]", aspect="equal")
-        ax.legend(loc="lower right", fontsize=8)
+        ax.plot([0], [0], "k+", ms=10, label="pivot")
+        ax.set(title=f"{label}: paths of the bobs", xlabel="x [m]", ylabel="y [m]", aspect="equal")
         ax.grid(alpha=0.3)
+    legend_below(fig, *axes[0, 0].get_legend_handles_labels())
     return save(fig, path)
 
 
@@ -40,14 +40,15 @@ def plot_energy(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
     """Energies [J] over time and the relative drift of the total energy."""
     fig, axes = plt.subplots(len(runs), 2, figsize=(12, 3 * len(runs)), squeeze=False)
     for (ax_e, ax_d), (label, r) in zip(axes, runs.items()):
-        for name in ("E_kin", "E_pot", "E_total"):
-            ax_e.plot(r["time"], r[name], label=name)
-        ax_e.set(title=label, xlabel="t [s]", ylabel="energy [J]")
-        ax_e.legend(loc="upper right", fontsize=8)
+        for name, word in (("E_kin", "kinetic"), ("E_pot", "potential"), ("E_total", "total")):
+            ax_e.plot(r["time"], r[name], label=f"{word} ({name})")
+        ax_e.set(title=f"{label}: energies", xlabel="t [s]", ylabel="energy [J]")
+        legend_outside(ax_e)
         ax_e.grid(alpha=0.3)
         e0 = r["E_total"][0]
         ax_d.plot(r["time"], (r["E_total"] - e0) / abs(e0))
-        ax_d.set(title=f"{label}: (E_total - E0) / E0", xlabel="t [s]", ylabel="relative drift")
+        ax_d.set(title=f"{label}: drift of the total energy", xlabel="t [s]",
+                 ylabel="relative drift (E_total - E0) / E0 [-]")
         ax_d.grid(alpha=0.3)
     return save(fig, path)
 
@@ -59,19 +60,37 @@ def plot_phase_portraits(runs: Mapping[str, np.ndarray], path: str | Path) -> Pa
         for ax, k in ((ax1, "1"), (ax2, "2")):
             phi = np.angle(np.exp(1j * r[f"phi{k}"]))  # wrapped to (-pi, pi]
             ax.plot(phi, r[f"omega{k}"], ",", alpha=0.6)
-            ax.set(title=f"{label}: rod {k}", xlabel=f"phi{k} [rad] (wrapped)", ylabel=f"omega{k} [rad/s]")
+            ax.set(title=f"{label}: phase portrait of rod {k}", xlabel=f"angle phi{k} [rad] (wrapped)",
+                   ylabel=f"angular velocity omega{k} [rad/s]")
             ax.grid(alpha=0.3)
     return save(fig, path)
 
 
 def plot_residuals(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
-    """|energy_residual| / E_total(0) over time [s], log scale, one line per run."""
-    fig, ax = plt.subplots(figsize=(9, 5))
+    """|energy_residual| / E_total(0) over time [s], log scale, one line per run.
+
+    The axis spans the nonzero values only; samples that are exactly zero (no residual to display on a
+    log scale) are marked on the bottom edge, so a zero does not stretch the axis over empty decades.
+    """
+    fig, ax = plt.subplots(figsize=(10, 5))
+    nonzero, zero_times = [], []
     for label, r in runs.items():
         e0 = abs(r["E_total"][0]) or 1.0
-        ax.semilogy(r["time"], np.abs(r["energy_residual"]) / e0 + 1e-18, label=label)
-    ax.set(xlabel="t [s]", ylabel="|energy_residual| / E_total(0)", title="Energy residual of the worst cases")
-    ax.legend(fontsize=8)
+        rel = np.abs(np.asarray(r["energy_residual"], dtype=float)) / e0
+        zero = rel == 0.0
+        ax.semilogy(r["time"], np.where(zero, np.nan, rel), label=label)
+        nonzero.append(rel[np.isfinite(rel) & ~zero])
+        zero_times.append(np.asarray(r["time"])[zero])
+    zeros = np.concatenate(zero_times) if zero_times else np.empty(0)
+    if zeros.size:
+        ax.plot(zeros, np.zeros(zeros.size), "|", color="k", ms=10, mew=1.5, transform=ax.get_xaxis_transform(),
+                clip_on=False, label="residual exactly 0 (off the log scale)")
+    values = np.concatenate(nonzero) if nonzero else np.empty(0)
+    if values.size:
+        ax.set_ylim(values.min() / 2.0, values.max() * 2.0)
+    ax.set(xlabel="t [s]", ylabel="relative energy residual |energy_residual| / E_total(0) [-]",
+           title=f"energy balance error of the {len(runs)} worst cases")
+    legend_outside(ax)
     ax.grid(alpha=0.3, which="both")
     return save(fig, path)
 
@@ -80,24 +99,26 @@ def plot_energy_per_mechanism(runs: Mapping[str, np.ndarray], path: str | Path) 
     """E_total [J] over time [s] for each run, log scale (straight lines mean exponential decay)."""
     fig, ax = plt.subplots(figsize=(9, 5))
     for label, r in runs.items():
-        ax.semilogy(r["time"], r["E_total"], label=label)
-    ax.set(xlabel="t [s]", ylabel="E_total [J]", title="Energy of the pendulum and its suspension")
-    ax.legend()
+        ax.semilogy(r["time"], r["E_total"], label=label.replace("_", " "))
+    ax.set(xlabel="t [s]", ylabel="total energy E_total [J]",
+           title="energy of the pendulum and its suspension: each loss mechanism alone, and all together")
+    legend_outside(ax)
     ax.grid(alpha=0.3, which="both")
     return save(fig, path)
 
 
 def plot_energy_budget_stacked(result: np.ndarray, path: str | Path) -> Path:
     """Where the energy went: stacked E_pendulum, E_suspension and each W_* [J] over time [s]."""
-    names = tuple(
-        n
-        for n in ("E_pendulum", "E_suspension", "W_air", "W_bearing", "W_bearing_drag", "W_suspension")
-        if n in (result.dtype.names or ())
-    )
-    fig, ax = plt.subplots(figsize=(9, 5))
-    ax.stackplot(result["time"], *(result[n] for n in names), labels=names, alpha=0.85)
+    words = {"E_pendulum": "stored in the pendulum", "E_suspension": "stored in the suspension",
+             "W_air": "dissipated by air drag", "W_bearing": "dissipated in the bearings",
+             "W_bearing_drag": "dissipated by the bearing drag torque",
+             "W_suspension": "dissipated in the suspension"}
+    names = {n: w for n, w in words.items() if n in (result.dtype.names or ())}
+    fig, ax = plt.subplots(figsize=(10, 5))
+    ax.stackplot(result["time"], *(result[n] for n in names),
+                 labels=[f"{word} ({name})" for name, word in names.items()], alpha=0.85)
     ax.axhline(result["E_total"][0], color="k", lw=0.8, ls="--", label="E_total(0)")
-    ax.set(xlabel="t [s]", ylabel="energy [J]", title="Energy budget, all mechanisms on")
-    ax.legend(loc="lower left", fontsize=8)
+    ax.set(xlabel="t [s]", ylabel="energy [J]", title="where the energy went: stored and dissipated, all mechanisms on")
+    legend_outside(ax)
     ax.grid(alpha=0.3)
     return save(fig, path)

@@ -1,0 +1,79 @@
+"""Figures: legends outside the data, panels in order, log axes fitted to the data (no scenario runs)."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+
+from double_pendulum.plots import decay, style, trajectories
+
+
+@pytest.fixture
+def captured(monkeypatch):
+    """Keep figures open: ``save`` records the figure instead of closing it."""
+    figures = []
+    monkeypatch.setattr(decay, "save", lambda fig, path: figures.append(fig) or path)
+    monkeypatch.setattr(trajectories, "save", lambda fig, path: figures.append(fig) or path)
+    yield figures
+    plt.close("all")
+
+
+def _panel(m_s: float) -> dict:
+    k, c = np.geomspace(5e3, 2e5, 5), np.geomspace(1.0, 3e3, 5)
+    b = -0.01 - 0.1 * np.outer(1.0 / (1.0 + k / 1e4), np.ones(c.size)) / m_s
+    return {"k": k, "c": c, "b": b, "m_s": m_s}
+
+
+def test_decay_rate_map_orders_panels_by_mass_with_one_colour_bar_and_the_legend_outside(captured):
+    panels = {f"M_s = {m:g} kg": _panel(m) for m in (2.0, 0.5, 8.0)}
+    decay.plot_decay_rate_map(panels, {"measured": -0.03}, "unused.png", points={"identified": (2e4, 40.0)},
+                              slope_through=(2e4, 40.0))
+    fig = captured[0]
+    data_axes = [ax for ax in fig.axes if ax.get_title().startswith("M_s")]
+    assert [ax.get_title().split(" (")[0] for ax in data_axes] == ["M_s = 0.5 kg", "M_s = 2 kg", "M_s = 8 kg"]
+    assert len(fig.axes) == 4  # three panels and one shared colour bar
+    assert "[1/s]" in fig.axes[-1].get_ylabel() and "decay rate" in fig.axes[-1].get_ylabel()
+    assert all(ax.get_legend() is None for ax in data_axes) and len(fig.legends) == 1
+    assert "identified" in data_axes[1].get_title()  # the points belong to the first panel given (2 kg)
+
+
+def test_smooth_log_field_keeps_the_grid_values_and_stays_within_their_range():
+    p = _panel(2.0)
+    k, c, b = decay.smooth_log_field(p["k"], p["c"], p["b"], n=41)
+    assert k[0] == pytest.approx(p["k"][0]) and c[-1] == pytest.approx(p["c"][-1]) and b.shape == (41, 41)
+    assert b.min() >= p["b"].min() - 1e-12 and b.max() <= p["b"].max() + 1e-12
+    assert b[0, 0] == pytest.approx(p["b"][0, 0]) and b[-1, -1] == pytest.approx(p["b"][-1, -1])
+
+
+def test_circle_fit_lists_flagged_frames_only_when_there_are_some(captured):
+    t = np.linspace(0.0, 1.0, 20)
+    x1, y1 = 0.3 * np.sin(t), -0.3 * np.cos(t)
+    x2, y2 = x1 + 0.2 * np.sin(2 * t), y1 - 0.2 * np.cos(2 * t)
+    decay.plot_circle_fit(x1, y1, x2, y2, t, 0.3, 0.2, "unused.png")
+    flagged = np.zeros(t.size, dtype=bool)
+    flagged[3] = True
+    decay.plot_circle_fit(x1, y1, x2, y2, t, 0.3, 0.2, "unused.png", valid=~flagged)
+    labels = [[text.get_text() for text in fig.legends[0].get_texts()] for fig in captured]
+    assert not any("flagged" in s for s in labels[0]) and "flagged frames (1)" in labels[1]
+    assert "fitted pivot" in labels[0]
+
+
+def test_residual_plot_marks_exact_zeros_instead_of_stretching_the_log_axis(captured):
+    t = np.linspace(0.0, 1.0, 11)
+    residual = np.where(t == 0.0, 0.0, 1e-10 * (1.0 + t))
+    run = {"time": t, "energy_residual": residual, "E_total": np.ones_like(t)}
+    trajectories.plot_residuals({"case": run}, "unused.png")
+    ax = captured[0].axes[0]
+    low, high = ax.get_ylim()
+    assert 1e-11 < low < 1e-10 and high < 1e-9
+    assert any("exactly 0" in text.get_text() for text in ax.get_legend().get_texts())
+
+
+def test_legend_outside_sits_right_of_the_axes():
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1], label="line")
+    legend = style.legend_outside(ax)
+    fig.canvas.draw()
+    assert legend.get_window_extent().x0 > ax.get_window_extent().x1
+    plt.close(fig)
