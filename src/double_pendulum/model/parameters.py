@@ -79,8 +79,10 @@ class PendulumParameters(Validated):
     link may carry a uniform rod (plate) of mass ``m_rod`` and length ``L_rod`` centred between its
     two joints (:mod:`double_pendulum.model.links`); the default rod mass 0 is the point-mass
     pendulum on massless rods. ``L_rod`` also sets the length the rod drag acts on
-    (:class:`AirDragParameters`), whatever the rod's mass. :data:`SEED_RIGID_LINKS` holds the
-    seed pendulum's plates.
+    (:class:`AirDragParameters`), whatever the rod's mass; its default 0 means "the plate spans
+    joint to joint" (``L = l``, :func:`~double_pendulum.model.links.plate_lengths`), so the default
+    parameters are the point-mass model bit for bit, rod drag included. :data:`SEED_RIGID_LINKS`
+    holds the seed pendulum's plates (35 cm and 25 cm, overhanging the joints).
     """
 
     m1: float = spec(0.301, "kg", "mass of the upper bob", rule="positive")
@@ -91,10 +93,16 @@ class PendulumParameters(Validated):
     m_rod1: float = spec(0.0, "kg", "mass of the upper rod (uniform plate; 0: massless)", rule="nonnegative")
     m_rod2: float = spec(0.0, "kg", "mass of the lower rod (uniform plate; 0: massless)", rule="nonnegative")
     L_rod1: float = spec(
-        0.35, "m", "length of the upper rod's plate, centred between pivot and upper bob", rule="positive"
+        0.0,
+        "m",
+        "length of the upper rod's plate, centred between pivot and upper bob (0: pivot to bob, L = l1)",
+        rule="nonnegative",
     )
     L_rod2: float = spec(
-        0.25, "m", "length of the lower rod's plate, centred between the two bobs", rule="positive"
+        0.0,
+        "m",
+        "length of the lower rod's plate, centred between the two bobs (0: bob to bob, L = l2)",
+        rule="nonnegative",
     )
 
 
@@ -131,8 +139,8 @@ class AirDragParameters(Validated):
     report gives no bob geometry: each bob's frontal area defaults to the seed's example area
     1.5e-3 m^2 (a 300 g steel cylinder of about 3 cm x 5 cm seen from the side) with c_W = 1
     (a short cylinder in cross flow at Reynolds numbers of 1e3..1e4). The rod drag acts over each
-    plate's whole length ``L_rod1``, ``L_rod2`` (:class:`PendulumParameters`), centred between its
-    joints, overhangs included.
+    plate's whole length ``L_rod1``, ``L_rod2`` (:class:`PendulumParameters`; 0: joint to joint),
+    centred between its joints, overhangs included.
     """
 
     air_drag: bool = spec(False, "", "switch: quadratic air drag on the bobs", rule="bool")
