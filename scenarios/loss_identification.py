@@ -42,8 +42,8 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
     plots.plot_energy_fit(ident.t, ident.e_measured, ident.sigma, ident.e_sim, best, out_dir / "energy_fit.png")
     plots.plot_loss_shares(s["models"], out_dir / "loss_shares.png")
     if s["profile_likelihood"]:
-        units = {p.name: p.unit for p in parameters_of(s["best_model"])}
-        plots.plot_profiles(s["profile_likelihood"], units, out_dir / "profiles.png")
+        labels = {p.name: f"{p.name}: {p.description} [{p.unit}]" for p in parameters_of(best)}
+        plots.plot_profiles(s["profile_likelihood"], labels, out_dir / "profiles.png")
     write_json(out_dir / "summary.json", s)
     write_text(out_dir / "report.md", report_text(s))
     return s

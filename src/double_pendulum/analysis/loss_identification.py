@@ -304,14 +304,15 @@ class ModelFit:
 
 
 def gauss_newton(
-    residuals: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, max_runs: int = 60, xtol: float = 1e-3
+    residuals: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, max_runs: int = 30, xtol: float = 1e-2
 ) -> tuple[np.ndarray, np.ndarray]:
     r"""Minimise :math:`|r(x)|^2` by damped Gauss-Newton with a forward-difference Jacobian.
 
     Each iteration: :math:`J_{:j} = (r(x + h e_j) - r(x))/h` (h = :data:`DIFF_STEP`, one run per
     parameter), step :math:`\Delta x = -(J^T J + \lambda\,\mathrm{diag} J^T J)^{-1} J^T r`, halved
     while :math:`|r|^2` grows (:math:`\lambda` = 1e-6 guards near-degenerate directions). Stops when
-    :math:`\max|\Delta x_j| <` ``xtol`` (0.1 % of a reference value) or after ``max_runs`` runs.
+    :math:`\max|\Delta x_j| <` ``xtol`` (1 % of a reference value, far below the parameters' errors)
+    or after ``max_runs`` runs.
     The problem is nearly linear in x, so two or three iterations suffice. Returns x and J at x.
     """
     x = np.asarray(x0, dtype=float).copy()
@@ -321,7 +322,7 @@ def gauss_newton(
         jac = np.column_stack([(residuals(x + DIFF_STEP * e) - r0) / DIFF_STEP for e in np.eye(len(x))])
         runs += len(x)
         a = jac.T @ jac
-        dx = -np.linalg.solve(a + 1e-6 * np.diag(np.diag(a)), jac.T @ r0)
+        dx = -np.linalg.pinv(a + 1e-6 * np.diag(np.diag(a))) @ (jac.T @ r0)  # pinv: a column may vanish at a bound
         if np.max(np.abs(dx)) < xtol or runs >= max_runs:
             return x, jac
         for _ in range(6):
@@ -340,7 +341,7 @@ def fit_loss_model(
     problem: FitProblem,
     fixed: Mapping[int, float] | None = None,
     start: Sequence[float] | None = None,
-    max_nfev: int = 60,
+    max_nfev: int = 30,
 ) -> ModelFit:
     """Fit ``model`` to ``problem`` (least squares in x = theta/ref); ``fixed``: index -> value held.
 
@@ -372,13 +373,58 @@ def fit_loss_model(
     works = sorted({m.work for m in mechanisms_of(model)})
     result = problem.simulate(model_values(model, theta), outputs=("E_pendulum", *works))
     r, kappa = problem.scaled_residuals(np.asarray(result["E_pendulum"])[problem.offsets])
-    extra = {"shares": shares(result, model)}
+    e_fit = problem.energy + r * problem.sigma  # kappa E_sim on the frames
+    extra = {"shares": shares(result, model), "decay": {
+        "b_sim_per_s": fit_model("exponential", problem.t, e_fit, problem.sigma).value("b"),
+        "p_sim": decay_shape(problem.t, e_fit, problem.sigma)["p"]}}  # fmt: skip
     return ModelFit(model, theta, float(r @ r), len(r), jac, r, kappa, runs[0] + 1, extra=extra)
 
 
-def fit_item(model: str, problem: FitProblem) -> ModelFit:
+@dataclass(frozen=True)
+class FitItem:
+    """A model to fit and its start values (None: the parameters' references)."""
+
+    model: str
+    start: tuple[float, ...] | None = None
+
+
+def fit_item(item: FitItem, problem: FitProblem) -> ModelFit:
     """:func:`fit_loss_model` for :func:`~double_pendulum.analysis.sweep.parallel_map`."""
-    return fit_loss_model(model, problem)
+    return fit_loss_model(item.model, problem, start=item.start)
+
+
+WARM_START_FRACTION = 0.1
+"""An added mechanism starts at this fraction of its reference value (a small extra loss)."""
+
+
+def warm_start(model: str, parent: ModelFit) -> tuple[float, ...]:
+    """Start values of ``model`` from a nested ``parent`` fit: shared parameters at the parent's optimum,
+    the added ones at :data:`WARM_START_FRACTION` of their references. A nested model then starts no
+    worse than its parent, so its chi2 cannot end above the parent's through a poor start (the
+    suspension's loss is not monotonic in c: from the references Gauss-Newton can stall)."""
+    known = dict(zip(parent.names, parent.theta))
+    return tuple(float(known.get(p.name, WARM_START_FRACTION * p.ref)) for p in parameters_of(model))
+
+
+def fit_models(
+    models: Sequence[str], problem: FitProblem, max_workers: int | None = None
+) -> tuple[list[ModelFit], int]:
+    """Fit every model: first those of at most two mechanisms from the references, then the larger ones
+    warm-started from the best-fitting smaller model they contain (:func:`warm_start`)."""
+    from .sweep import parallel_map  # noqa: PLC0415 - process pools only when identifying
+
+    small = [m for m in models if len(m.split("+")) <= 2]
+    large = [m for m in models if m not in small]
+    fits, workers = parallel_map(fit_item, [FitItem(m) for m in small], shared=problem, max_workers=max_workers,
+                                 label="loss models")  # fmt: skip
+    if large:
+        items = []
+        for m in large:
+            parents = [f for f in fits if set(f.model.split("+")) <= set(m.split("+"))]
+            items.append(FitItem(m, warm_start(m, min(parents, key=lambda f: f.chi2)) if parents else None))
+        more, _ = parallel_map(fit_item, items, shared=problem, max_workers=max_workers, label="loss models")
+        fits += more
+    return fits, workers
 
 
 def common_factor(fits: Sequence[ModelFit]) -> float:
@@ -410,6 +456,7 @@ def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, A
             "akaike_weight": float(w),
             "energy_scale_kappa": f.kappa,
             "shares": f.extra.get("shares", {}),
+            **f.extra.get("decay", {}),
             "n_runs": f.n_runs,
         }
         for f, w in zip(ordered, weights)
@@ -427,16 +474,17 @@ def parameter_table(fit: ModelFit, factor: float) -> dict[str, dict[str, Any]]:
 
 
 def identifiability(fit: ModelFit, factor: float, max_rel_error: float = 0.5, max_corr: float = 0.95) -> dict[str, Any]:
-    """Correlation matrix and a verdict per parameter: identified if its relative error is below
-    ``max_rel_error`` and no correlation with another parameter exceeds ``max_corr`` in magnitude."""
+    """Correlation matrix and a verdict per parameter: ``identified`` if its relative error (the
+    other parameters free) is below ``max_rel_error``; ``strongly_correlated`` names the parameters
+    it trades off against (|r| > ``max_corr``): the energy fixes their combination far better than
+    each alone, and the split of the loss between them is uncertain by their errors."""
     corr = fit.correlation(factor)
     rel = fit.stderr(factor) / fit.theta
     names = fit.names
-    verdict = {}
-    for i, name in enumerate(names):
-        others = [abs(corr[i, j]) for j in range(len(names)) if j != i]
-        verdict[name] = bool(rel[i] < max_rel_error and (not others or max(others) < max_corr))
-    return {"parameters": names, "correlation": corr.tolist(), "identified": verdict}
+    verdict = {name: bool(rel[i] < max_rel_error) for i, name in enumerate(names)}
+    strong = {name: [names[j] for j in range(len(names)) if j != i and abs(corr[i, j]) > max_corr]
+              for i, name in enumerate(names)}  # fmt: skip
+    return {"parameters": names, "correlation": corr.tolist(), "identified": verdict, "strongly_correlated": strong}
 
 
 # --- profile likelihood --------------------------------------------------------------------------
@@ -518,6 +566,18 @@ def shares(result: np.ndarray, model: str) -> dict[str, float]:
     works = {m.label: float(result[m.work][-1]) for m in mechanisms_of(model)}
     total = sum(works.values())
     return {name: w / total for name, w in works.items()}
+
+
+def share_errors(fit: ModelFit, model_shares: Mapping[str, float], factor: float) -> dict[str, float]:
+    """First-order standard errors of the shares [1]: a mechanism's work at fixed motion is proportional
+    to its (single) coefficient and the data fix the total, so sigma_share = share x relative error of
+    that coefficient (mechanisms with two coefficients: the larger relative error)."""
+    rel = dict(zip(fit.names, fit.stderr(factor) / fit.theta))
+    out = {}
+    for mech in mechanisms_of(fit.model):
+        r = max(rel[p.name] for p in mech.parameters)
+        out[mech.label] = float(model_shares[mech.label] * r)
+    return out
 
 
 def half_residuals(problem: FitProblem, e_sim: np.ndarray, kappa: float, factor: float) -> dict[str, Any]:
@@ -644,7 +704,7 @@ def identify_losses(runner: Any, *, quick: bool = False, max_workers: int | None
     md = measured(rec, QUICK_WINDOW_S if quick else None)
     problem = problem_from_track(rec, md)
     models = QUICK_MODELS if quick else FULL_MODELS
-    fits, workers = parallel_map(fit_item, list(models), shared=problem, max_workers=max_workers, label="loss models")
+    fits, workers = fit_models(models, problem, max_workers)
     factor = common_factor(fits)
     rows = comparison_rows(fits, factor)
     best = next(f for f in fits if f.model == rows[0]["model"])
@@ -672,6 +732,7 @@ def identify_losses(runner: Any, *, quick: bool = False, max_workers: int | None
         "best_model": best.model,
         **numbers,
         "shares": shares(result, best.model),
+        "shares_stderr": share_errors(best, shares(result, best.model), factor),
         "parameters": parameter_table(best, factor),
         "identifiability": identifiability(best, factor),
         "profile_likelihood": profile,

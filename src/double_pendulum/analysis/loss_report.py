@@ -18,13 +18,14 @@ def _pm(value: float, err: float) -> str:
 
 def model_table(rows: list[Mapping[str, Any]]) -> str:
     """Markdown table: model, parameters with errors, chi2_red, dAIC, dBIC, Akaike weight, shares."""
-    lines = ["| model | parameters | chi2_red | dAIC | dBIC | Akaike weight | shares of the loss |",
-             "|---|---|---|---|---|---|---|"]  # fmt: skip
+    lines = ["| model | parameters | chi2_red | dAIC | dBIC | Akaike weight | b_sim [1/s] | p_sim | loss shares |",
+             "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for r in rows:
         params = ", ".join(f"{n} = {_pm(p['value'], p['stderr'])} {p['unit']}" for n, p in r["parameters"].items())
         shares = ", ".join(f"{k} {v:.0%}" for k, v in r["shares"].items())
         lines.append(f"| {r['model']} | {params} | {r['chi2_red']:.3f} | {r['delta_aic']:.1f} | {r['delta_bic']:.1f} "
-                     f"| {r['akaike_weight']:.3f} | {shares} |")  # fmt: skip
+                     f"| {r['akaike_weight']:.3f} | {r.get('b_sim_per_s', float('nan')):.5f} "
+                     f"| {r.get('p_sim', float('nan')):.2f} | {shares} |")  # fmt: skip
     return "\n".join(lines)
 
 
@@ -39,7 +40,10 @@ def parameter_lines(s: Mapping[str, Any]) -> str:
             lo, hi = prof["interval_1sigma"]
             fmt = lambda v: "beyond the profiled range" if v is None else f"{v:.3g}"  # noqa: E731
             interval = f"; profile (delta chi2/F = 1): {fmt(lo)} .. {fmt(hi)}"
-        verdict = "identified" if ident[name] else "NOT identified (large error or correlation)"
+        verdict = "identified" if ident[name] else "NOT identified (relative error above 50 %)"
+        partners = s["identifiability"].get("strongly_correlated", {}).get(name)
+        if partners:
+            verdict += f"; strongly correlated with {', '.join(partners)}: the energy fixes their combination"
         out.append(f"- {name} = {_pm(p['value'], p['stderr'])} {p['unit']} ({p['description']}; "
                    f"{p['relative_error']:.0%} relative{interval}) -- {verdict}")  # fmt: skip
     return "\n".join(out)
@@ -78,7 +82,8 @@ def goal_text(s: Mapping[str, Any]) -> str:
 def report_text(s: Mapping[str, Any]) -> str:
     """The whole report."""
     air = s["air_drag_at_defaults"]
-    shares = ", ".join(f"{k} {v:.1%}" for k, v in s["shares"].items())
+    err = s.get("shares_stderr", {})
+    shares = ", ".join(f"{k} {v:.0%} +- {err.get(k, 0.0):.0%}" for k, v in s["shares"].items())
     mode = " (quick mode: two models, the first 8 s, no profiles)" if s["quick"] else ""
     return f"""# Loss identification: which mechanisms drain the seed's pendulum?
 

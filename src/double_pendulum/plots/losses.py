@@ -50,19 +50,20 @@ def plot_loss_shares(rows: list[Mapping[str, Any]], path: str | Path) -> Path:
     ax.set_yticks(y, [f"{r['model']}  (dAIC {r['delta_aic']:.0f})" for r in rows])
     ax.set(xlim=(0, 1), xlabel="share of the energy dissipated over the record [1]",
            title="Loss shares per model (best model on top)")  # fmt: skip
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18 - 0.4 / len(rows)), ncol=len(labels), fontsize=8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1 - 0.6 / len(rows)), ncol=3, fontsize=8)
     return save(fig, path)
 
 
-def plot_profiles(profile: Mapping[str, Mapping[str, Any]], units: Mapping[str, str], path: str | Path) -> Path:
-    """Profile likelihood delta chi2 / F against each parameter of the best model (1: one standard error)."""
+def plot_profiles(profile: Mapping[str, Mapping[str, Any]], labels: Mapping[str, str], path: str | Path) -> Path:
+    """Profile likelihood delta chi2 / F against each parameter of the best model, the others re-fitted
+    (1: one standard error); ``labels`` maps a parameter to its axis label in words with the unit."""
     names = list(profile)
-    fig, axes = plt.subplots(1, len(names), figsize=(5 * len(names), 3.8), squeeze=False)
+    fig, axes = plt.subplots(1, len(names), figsize=(5.5 * len(names), 4.2), squeeze=False)
     for ax, name in zip(axes[0], names):
         p = profile[name]
-        ax.plot(p["values"], p["delta_chi2_over_F"], "o-", color="C0")
-        ax.axhline(1.0, color="k", lw=0.8, ls="--")
-        unit = units.get(name, "")
-        ax.set(xlabel=f"{name} [{unit}]", ylabel="delta chi2 / F [1]", title=f"Profile likelihood of {name}")
+        ax.plot(p["values"], p["delta_chi2_over_F"], "o-", color="C0", label="others re-fitted")
+        ax.axhline(1.0, color="k", lw=0.8, ls="--", label="one standard error")
+        ax.set(xlabel=labels.get(name, name), ylabel="rise of chi2 / F [1]", title=f"Profile likelihood: {name}")
+        ax.legend(loc="upper center", fontsize=8)
         ax.grid(alpha=0.3)
     return save(fig, path)
