@@ -16,12 +16,18 @@ def _pm(value: float, err: float) -> str:
     return f"{value:.3g} +- {err:.2g}"
 
 
+def _unit(unit: str) -> str:
+    """A unit after a value (nothing for the dimensionless '1')."""
+    return "" if unit == "1" else f" {unit}"
+
+
 def model_table(rows: list[Mapping[str, Any]]) -> str:
     """Markdown table: model, parameters with errors, chi2_red, dAIC, dBIC, Akaike weight, shares."""
     lines = ["| model | parameters | chi2_red | dAIC | dBIC | Akaike weight | b_sim [1/s] | p_sim | loss shares |",
              "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for r in rows:
-        params = ", ".join(f"{n} = {_pm(p['value'], p['stderr'])} {p['unit']}" for n, p in r["parameters"].items())
+        params = ", ".join(f"{n} = {_pm(p['value'], p['stderr'])}{_unit(p['unit'])}"
+                           for n, p in r["parameters"].items())
         shares = ", ".join(f"{k} {v:.0%}" for k, v in r["shares"].items())
         lines.append(f"| {r['model']} | {params} | {r['chi2_red']:.3f} | {r['delta_aic']:.1f} | {r['delta_bic']:.1f} "
                      f"| {r['akaike_weight']:.3f} | {r.get('b_sim_per_s', float('nan')):.5f} "
@@ -44,7 +50,7 @@ def parameter_lines(s: Mapping[str, Any]) -> str:
         partners = s["identifiability"].get("strongly_correlated", {}).get(name)
         if partners:
             verdict += f"; strongly correlated with {', '.join(partners)}: the energy fixes their combination"
-        out.append(f"- {name} = {_pm(p['value'], p['stderr'])} {p['unit']} ({p['description']}; "
+        out.append(f"- {name} = {_pm(p['value'], p['stderr'])}{_unit(p['unit'])} ({p['description']}; "
                    f"{p['relative_error']:.0%} relative{interval}) -- {verdict}")  # fmt: skip
     return "\n".join(out)
 
