@@ -90,3 +90,14 @@ def test_best_model_on_the_real_data_quick(runner):
     assert isinstance(s["suspension_dominates"], bool) and s["answer"].startswith(("Yes", "No"))
     for key in ("b_measured_per_s", "b_sim_per_s", "p_measured", "p_measured_stderr", "p_sim"):
         assert math.isfinite(s[key])
+
+
+def test_a_fit_above_its_nested_model_counts_as_not_converged():
+    def fake(model: str, chi2: float) -> li.ModelFit:
+        n = len(li.parameters_of(model))
+        return li.ModelFit(model, np.ones(n), chi2, 100, np.eye(100)[:, :n], np.zeros(100), 1.0, 1)
+
+    fits = [fake("air+drag", 100.0), fake("air+drag+viscous", 120.0), fake("air", 130.0)]
+    rows = li.comparison_rows(fits, 1.0)
+    assert [r["model"] for r in rows] == ["air+drag", "air", "air+drag+viscous"]
+    assert not rows[-1]["converged"] and rows[-1]["akaike_weight"] == 0.0

@@ -433,13 +433,29 @@ def common_factor(fits: Sequence[ModelFit]) -> float:
     return effective_sample_factor(best.residuals, LAG_FRAMES)
 
 
+CONVERGENCE_TOLERANCE = 0.5
+"""chi2 a model may end above the best model nested in it before its fit counts as not converged."""
+
+
+def converged(fit: ModelFit, fits: Sequence[ModelFit]) -> bool:
+    """False if a model nested in ``fit``'s (a subset of its mechanisms) reached a lower chi2 by more
+    than :data:`CONVERGENCE_TOLERANCE`: the larger model contains that optimum, so its own fit stalled."""
+    mine = set(fit.model.split("+"))
+    nested = [f.chi2 for f in fits if f is not fit and set(f.model.split("+")) < mine]
+    return not nested or fit.chi2 <= min(nested) + CONVERGENCE_TOLERANCE
+
+
 def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, Any]]:
-    """One row per model, sorted by the corrected AIC: parameters with errors, chi2, AIC, BIC, Akaike weight."""
+    """One row per model, sorted by the corrected AIC: parameters with errors, chi2, AIC, BIC, Akaike weight.
+
+    Fits that did not converge (:func:`converged`) come last with Akaike weight 0: their chi2 is not
+    the model's minimum, so the comparison says nothing about them."""
     crit = {f.model: f.criteria(factor) for f in fits}
-    ordered = sorted(fits, key=lambda f: crit[f.model][0])
+    ok = {f.model: converged(f, fits) for f in fits}
+    ordered = sorted(fits, key=lambda f: (not ok[f.model], crit[f.model][0]))
     best_aic = crit[ordered[0].model][0]
-    best_bic = min(c[1] for c in crit.values())
-    weights = np.array([math.exp(-0.5 * (crit[f.model][0] - best_aic)) for f in ordered])
+    best_bic = min(crit[m][1] for m in crit if ok[m])
+    weights = np.array([math.exp(-0.5 * (crit[f.model][0] - best_aic)) if ok[f.model] else 0.0 for f in ordered])
     weights /= weights.sum()
     return [
         {
@@ -454,6 +470,7 @@ def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, A
             "delta_aic": crit[f.model][0] - best_aic,
             "delta_bic": crit[f.model][1] - best_bic,
             "akaike_weight": float(w),
+            "converged": ok[f.model],
             "energy_scale_kappa": f.kappa,
             "shares": f.extra.get("shares", {}),
             **f.extra.get("decay", {}),
@@ -662,7 +679,7 @@ def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """Does the suspension dominate the loss? From the suspension's share in every model that has it
     and the best model's composition (a plain sentence and the numbers)."""
     label = MECHANISMS["suspension"].label
-    with_susp = {r["model"]: r["shares"].get(label) for r in rows if label in r["shares"]}
+    with_susp = {r["model"]: r["shares"].get(label) for r in rows if label in r["shares"] and r["converged"]}
     best = rows[0]
     dominates = bool(label in best["shares"] and best["shares"][label] > 0.5)
     if dominates:

@@ -29,6 +29,8 @@ def model_table(rows: list[Mapping[str, Any]]) -> str:
         params = ", ".join(f"{n} = {_pm(p['value'], p['stderr'])}{_unit(p['unit'])}"
                            for n, p in r["parameters"].items())
         shares = ", ".join(f"{k} {v:.0%}" for k, v in r["shares"].items())
+        if not r.get("converged", True):
+            shares += " (fit did not converge: chi2 above a model nested in it; not ranked)"
         lines.append(f"| {r['model']} | {params} | {r['chi2_red']:.3f} | {r['delta_aic']:.1f} | {r['delta_bic']:.1f} "
                      f"| {r['akaike_weight']:.3f} | {r.get('b_sim_per_s', float('nan')):.5f} "
                      f"| {r.get('p_sim', float('nan')):.2f} | {shares} |")  # fmt: skip
