@@ -9,6 +9,7 @@ SCENARIOS: tuple[str, ...] = (
     "free_swing",
     "friction_budget",
     "energy_decay",
+    "loss_identification",
     "suspension_transfer",
     "measured_vs_sim",
     "work_precision",

@@ -8,7 +8,9 @@ section 4.2, with the package's own energy function. Outputs in ``results/energy
 - ``energy_decay.png``: energy with error bars and the fitted decay models (the seed's fig. 7);
 - ``circle_fit.png``: the pivot circle fit and the rod-length residuals;
 - ``summary.json``: pivot, rod lengths, the exponential fit ``a_J``, ``b_per_s`` with errors, the
-  model comparison (AIC/BIC), the same fit with other weights, and the seed's numbers;
+  model comparison (AIC/BIC), the same fit with other weights, the seed's numbers, and the error
+  budget of a and b (``error_budget``: statistical and systematic rows, totals ``total_a_J``,
+  ``total_b_per_s``; :mod:`double_pendulum.analysis.decay_error_budget`);
 - ``report.md``: the figures and why they differ from the seed's a = 0.813 J, b = -0.024 1/s.
 
 The runner argument of :func:`run` is not used, nor is ``quick`` (the analysis takes about a second).
@@ -22,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from double_pendulum import plots
+from double_pendulum.analysis.decay_error_budget import error_budget
 from double_pendulum.analysis.decay_fit import SEED_FIT, FitResult, calibrate_error_model, comparison_table, fit_all
 from double_pendulum.analysis.decay_report import report_text
 from double_pendulum.analysis.decay_summary import (
@@ -95,6 +98,7 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
         "seed": seed_comparison(main),
         "null_means": {"chi2_red": "not defined for this fit: its errors are relative weights (scaled to the "
                                    "scatter), not absolute errors"},
+        "error_budget": error_budget(rec, errors.sigma),
     }
     write_results_csv(out_dir / "track.csv", track_table(rec, on_all_frames(errors.sigma, m)), TRACK_CSV_UNITS)
     _plots(rec, m, errors.sigma, fits, out_dir)

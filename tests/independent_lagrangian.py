@@ -43,6 +43,7 @@ class IndependentPendulum:
         links, dists, masses = [1, 2], [p.l1, p.l2], [p.m1, p.m2]
         self.plates = []
         for link, length, plate, mass in ((1, p.l1, p.L_rod1, p.m_rod1), (2, p.l2, p.L_rod2, p.m_rod2)):
+            plate = plate if plate > 0.0 else length  # L_rod = 0: the plate spans joint to joint
             lo, hi = length / 2 - plate / 2, length / 2 + plate / 2
             self.plates.append((link, lo, hi))
             for node, weight in zip(NODES, WEIGHTS):

@@ -4,7 +4,8 @@ r"""Lyapunov exponents of one release, checked several ways (built on :mod:`.cha
   neighbours by several integrations (step halving), plus the two-trajectory estimate. A single
   finite-time estimate scatters by 10-20 % after 100 s; neighbours in the same chaotic sea share one
   exponent, so the cloud mean with its standard error :math:`s/\sqrt{N}` is the estimate.
-* :func:`spectrum_summary`: all four exponents; the frictionless flow pairs them as
+* :func:`spectrum_summary`: all four exponents of one run (finite-time values); the frictionless flow
+  pairs them as
   :math:`(\lambda, 0, 0, -\lambda)` and :math:`|\sum_i \lambda_i(T)| \le \ln\frac{m_1+m_2}{m_1} / T`.
 * :func:`energy_scan`: :math:`\lambda_1` against the release angle :math:`\varphi_1 = \varphi_2 = \theta_0`
   from rest, with the energy over the flip threshold :math:`E / E_\mathrm{flip}`.
@@ -192,7 +193,12 @@ def spectrum_table(spectrum: Spectrum) -> tuple[np.ndarray, dict[str, str]]:
 
 
 def spectrum_summary(spectrum: Spectrum, t_end: float) -> dict:
-    """Final exponents [1/s], the pairing ``lambda1 + lambda4``, their sum and its bound."""
+    """Final exponents [1/s], the pairing ``lambda1 + lambda4``, their sum and its bound.
+
+    The exponents are finite-time values of one run up to ``t_end`` [s], not the limit T -> infinity:
+    the middle pair, 0 in the limit, is still of order 1/T, and a single run's lambda1 scatters by
+    10-20 % between neighbouring starts (:func:`compare_integrations` averages a cloud).
+    """
     lam = spectrum.running[-1]
     return {
         "exponents_per_s": lam,
@@ -201,6 +207,8 @@ def spectrum_summary(spectrum: Spectrum, t_end: float) -> dict:
         "sum_bound_per_s": float(spectrum.sum_bound[-1]),
         "t_end_s": t_end,
         "method": f"QR (Gram-Schmidt) of 4 complex-step tangent vectors, rk4 h = {spectrum.h * 1e3:g} ms",
+        "note": f"finite-time spectrum of one {t_end:g} s run (not the T -> infinity limit; the middle pair "
+        "tends to 0 like 1/T)",
     }
 
 

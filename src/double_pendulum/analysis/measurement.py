@@ -31,6 +31,7 @@ step skips them (the circle fit, l2, the noise estimate) or marks the frames tha
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
@@ -507,13 +508,16 @@ def reconstruct(
     sigma_pos: tuple[float, float] | None = None,
     window: int = SG_WINDOW,
     polyorder: int = SG_POLYORDER,
+    rods: Mapping[str, float] | None = None,
 ) -> Reconstruction:
     """Angles, rates and energies per frame of a measured track.
 
     ``geometry`` defaults to :func:`fit_geometry`; masses default to the seed's
     (:class:`PendulumParameters` defaults); ``sigma_pos`` (upper, lower bob) [m] defaults to
     :func:`estimate_position_noise`. The energy is ``total_energy`` of a ``PendulumParameters``
-    with the measured l1, l2 (potential zero with both bobs hanging at rest below the fitted pivot).
+    with the measured l1, l2 (potential zero with both bobs hanging at rest below the fitted pivot);
+    ``rods`` (``m_rod1, m_rod2, L_rod1, L_rod2``, e.g. :data:`~double_pendulum.model.parameters.SEED_RIGID_LINKS`)
+    adds the links' rods to it (default: point masses on massless rods).
     """
     geometry = fit_geometry(track) if geometry is None else geometry
     defaults = PendulumParameters()
@@ -522,6 +526,7 @@ def reconstruct(
         m2=defaults.m2 if m2 is None else m2,
         l1=geometry.l1,
         l2=geometry.l2,
+        **dict(rods or {}),
     )
     s1, s2 = estimate_position_noise(track, geometry) if sigma_pos is None else sigma_pos
     x1, y1 = track.x1 - geometry.pivot.xc, track.y1 - geometry.pivot.yc

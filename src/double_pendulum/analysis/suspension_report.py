@@ -366,6 +366,9 @@ def report_text(summary: Mapping[str, Any]) -> str:
 Air drag and bearing friction at the seed's estimates take b = {b0:.4f} 1/s
 of the measured {summary["measured"]["b_per_s"]:.4f} 1/s. How much can a damped suspension of the pivot add, which
 suspensions reproduce the measurement, and is that the explanation? Run time {summary["wall_time_s"]:.0f} s.
+The fitted c is a fit parameter, not a measured property: it drifts with the fit window (below), and
+``loss_identification`` finds that a suspension does not explain the decay's shape as well as a
+load-independent bearing drag torque with air drag (see its report).
 
 """
     sections = (_measured_section, _map_section, _identification_section, _refit_section, _flow_section)

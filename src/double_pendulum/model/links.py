@@ -4,7 +4,8 @@ Each link is a point mass (bob) at its lower joint plus, optionally, a uniform r
 plate) of mass :math:`m_{r,i}` and length :math:`L_i`, centred between the link's two joints:
 centre of mass at :math:`l_i/2` from the upper joint, moment of inertia :math:`m_{r,i} L_i^2/12`
 about its centre (the plate's width is neglected; it would add :math:`m_{r,i} w^2/12`). A plate
-longer than :math:`l_i` overhangs both joints by :math:`(L_i - l_i)/2`.
+longer than :math:`l_i` overhangs both joints by :math:`(L_i - l_i)/2`. ``L_rod = 0`` (the
+default) stands for :math:`L_i = l_i`, a plate from joint to joint (:func:`plate_lengths`).
 
 With :math:`\vec e_i = (\sin\varphi_i, -\cos\varphi_i)` along link ``i`` and the pivot at
 :math:`\vec s`, the bodies sit at
@@ -69,6 +70,16 @@ class LinkCoefficients(NamedTuple):
     mass2: float  # kg, mass of link 2 (bob 2 and rod 2): what the elbow carries
 
 
+def plate_lengths(p: PendulumParameters) -> tuple[float, float]:
+    """Return the plate lengths ``(L1, L2)`` [m] of the two links.
+
+    ``L_rod = 0`` (the default) means a plate spanning joint to joint, ``L = l``: the rod of the
+    point-mass model, whose drag acts between the joints only. Used alike for the rods' inertia
+    (:func:`link_coefficients`) and their air drag (:mod:`double_pendulum.model.vector_field`).
+    """
+    return (p.L_rod1 if p.L_rod1 > 0.0 else p.l1, p.L_rod2 if p.L_rod2 > 0.0 else p.l2)
+
+
 @lru_cache(maxsize=128)
 def link_coefficients(p: PendulumParameters) -> LinkCoefficients:
     """Return the :class:`LinkCoefficients` of ``p`` (bobs, and rods of mass ``m_rod1, m_rod2``).
@@ -77,9 +88,10 @@ def link_coefficients(p: PendulumParameters) -> LinkCoefficients:
     """
     m1, m2, l1, l2, g = p.m1, p.m2, p.l1, p.l2, p.g
     mr1, mr2 = p.m_rod1, p.m_rod2
+    big_l1, big_l2 = plate_lengths(p)
     # second moments <r^2> of the rods about their upper joints
-    r2_1 = p.L_rod1 * p.L_rod1 / 12.0 + l1 * l1 / 4.0
-    r2_2 = p.L_rod2 * p.L_rod2 / 12.0 + l2 * l2 / 4.0
+    r2_1 = big_l1 * big_l1 / 12.0 + l1 * l1 / 4.0
+    r2_2 = big_l2 * big_l2 / 12.0 + l2 * l2 / 4.0
     m_j1 = m1 + m2 + mr2  # masses at distance l1 from the pivot
     m_s1 = m_j1 + 0.5 * mr1  # first-moment mass of link 1
     m_2 = m2 + 0.5 * mr2  # first-moment mass of link 2

@@ -79,8 +79,10 @@ class PendulumParameters(Validated):
     link may carry a uniform rod (plate) of mass ``m_rod`` and length ``L_rod`` centred between its
     two joints (:mod:`double_pendulum.model.links`); the default rod mass 0 is the point-mass
     pendulum on massless rods. ``L_rod`` also sets the length the rod drag acts on
-    (:class:`AirDragParameters`), whatever the rod's mass. :data:`SEED_RIGID_LINKS` holds the
-    seed pendulum's plates.
+    (:class:`AirDragParameters`), whatever the rod's mass; its default 0 means "the plate spans
+    joint to joint" (``L = l``, :func:`~double_pendulum.model.links.plate_lengths`), so the default
+    parameters are the point-mass model bit for bit, rod drag included. :data:`SEED_RIGID_LINKS`
+    holds the seed pendulum's plates (35 cm and 25 cm, overhanging the joints).
     """
 
     m1: float = spec(0.301, "kg", "mass of the upper bob", rule="positive")
@@ -91,10 +93,16 @@ class PendulumParameters(Validated):
     m_rod1: float = spec(0.0, "kg", "mass of the upper rod (uniform plate; 0: massless)", rule="nonnegative")
     m_rod2: float = spec(0.0, "kg", "mass of the lower rod (uniform plate; 0: massless)", rule="nonnegative")
     L_rod1: float = spec(
-        0.35, "m", "length of the upper rod's plate, centred between pivot and upper bob", rule="positive"
+        0.0,
+        "m",
+        "length of the upper rod's plate, centred between pivot and upper bob (0: pivot to bob, L = l1)",
+        rule="nonnegative",
     )
     L_rod2: float = spec(
-        0.25, "m", "length of the lower rod's plate, centred between the two bobs", rule="positive"
+        0.0,
+        "m",
+        "length of the lower rod's plate, centred between the two bobs (0: bob to bob, L = l2)",
+        rule="nonnegative",
     )
 
 
@@ -125,14 +133,18 @@ values. Assumptions, from the report's words:
 class AirDragParameters(Validated):
     """Quadratic air drag (seed eq. 23), F = -1/2 rho c_W A |v| v, on the bobs and optionally the rods.
 
-    Defaults: rho = 1.2 kg/m^3 and, for the rods, c_W = 2 are the seed's numbers (section 4.2.3).
-    The rods are the acrylic plates of section 3.1 moving broadside through the air: the upper
-    member is two plates 4 mm thick (frontal width 8 mm), the lower one plate 6 mm thick. The
+    Defaults: rho = 1.2 kg/m^3 is the seed's number (section 4.2.3). The rods are the acrylic plates
+    of section 3.1; they swing in their own plane, so the air meets them edge-on: the frontal width
+    is the plates' thickness (upper member two plates 4 mm thick, 8 mm; lower one plate 6 mm) and
+    the flow runs across the plate's width. The seed's c_W = 2 is the face-on value of a flat
+    plate (flow normal to its face); a thin rectangular section met edge-on, its chord several
+    times its thickness, has c_W of about 1 to 1.3 on the thickness, so ``cw_rod`` defaults to 1.2.
+    ``loss_identification`` fits a common factor on all drag coefficients to the measured energy. The
     report gives no bob geometry: each bob's frontal area defaults to the seed's example area
     1.5e-3 m^2 (a 300 g steel cylinder of about 3 cm x 5 cm seen from the side) with c_W = 1
     (a short cylinder in cross flow at Reynolds numbers of 1e3..1e4). The rod drag acts over each
-    plate's whole length ``L_rod1``, ``L_rod2`` (:class:`PendulumParameters`), centred between its
-    joints, overhangs included.
+    plate's whole length ``L_rod1``, ``L_rod2`` (:class:`PendulumParameters`; 0: joint to joint),
+    centred between its joints, overhangs included.
     """
 
     air_drag: bool = spec(False, "", "switch: quadratic air drag on the bobs", rule="bool")
@@ -141,7 +153,10 @@ class AirDragParameters(Validated):
     A1: float = spec(1.5e-3, "m2", "frontal area of the upper bob", rule="nonnegative")
     A2: float = spec(1.5e-3, "m2", "frontal area of the lower bob", rule="nonnegative")
     rod_drag: bool = spec(False, "", "switch: also drag on the rods (needs air_drag)", rule="bool")
-    cw_rod: float = spec(2.0, "1", "drag coefficient of the rods (flat plates broadside)", rule="nonnegative")
+    cw_rod: float = spec(
+        1.2, "1", "drag coefficient of the rods (plates met edge-on, on their thickness; face-on would be 2)",
+        rule="nonnegative",
+    )
     d_rod1: float = spec(8e-3, "m", "frontal width of the upper rod (two 4 mm plates)", rule="nonnegative")
     d_rod2: float = spec(6e-3, "m", "frontal width of the lower rod (one 6 mm plate)", rule="nonnegative")
 

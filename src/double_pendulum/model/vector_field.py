@@ -37,7 +37,7 @@ are eliminated (Schur complement) and the remaining 2x2 system solved in closed 
 Forces on the bodies: the pivot force is the rate of change of the total momentum of bobs and
 rods minus gravity and air drag (each rod's centre accelerates as the mean of its two joints);
 the elbow carries bob 2 and rod 2. Air drag on a rod acts over its whole plate,
-``l/2 - L_rod/2 .. l/2 + L_rod/2`` from its upper joint, overhangs included (whatever the rod's
+``l/2 - L/2 .. l/2 + L/2`` from its upper joint (L = L_rod, or l for L_rod = 0), overhangs included (whatever the rod's
 mass). The bearing drag torques :math:`\tau_{b,i}\tanh(\omega_{rel}/\omega_{reg})` are
 generalised forces like the friction torques: :math:`Q_1 = -\tau_p + \tau_e`,
 :math:`Q_2 = -\tau_e` (pivot torque :math:`\tau_p` along :math:`\omega_1`, elbow torque
@@ -73,7 +73,7 @@ from typing import TYPE_CHECKING, NamedTuple
 from .dynamics import fixed_pivot_vector_field
 from .energy import kinetic_energy_moving_pivot, potential_energy, suspension_energy
 from .forces import bearing_drag_torque, bearing_torque, quadratic_drag, rod_drag_integrals
-from .links import link_coefficients
+from .links import link_coefficients, plate_lengths
 from .parameters import AirDragParameters, BearingParameters, PendulumParameters, SuspensionParameters
 
 if TYPE_CHECKING:
@@ -173,8 +173,9 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
     lc = link_coefficients(p)
     j1, j2, k12, fm1, fm2, gs1, gs2 = lc.j1, lc.j2, lc.k, lc.s1, lc.s2, lc.gs1, lc.gs2
     hr1, hr2 = 0.5 * p.m_rod1, 0.5 * p.m_rod2  # half rod masses (a rod's centre: mean of its joints)
-    rod1_lo, rod1_hi = 0.5 * l1 - 0.5 * p.L_rod1, 0.5 * l1 + 0.5 * p.L_rod1  # plates, from upper joints
-    rod2_lo, rod2_hi = 0.5 * l2 - 0.5 * p.L_rod2, 0.5 * l2 + 0.5 * p.L_rod2
+    big_l1, big_l2 = plate_lengths(p)  # L_rod = 0: joint to joint
+    rod1_lo, rod1_hi = 0.5 * l1 - 0.5 * big_l1, 0.5 * l1 + 0.5 * big_l1  # plates, from upper joints
+    rod2_lo, rod2_hi = 0.5 * l2 - 0.5 * big_l2, 0.5 * l2 + 0.5 * big_l2
     ix, iy = layout.index("xs"), layout.index("ys")
     has_x, has_y = ix is not None, iy is not None
     has_air = air.air_drag

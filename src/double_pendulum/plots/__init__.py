@@ -20,6 +20,7 @@ from .decay import (
     plot_energy_flow,
     plot_force_spectrum,
 )
+from .losses import plot_energy_fit, plot_loss_shares, plot_profiles
 from .solvers import plot_work_precision
 from .track import plot_prediction_errors, plot_track_comparison
 from .trajectories import (
@@ -59,4 +60,7 @@ __all__ = [
     "plot_work_precision",
     "plot_track_comparison",
     "plot_prediction_errors",
+    "plot_energy_fit",
+    "plot_loss_shares",
+    "plot_profiles",
 ]

@@ -1,0 +1,49 @@
+"""Scenario ``loss_identification``: which loss mechanisms drain the seed's pendulum (issue 12, item 3).
+
+Fits the simulated energy of the seed's pendulum (rigid links, start state from the track) to the
+measured energy over the whole 21 s record for combinations of air drag (free factor),
+load-proportional bearing friction, bearing drag torque, viscous joint damping and a damped
+suspension, and compares them by AIC/BIC with the residuals' correlation accounted for
+(:mod:`double_pendulum.analysis.loss_identification`). Outputs in ``results/loss_identification/``:
+
+- ``energy.csv``: per fitted frame the measured energy, its error, the best model's simulated energy
+  (FMU run) and its dissipated work per mechanism;
+- ``energy_fit.png``, ``loss_shares.png``, ``profiles.png`` (not in quick mode);
+- ``summary.json``: ``best_model``, ``b_measured_per_s``, ``b_sim_per_s``, ``p_measured``,
+  ``p_measured_stderr``, ``p_sim``, ``shares`` and the model comparison;
+- ``report.md``.
+
+``quick``: two models, no profile likelihood.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from double_pendulum import plots
+from double_pendulum.analysis.loss_identification import identify_losses, parameters_of
+from double_pendulum.analysis.loss_report import report_text
+from double_pendulum.results_io import table_from_columns, write_json, write_results_csv, write_text
+
+DESCRIPTION = "loss mechanisms of the real pendulum identified from its measured energy (AIC/BIC, shares)"
+
+
+def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
+    """Identify the losses, run the best model through the FMU and write CSV, plots, summary, report."""
+    out_dir = Path(out_dir)
+    ident = identify_losses(runner, quick=quick)
+    s = ident.summary
+    table = table_from_columns(t=ident.t, E_measured=ident.e_measured, sigma_E=ident.sigma,
+                               E_simulated=ident.e_sim, **ident.works)  # fmt: skip
+    units = {"t": "s", "E_measured": "J", "sigma_E": "J", "E_simulated": "J", **{w: "J" for w in ident.works}}
+    write_results_csv(out_dir / "energy.csv", table, units)
+    best = s["best_model"]
+    plots.plot_energy_fit(ident.t, ident.e_measured, ident.sigma, ident.e_sim, best, out_dir / "energy_fit.png")
+    plots.plot_loss_shares(s["models"], out_dir / "loss_shares.png")
+    if s["profile_likelihood"]:
+        labels = {p.name: f"{p.name}: {p.description} [{p.unit}]" for p in parameters_of(best)}
+        plots.plot_profiles(s["profile_likelihood"], labels, out_dir / "profiles.png")
+    write_json(out_dir / "summary.json", s)
+    write_text(out_dir / "report.md", report_text(s))
+    return s
