@@ -27,6 +27,8 @@ SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 DEFAULT_MAX_STEPS_PER_CALL = 1_000_000
+# A step landing on a stop time may be stretched by this factor rather than leave a sliver.
+LANDING_SLACK = 1.01
 
 
 class SolverError(RuntimeError):
@@ -126,12 +128,20 @@ class Integrator:
         self._accept(h, y_new, f_new, stages)
         self.t = t_new
 
-    def _adaptive_step(self) -> None:
+    def _adaptive_step(self, t_stop: float | None = None) -> None:
+        """Take one accepted adaptive step; with ``t_stop`` [s] never step past it.
+
+        A step that would reach within :data:`LANDING_SLACK` of ``t_stop`` is stretched or clipped
+        to end exactly there (``self.t = t_stop``, no rounding of ``t + h``), so no sliver is left.
+        """
         method = self.method
         exponent = -1.0 / (method.error_order + 1)
         h = min(self.h, self.max_step)
         rejected = False
         while True:
+            landing = t_stop is not None and t_stop - self.t <= LANDING_SLACK * h
+            if landing:
+                h = t_stop - self.t
             h_min = 16.0 * math.ulp(max(abs(self.t), 1.0))
             if h < h_min:
                 raise SolverError(
@@ -146,7 +156,7 @@ class Integrator:
                 if rejected:
                     factor = min(1.0, factor)
                 self._accept(h, y_new, f_new, stages)
-                self.t = self.t + h
+                self.t = t_stop if landing else self.t + h
                 self.h = h * factor
                 return
             self.n_rejected += 1
@@ -156,10 +166,10 @@ class Integrator:
             else:
                 h *= MIN_FACTOR
 
-    def step(self) -> None:
-        """Take one accepted step."""
+    def step(self, t_stop: float | None = None) -> None:
+        """Take one accepted step (adaptive methods: ending at ``t_stop`` [s] at the latest)."""
         if self.method.adaptive:
-            self._adaptive_step()
+            self._adaptive_step(t_stop)
         else:
             self._fixed_step()
 
@@ -186,8 +196,15 @@ class Integrator:
         self.grid_start = self.n_steps
 
     # ------------------------------------------------------------------ output
-    def advance_to(self, t_out: float) -> list[float]:
-        """Integrate until ``t >= t_out`` and return the state at ``t_out`` (dense output)."""
+    def advance_to(self, t_out: float, land: bool = False) -> list[float]:
+        """Integrate until ``t >= t_out`` and return the state at ``t_out`` (dense output).
+
+        ``land=True`` (adaptive methods): the last step ends exactly at ``t_out``, so the state
+        needs no dense output. Cheaper when the integration restarts at ``t_out`` anyway (an
+        input jump): a step past it would be thrown away, and the interpolant costs right-hand
+        side evaluations (DOP853: 3). Otherwise stepping past ``t_out`` keeps the step sequence
+        independent of the communication points.
+        """
         if t_out < self.t_prev:
             raise SolverError(f"cannot return to t = {t_out:.9g} s: the integrator is at t = {self.t:.9g} s")
         budget = self.max_steps_per_call
@@ -198,7 +215,7 @@ class Integrator:
                     f"t = {t_out:.6g} s (stuck at t = {self.t:.6g} s, h = {self.h:.3g} s); "
                     "the problem may be stiff"
                 )
-            self.step()
+            self.step(t_out if land else None)
             budget -= 1
         return self.state_at(t_out)
 
