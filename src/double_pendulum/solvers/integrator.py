@@ -148,10 +148,15 @@ class Integrator:
                     f"{method.name}: step size underflow (h = {h:.3g} s) at t = {self.t:.6g} s; "
                     "the problem may be stiff or the state has blown up"
                 )
-            y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h)
-            self.nfev += method.evals_per_step
+            if landing and getattr(method, "deferrable_f_new", False):
+                # f(t_stop, y_new) waits until needed: a restart at t_stop replaces it (FSAL saved)
+                y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h, with_f_new=False)
+                self.nfev += method.evals_per_step - 1
+            else:
+                y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h)
+                self.nfev += method.evals_per_step
             err = method.error_norm(self.y, y_new, stages, h, self.rtol, self.atol)
-            if err <= 1.0 and _all_finite(y_new) and _all_finite(f_new):
+            if err <= 1.0 and _all_finite(y_new) and (f_new is None or _all_finite(f_new)):
                 factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**exponent)
                 if rejected:
                     factor = min(1.0, factor)
@@ -166,8 +171,16 @@ class Integrator:
             else:
                 h *= MIN_FACTOR
 
+    def _complete_fy(self) -> None:
+        """Evaluate a deferred ``fy = f(t, y)`` of a landed step and append it to its stages."""
+        if self.fy is None:
+            self.fy = self.f(self.t, self.y)
+            self.nfev += 1
+            self.stages.append(self.fy)
+
     def step(self, t_stop: float | None = None) -> None:
         """Take one accepted step (adaptive methods: ending at ``t_stop`` [s] at the latest)."""
+        self._complete_fy()
         if self.method.adaptive:
             self._adaptive_step(t_stop)
         else:
@@ -230,6 +243,7 @@ class Integrator:
                 f"t = {t_out:.9g} s is outside the last step [{self.t_prev:.9g}, {self.t:.9g}] s"
             )
         if self._interp is None:
+            self._complete_fy()
             h = self.t - self.t_prev
             self._interp = self.method.interpolant(
                 self.f, self.t_prev, self.y_prev, self.y, self.fy_prev, self.fy, h, self.stages
