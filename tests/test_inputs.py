@@ -234,3 +234,37 @@ def test_fmu_state_with_inputs_restores_through_the_fmu(runner):
         slave.close()
     assert again == first
     assert first[-1][2] != 0.0
+
+
+@pytest.mark.parametrize("rods", [False, True])
+def test_fast_driven_core_agrees_with_the_general_evaluator(rods):
+    import random
+
+    from double_pendulum.model.inputs import InputHold, InputValues
+    from double_pendulum.model.vector_field import (
+        ModelConfig,
+        build_evaluator,
+        build_vector_field,
+        driven_core_vector_field,
+    )
+
+    pendulum = PendulumParameters(m_rod1=0.05, L_rod1=0.3, m_rod2=0.03, L_rod2=0.25) if rods else PendulumParameters()
+    config = ModelConfig(pendulum=pendulum, inputs=True)
+    evaluate = build_evaluator(config)
+    rng = random.Random(11)
+    for _ in range(200):
+        hold = InputHold(rng.uniform(-1, 1), InputValues(*(rng.uniform(-3, 3) for _ in INPUT_NAMES)))
+        fast = driven_core_vector_field(pendulum, hold)
+        assert build_vector_field(config, evaluate, hold).__qualname__ == fast.__qualname__
+        t = hold.t0 + rng.uniform(0, 0.01)
+        y = [rng.uniform(-4, 4), rng.uniform(-4, 4), rng.uniform(-8, 8), rng.uniform(-8, 8), rng.uniform(-1, 1)]
+        general = evaluate(y, hold.at(t))
+        got = fast(t, y)
+        scale = [1.0, 1.0, max(abs(general.alpha1), abs(general.alpha2)), max(abs(general.alpha1), abs(general.alpha2))]
+        for a, b, s in zip(got[:4], general.dydt[:4], scale):
+            assert abs(a - b) <= 1e-12 * s
+        # the input power: rounding of its largest term
+        u = hold.at(t)
+        terms = (abs(general.f_pivot_x * u.pivot_vx) + abs(general.f_pivot_y * u.pivot_vy)
+                 + abs(u.tau1 * y[2]) + abs(u.tau2 * (y[3] - y[2])) + abs(general.p_input))
+        assert abs(got[4] - general.p_input) <= 1e-12 * terms

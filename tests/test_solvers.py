@@ -157,3 +157,29 @@ def test_cannot_go_back_in_time():
 
 def test_registry_names():
     assert set(METHODS) >= {"dop853", "dopri5", "rk4", "euler"}
+
+
+def test_landing_ends_the_last_step_on_the_output_time_without_dense_output():
+    free = make_integrator("dop853", F, 0.0, Y0, rtol=1e-10, atol=1e-12, fixed_step=1.0)
+    landed = make_integrator("dop853", F, 0.0, Y0, rtol=1e-10, atol=1e-12, fixed_step=1.0)
+    for k in range(1, 40):
+        t = k * 1e-3 * math.pi  # a time no step reaches by rounding
+        expected = free.advance_to(t)
+        got = landed.advance_to(t, land=True)
+        assert landed.t == t  # exactly: no sliver left, no step past t
+        assert max(abs(a - b) for a, b in zip(got, expected)) < 1e-9
+    # no dense output was evaluated: at most 12 evaluations per step (and the start's 2)
+    assert landed.nfev <= 2 + 12 * (landed.n_steps + landed.n_rejected)
+    assert landed.fy is None  # the last landed step's f(t, y) waits until needed
+    assert max(abs(a - b) for a, b in zip(landed.advance_to(0.2), free.advance_to(0.2))) < 1e-9
+
+
+def test_deferred_f_new_of_a_landed_step_is_evaluated_for_dense_output():
+    it = make_integrator("dop853", F, 0.0, Y0, rtol=1e-10, atol=1e-12, fixed_step=1.0)
+    it.advance_to(0.05, land=True)
+    ref = make_integrator("dop853", F, 0.0, Y0, rtol=1e-10, atol=1e-12, fixed_step=1.0)
+    ref.advance_to(0.05, land=True)
+    ref._complete_fy()
+    mid = 0.5 * (it.t_prev + it.t)
+    assert it.state_at(mid) == ref.state_at(mid)
+    assert it.fy == F(it.t, it.y)

@@ -299,9 +299,12 @@ class DoublePendulumCoSimulation:
         check_step_call(self.initialised and self.integrator is not None, self.time, current_time, step_size)
         t_end = current_time + step_size
         try:
-            if self.driven and not self._hold.continued_by(self.time, self._input_values()):
+            jump = self.driven and not self._hold.continued_by(self.time, self._input_values())
+            if jump:
                 self._restart(self.time)  # the inputs jump here: integrate nothing across it
-            y = self.integrator.advance_to(t_end)
+            # After a jump, land on t_end: the next step likely restarts too, so a step past it
+            # and its dense output would be wasted.
+            y = self.integrator.advance_to(t_end, land=jump)
         except ModelError as error:
             raise SolverError(str(error)) from error
         outputs = self._outputs_at(y, self._hold.at(t_end) if self.driven else None)

@@ -112,6 +112,14 @@ class InputHold:
             v.tau2,
         )
 
+    def velocity_at(self, t: float) -> tuple[float, float]:
+        """Return the held pivot velocity ``(vx, vy)`` [m/s] at time ``t`` [s], as in :meth:`at`."""
+        v = self.values
+        tau = t - self.t0
+        if tau == 0.0:
+            return v.pivot_vx, v.pivot_vy
+        return v.pivot_vx + tau * v.pivot_ax, v.pivot_vy + tau * v.pivot_ay
+
     def continued_by(self, t0: float, values: InputValues) -> bool:
         """True if ``values`` set at ``t0`` describe this same hold (no discontinuity at ``t0``).
 

@@ -27,6 +27,8 @@ SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
 DEFAULT_MAX_STEPS_PER_CALL = 1_000_000
+# A step landing on a stop time may be stretched by this factor rather than leave a sliver.
+LANDING_SLACK = 1.01
 
 
 class SolverError(RuntimeError):
@@ -126,27 +128,40 @@ class Integrator:
         self._accept(h, y_new, f_new, stages)
         self.t = t_new
 
-    def _adaptive_step(self) -> None:
+    def _adaptive_step(self, t_stop: float | None = None) -> None:
+        """Take one accepted adaptive step; with ``t_stop`` [s] never step past it.
+
+        A step that would reach within :data:`LANDING_SLACK` of ``t_stop`` is stretched or clipped
+        to end exactly there (``self.t = t_stop``, no rounding of ``t + h``), so no sliver is left.
+        """
         method = self.method
         exponent = -1.0 / (method.error_order + 1)
         h = min(self.h, self.max_step)
         rejected = False
         while True:
+            landing = t_stop is not None and t_stop - self.t <= LANDING_SLACK * h
+            if landing:
+                h = t_stop - self.t
             h_min = 16.0 * math.ulp(max(abs(self.t), 1.0))
             if h < h_min:
                 raise SolverError(
                     f"{method.name}: step size underflow (h = {h:.3g} s) at t = {self.t:.6g} s; "
                     "the problem may be stiff or the state has blown up"
                 )
-            y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h)
-            self.nfev += method.evals_per_step
+            if landing and getattr(method, "deferrable_f_new", False):
+                # f(t_stop, y_new) waits until needed: a restart at t_stop replaces it (FSAL saved)
+                y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h, with_f_new=False)
+                self.nfev += method.evals_per_step - 1
+            else:
+                y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h)
+                self.nfev += method.evals_per_step
             err = method.error_norm(self.y, y_new, stages, h, self.rtol, self.atol)
-            if err <= 1.0 and _all_finite(y_new) and _all_finite(f_new):
+            if err <= 1.0 and _all_finite(y_new) and (f_new is None or _all_finite(f_new)):
                 factor = MAX_FACTOR if err == 0.0 else min(MAX_FACTOR, SAFETY * err**exponent)
                 if rejected:
                     factor = min(1.0, factor)
                 self._accept(h, y_new, f_new, stages)
-                self.t = self.t + h
+                self.t = t_stop if landing else self.t + h
                 self.h = h * factor
                 return
             self.n_rejected += 1
@@ -156,10 +171,18 @@ class Integrator:
             else:
                 h *= MIN_FACTOR
 
-    def step(self) -> None:
-        """Take one accepted step."""
+    def _complete_fy(self) -> None:
+        """Evaluate a deferred ``fy = f(t, y)`` of a landed step and append it to its stages."""
+        if self.fy is None:
+            self.fy = self.f(self.t, self.y)
+            self.nfev += 1
+            self.stages.append(self.fy)
+
+    def step(self, t_stop: float | None = None) -> None:
+        """Take one accepted step (adaptive methods: ending at ``t_stop`` [s] at the latest)."""
+        self._complete_fy()
         if self.method.adaptive:
-            self._adaptive_step()
+            self._adaptive_step(t_stop)
         else:
             self._fixed_step()
 
@@ -186,8 +209,15 @@ class Integrator:
         self.grid_start = self.n_steps
 
     # ------------------------------------------------------------------ output
-    def advance_to(self, t_out: float) -> list[float]:
-        """Integrate until ``t >= t_out`` and return the state at ``t_out`` (dense output)."""
+    def advance_to(self, t_out: float, land: bool = False) -> list[float]:
+        """Integrate until ``t >= t_out`` and return the state at ``t_out`` (dense output).
+
+        ``land=True`` (adaptive methods): the last step ends exactly at ``t_out``, so the state
+        needs no dense output. Cheaper when the integration restarts at ``t_out`` anyway (an
+        input jump): a step past it would be thrown away, and the interpolant costs right-hand
+        side evaluations (DOP853: 3). Otherwise stepping past ``t_out`` keeps the step sequence
+        independent of the communication points.
+        """
         if t_out < self.t_prev:
             raise SolverError(f"cannot return to t = {t_out:.9g} s: the integrator is at t = {self.t:.9g} s")
         budget = self.max_steps_per_call
@@ -198,7 +228,7 @@ class Integrator:
                     f"t = {t_out:.6g} s (stuck at t = {self.t:.6g} s, h = {self.h:.3g} s); "
                     "the problem may be stiff"
                 )
-            self.step()
+            self.step(t_out if land else None)
             budget -= 1
         return self.state_at(t_out)
 
@@ -213,6 +243,7 @@ class Integrator:
                 f"t = {t_out:.9g} s is outside the last step [{self.t_prev:.9g}, {self.t:.9g}] s"
             )
         if self._interp is None:
+            self._complete_fy()
             h = self.t - self.t_prev
             self._interp = self.method.interpolant(
                 self.f, self.t_prev, self.y_prev, self.y, self.fy_prev, self.fy, h, self.stages

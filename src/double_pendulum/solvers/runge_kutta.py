@@ -150,10 +150,18 @@ class Dop853:
     dense_order = 7
     evals_per_step = 12
     dense_evals = 3
+    deferrable_f_new = True  # the error estimate does not use f(t + h, y_new)
 
-    def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
+    def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float, *, with_f_new: bool = True):
+        """One step; ``with_f_new=False`` skips ``f(t + h, y_new)`` (returned as ``None``, not in the stages).
+
+        The caller then evaluates it when needed (next step, dense output) and appends it to the
+        stages, or never, if the right-hand side changes at ``t + h`` (a restart).
+        """
         ks = _run_stages(f, t, y, fy, h, tb.DOP853_A, tb.DOP853_C, 12)
         y_new = _constant_kernel(_DOP853_B_ROW, len(y))(y, h, ks)
+        if not with_f_new:
+            return y_new, None, ks
         f_new = f(t + h, y_new)
         ks.append(f_new)
         return y_new, f_new, ks
