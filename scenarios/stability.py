@@ -13,6 +13,9 @@ Explicit methods on the stiff cases are expected to fail (fixed step: blow-up de
 energy; adaptive: the step budget per doStep is exhausted), and the table shows the stiff solver
 passing the same case. Outputs: ``stability.csv`` (one row per case), ``report.md``, plots of the
 residual of the worst passing cases and CSVs of their trajectories.
+
+Cost: the cases run on parallel worker processes (one per core, the longest first), about 90 s CPU
+in all; each case's CPU time is the process time of its own run.
 """
 
 from __future__ import annotations
@@ -24,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from double_pendulum import plots
+from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.stability_cases import (
     Case,
     cases,
@@ -34,6 +38,7 @@ from double_pendulum.analysis.stability_cases import (
     run_length,
     worst_passing,
 )
+from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.fmu.runner import FmuRunError, FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv, write_table_csv, write_text
 
@@ -58,14 +63,28 @@ def run_case(runner: FmuRunner, case: Case, quick: bool) -> tuple[dict[str, Any]
     return judged_row(row, case, result), result
 
 
+def _run_case(runner: FmuRunner, item: tuple[Case, bool]) -> tuple[dict[str, Any], np.ndarray | None]:
+    return run_case(runner, *item)
+
+
+def _cost(case: Case, quick: bool) -> float:
+    """A rough CPU estimate [s] of a case (to start the long ones first): stiff solvers and long runs."""
+    stiff = case.start.get("solver") in ("rodas4", "gauss4") or case.start.get("omega_reg") is not None
+    return run_length(case, quick) * (10.0 if stiff else 1.0) + (5.0 if case.output_interval < 1e-3 else 0.0)
+
+
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     """Run every case; write the table, the report, and plots/CSVs of the worst passing cases."""
+    table = cases()
+    step(f"{len(table)} cases through fmpy" + ("" if quick else " on parallel processes"))
+    outcomes = runner_map(_run_case, [(case, quick) for case in table], runner, max_workers=1 if quick else None,
+                          costs=[_cost(case, quick) for case in table], label="stability cases", unit="case")
     rows, results = [], {}
-    for case in cases():
-        row, result = run_case(runner, case, quick)
+    for case, (row, result) in zip(table, outcomes):
         rows.append(row)
         if result is not None:
             results[case.name] = result
+    step("table, report and the worst passing cases")
     write_table_csv(out_dir / "stability.csv", rows)
     write_text(out_dir / "report.md", report(rows, quick))
     worst = worst_passing(rows, 3)
