@@ -164,6 +164,17 @@ def cmd_variables(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cpu_seconds() -> float:
+    """CPU time [s] of this process and of its finished worker processes (user + system)."""
+    total = time.process_time()
+    try:
+        import resource
+    except ImportError:  # not on POSIX: this process only
+        return total
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return total + children.ru_utime + children.ru_stime
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     names = _check_scenario(args.scenario)
     if args.quick and args.thorough:
@@ -174,7 +185,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         for number, name in enumerate(names, start=1):
             print(f"[{number}/{len(names)}] {name}: {scenario_description(name)} ...", flush=True)
             module = importlib.import_module(f"double_pendulum.scenarios.{name}")
-            start = time.perf_counter()
+            start, cpu_start = time.perf_counter(), _cpu_seconds()
             if args.thorough and not accepts_thorough(module):
                 print(f"  ({name} has no --thorough setting: its normal run)", flush=True)
             try:
@@ -185,7 +196,8 @@ def cmd_run(args: argparse.Namespace) -> int:
                 failed.append(name)
                 print(f"{name}: FAILED: {error} (partial results in {out / (name + '.failed')})", file=sys.stderr)
                 continue
-            print(f"{name}: wrote {out / name} in {time.perf_counter() - start:.1f} s", flush=True)
+            print(f"{name}: wrote {out / name} in {time.perf_counter() - start:.1f} s "
+                  f"(CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
     if failed:
         print(f"{len(failed)} of {len(names)} scenarios failed: {', '.join(failed)}", file=sys.stderr)
     return 1 if failed else 0
