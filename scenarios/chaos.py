@@ -95,7 +95,7 @@ figure), the energy scan and the Poincare sections over 50 s, and the largest ex
 only: RK4 at h / 2 costs as much as all the others and agreed with both to 0.7 % (within the standard
 error) in the thorough run."""
 QUICK = Plan(
-    workers=1, fmu_stop=4.0, sigmas=(1e-4, 1e-3, 5e-3), members=40, spread_t_end=3.0, lyap_t_end=2.0, lyap_members=7,
+    workers=None, fmu_stop=4.0, sigmas=(1e-4, 1e-3, 5e-3), members=40, spread_t_end=3.0, lyap_t_end=2.0, lyap_members=7,
     scan_thetas=(0.5, 1.0, 1.5, 2.0, 2.5, 3.0), scan_t_end=2.0, spectrum_t_end=2.0, flip_n=24, flip_t_max=2.0,
     poincare_starts=4, poincare_t_end=3.0, friction_t_end=2.0, friction_window=1.0,
 )

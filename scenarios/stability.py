@@ -76,8 +76,8 @@ def _cost(case: Case, quick: bool) -> float:
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     """Run every case; write the table, the report, and plots/CSVs of the worst passing cases."""
     table = cases()
-    step(f"{len(table)} cases through fmpy" + ("" if quick else " on parallel processes"))
-    outcomes = runner_map(_run_case, [(case, quick) for case in table], runner, max_workers=1 if quick else None,
+    step(f"{len(table)} cases through fmpy on parallel processes")
+    outcomes = runner_map(_run_case, [(case, quick) for case in table], runner,
                           costs=[_cost(case, quick) for case in table], label="stability cases", unit="case")
     rows, results = [], {}
     for case, (row, result) in zip(table, outcomes):

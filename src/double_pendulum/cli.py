@@ -232,8 +232,8 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("--rebuild", action="store_true", help="rebuild the FMU first")
     p_run.add_argument("--quick", action="store_true", help="short runs, for smoke tests (about 30 s for all)")
     p_run.add_argument("--thorough", action="store_true",
-                       help="heavier, publication-grade settings where a scenario has them (chaos, work_precision, "
-                       "suspension_transfer); the others run as usual")
+                       help="heavier, publication-grade settings where a scenario has them (chaos, "
+                       "work_precision); the others run as usual")
     p_run.set_defaults(func=cmd_run)
 
     p_list = sub.add_parser("list", help="list the scenarios", description="List the scenarios.")

@@ -181,7 +181,10 @@ def report(
              "Error: max over phi1, phi2, omega1, omega2 against a DOP853 rtol 1e-13 reference "
              "(cross-checked with SciPy Radau: the floor below). "
              f"CPU: process time through fmpy, {timing.describe()}, configurations run on parallel worker "
-             f"processes{spread}: CPU times closer than that do not rank the methods.", ""]
+             f"processes{spread}: CPU times closer than that do not rank the methods."
+             + ("" if quick or thorough else " Rodas4 stops at rtol 1e-10 here (its rtol 1e-12 runs take 10-40 s "
+                "and are never the fastest in a band; `--thorough` adds them and times every run at least 3 "
+                "times)."), ""]
     for case, floor in floors.items():
         lines += [f"## {case}", "", f"Reference error floor: {floor:.1e}", "",
                   "| max error <= | fastest method | setting | comm step [s] | max error | CPU [s] |",
