@@ -165,7 +165,8 @@ def cmd_variables(args: argparse.Namespace) -> int:
 
 
 def _cpu_seconds() -> float:
-    """CPU time [s] of this process and of its finished worker processes (user + system)."""
+    """CPU time [s] of this process and of its finished worker processes (user + system; the workers of
+    :mod:`double_pendulum.analysis.sweep` are spawned as this process's children)."""
     total = time.process_time()
     try:
         import resource

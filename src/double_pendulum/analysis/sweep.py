@@ -7,9 +7,11 @@ cases. The cases are split into contiguous chunks; each worker process extracts 
 chunks one case after another.
 
 * Locally (default) the chunks go to a :class:`concurrent.futures.ProcessPoolExecutor` with one
-  process per core (``max_workers=None``), started by ``forkserver`` so no threads of the calling
-  process are forked; ``max_workers=1`` runs in the calling process. As with any spawned worker
-  processes, a script that calls this must guard its top level with ``if __name__ == "__main__":``.
+  process per core (``max_workers=None``), started by ``spawn`` so no threads of the calling
+  process are forked and the workers are the caller's own children (their CPU time counts in the
+  caller's ``RUSAGE_CHILDREN`` and in ``time``); ``max_workers=1`` runs in the calling process. As
+  with any spawned worker processes, a script that calls this must guard its top level with
+  ``if __name__ == "__main__":``.
 * With ``scheduler="tcp://host:8786"`` (or a ``distributed.Client``) they go to a Dask cluster,
   as in FMPy's own parameter-variation example. The FMU file itself is sent to the workers once
   (``Client.scatter(..., broadcast=True)``), so they need not share a file system; they need this
@@ -141,7 +143,7 @@ def parallel_map(
                 results[i] = _call(func, item, shared)
                 bar.update(weights[i])
             return results, 1
-        context = multiprocessing.get_context("forkserver" if os.name == "posix" else "spawn")
+        context = multiprocessing.get_context("spawn")
         with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
             with _without_fmu_resources_on_path():  # workers start on these submits
                 futures = {pool.submit(_call, func, item, shared): i for i, item in enumerate(items)}
