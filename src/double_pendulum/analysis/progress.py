@@ -30,6 +30,8 @@ QUIET_SECONDS = 5.0
 """Plain-line mode stays silent for loops shorter than this [s]."""
 LINE_FRACTION = 0.1
 """Plain-line mode prints a line each time this fraction of the loop is done."""
+LINE_EVERY_S = 60.0
+"""... and also when an item finishes this long [s] after the last line (or the start)."""
 
 
 def step(text: str) -> None:
@@ -79,6 +81,7 @@ class LineProgress:
         self.marks = 1  # lines printed for LINE_FRACTION, 2 LINE_FRACTION, ... of total
         self.printed = False
         self.closed = False
+        self.last_line = self.start
 
     def _write(self, text: str) -> None:
         stream = self.file or sys.stderr
@@ -94,13 +97,17 @@ class LineProgress:
         if self.total <= 0:
             return
         fraction = self.n / self.total
-        if fraction < self.marks * LINE_FRACTION - 1e-9 or self.n >= self.total:
+        now = time.monotonic()
+        crossed = fraction >= self.marks * LINE_FRACTION - 1e-9
+        overdue = now - self.last_line >= LINE_EVERY_S
+        if not (crossed or overdue) or self.n >= self.total:
             return
         while self.marks * LINE_FRACTION - 1e-9 <= fraction:
             self.marks += 1
-        elapsed = time.monotonic() - self.start
+        elapsed = now - self.start
         if elapsed < QUIET_SECONDS:
             return
+        self.last_line = now
         left = elapsed / self.n * (self.total - self.n)
         self._write(f"{self.n}/{self.total} ({100 * fraction:.0f} %), {_clock(elapsed)} elapsed, "
                     f"{self._rate(elapsed)}, about {_clock(left)} left")
