@@ -20,6 +20,8 @@ import numpy as np
 
 from double_pendulum import plots
 from double_pendulum.analysis.decay_fit import fit_model
+from double_pendulum.analysis.progress import step
+from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv
 
@@ -50,6 +52,14 @@ def _decay_rate(result: np.ndarray) -> dict[str, float]:
     }
 
 
+def _timed_run(runner: FmuRunner, item: tuple[dict, float]) -> tuple[np.ndarray, float]:
+    """Worker: one run with the mechanisms ``switches`` on, and its CPU time [s]."""
+    switches, stop_time = item
+    t0 = time.process_time()
+    r = runner.simulate({**SEED_RELEASE, **SETTINGS, **switches}, stop_time=stop_time, output_interval=OUTPUT_INTERVAL)
+    return r, time.process_time() - t0
+
+
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     """Run every mechanism alone and all together; write CSVs, plots and the summary."""
     stop_time = 5.0 if quick else STOP_TIME
@@ -61,12 +71,10 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "stop_time_s": stop_time,
         "runs": {},
     }
-    for label, switches in RUNS.items():
-        t0 = time.process_time()
-        r = runner.simulate(
-            {**SEED_RELEASE, **SETTINGS, **switches}, stop_time=stop_time, output_interval=OUTPUT_INTERVAL
-        )
-        cpu = time.process_time() - t0
+    step(f"{len(RUNS)} runs of {stop_time:g} s through fmpy on parallel processes")
+    timed = runner_map(_timed_run, [(switches, stop_time) for switches in RUNS.values()], runner,
+                       label="friction_budget runs", costs=[len(s) + 1.0 for s in RUNS.values()])
+    for (label, switches), (r, cpu) in zip(RUNS.items(), timed):
         write_results_csv(out_dir / f"{label}.csv", r, runner.units)
         results[label] = r
         e0, e_end = float(r["E_total"][0]), float(r["E_total"][-1])

@@ -22,6 +22,10 @@ Outputs in ``results/suspension_transfer/``: ``decay_rate_map.csv`` (the sweep),
 (measured and simulated energy per frame), ``identified.csv`` / ``resonant.csv`` (energy-flow runs),
 ``fixed_pivot_force.csv``; plots ``decay_rate_map.png``, ``decay_rate_cuts.png``,
 ``force_spectrum.png``, ``energy_flow.png``, ``energy_fit.png``; ``summary.json``; ``report.md``.
+
+Cost: the identification is sequential (each Gauss-Newton step needs the last); the three maps
+run in one parallel sweep; the refits along the valley, the window checks, the Fisher matrix and
+the final runs, all independent once c is identified, run on parallel worker processes too.
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ from double_pendulum.analysis import suspension_transfer as study
 from double_pendulum.analysis.decay_map import MAP_SETTINGS, MAP_UNITS, decay_maps, map_summary, trace_valley
 from double_pendulum.analysis.energy_flow import energy_flow_run, energy_flow_summary
 from double_pendulum.analysis.measurement import load_track, reconstruct
+from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.suspension_identification import (
     DEFAULT_SUSPENSION,
     FIT_SETTINGS,
@@ -54,6 +59,7 @@ from double_pendulum.analysis.suspension_identification import (
     window_check,
 )
 from double_pendulum.analysis.suspension_report import report_text
+from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv, write_text
 
@@ -115,8 +121,29 @@ QUICK = Plan(
     window_s=QUICK_WINDOW_S,
     valley_k_factors=(),
     window_checks_s=(),
-    max_workers=1,
+    max_workers=None,
 )
+
+
+def checks(runner: FmuRunner, task: tuple[str, Any, dict[str, Any]]) -> Any:
+    """Worker: one of the independent runs after the identification (``kind``, argument, shared context)."""
+    kind, arg, ctx = task
+    md, base, ident = ctx["md"], ctx["base"], ctx["ident"]
+    if kind == "trace":
+        return trace_valley(runner, md, base, ident, ctx["map"], (arg,))[0]
+    if kind == "window":
+        return window_check(runner, ctx["rec"], base, ident, arg)
+    if kind == "fisher":
+        return valley_fisher(runner, md, base, ident)
+    if kind == "frames":
+        return simulate_frames_from(runner, arg, md.frames)
+    if kind == "flow":
+        return energy_flow_run(runner, arg, md.frames)
+    raise ValueError(f"unknown task {kind!r}")
+
+
+TASK_COST = {"trace": 12.0, "window": 6.0, "fisher": 3.0, "frames": 1.5, "flow": 2.0}
+"""Rough CPU seconds per task (to start the long ones first)."""
 
 
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
@@ -126,32 +153,46 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     plan = QUICK if quick else FULL
 
     # identification of c at the default k, M_s; the map b(k, c); c refitted along its valley
+    step("fitting the release state and the damping c to the measured energy (sequential FMU runs)")
     rec = reconstruct(load_track())
     model = identify_suspension(runner, rec, quick=quick, m_s=plan.m_s_main)
     md, ident, spectrum = model.measured, model.identification, model.spectrum
     base = {**pendulum_values(rec), **LOSSES, **model.start.start_values()}
+    step(f"decay-rate maps over (k, c) at M_s = {', '.join(f'{m:g}' for m in (plan.m_s_main, *plan.m_s_extra))} kg")
     t_map = time.perf_counter()
     maps = decay_maps(
         runner.fmu_path, base, md.frames, spectrum, plan.k_grid, plan.c_grid, plan.m_s_main,
         m_s_extra=plan.m_s_extra, extra_stride=plan.extra_stride, max_workers=plan.max_workers,
     )
     map_wall = time.perf_counter() - t_map
-    trace = trace_valley(runner, md, base, ident, maps[0], plan.valley_k_factors)
 
-    # runs on the measured frames: identified, no suspension, the resonant end of the iso-b curve
-    runs = {
-        "identified": simulate_frames_from(runner, model.values, md.frames),
-        "no suspension": simulate_frames_from(runner, base, md.frames),
-    }
-    flows = {"identified": energy_flow_run(runner, model.values, md.frames)}
-    points = {f"identified (k fixed at {ident.k:g} N/m)": (ident.k, ident.c)}
-    points.update({f"c refitted at k = {f.k:.3g} N/m": (f.k, f.c) for f in trace})
+    # independent now: refits along the valley, window checks, Fisher matrix, runs on the measured frames
     resonant = study.resonant_point(maps[0], md.b) if plan.valley_k_factors else None
+    ctx = {"md": md, "base": base, "ident": ident, "map": maps[0], "rec": rec}
+    tasks: list[tuple[str, Any, dict[str, Any]]] = [("trace", f, ctx) for f in plan.valley_k_factors]
+    tasks += [("window", w, ctx) for w in plan.window_checks_s]
+    tasks += [("fisher", None, ctx), ("frames", model.values, ctx), ("frames", base, ctx), ("flow", model.values, ctx)]
     if resonant is not None:
         values = {**base, **suspension_values(resonant[0], resonant[1], plan.m_s_main)}
-        runs["resonant"] = simulate_frames_from(runner, values, md.frames)
-        flows["resonant"] = energy_flow_run(runner, values, md.frames)
+        tasks += [("frames", values, ctx), ("flow", values, ctx)]
+    step(f"{len(plan.valley_k_factors)} refits along the valley, {len(plan.window_checks_s)} window checks, "
+         "the Fisher matrix and the energy-flow runs")
+    done = runner_map(checks, tasks, runner, max_workers=plan.max_workers, costs=[TASK_COST[t[0]] for t in tasks],
+                      label="suspension checks", unit="task")
+    n_trace, n_window = len(plan.valley_k_factors), len(plan.window_checks_s)
+    trace = done[:n_trace]
+    windows = done[n_trace:n_trace + n_window]
+    fisher, ident_run, base_run, ident_flow, *resonant_runs = done[n_trace + n_window:]
+
+    # runs on the measured frames: identified, no suspension, the resonant end of the iso-b curve
+    runs = {"identified": ident_run, "no suspension": base_run}
+    flows = {"identified": ident_flow}
+    points = {f"identified (k fixed at {ident.k:g} N/m)": (ident.k, ident.c)}
+    points.update({f"c refitted at k = {f.k:.3g} N/m": (f.k, f.c) for f in trace})
+    if resonant is not None:
+        runs["resonant"], flows["resonant"] = resonant_runs
         points["resonant end of the curve"] = resonant
+    step("summary, tables, plots and the report")
 
     summary: dict[str, Any] = {
         "scenario": "suspension_transfer",
@@ -163,15 +204,15 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "identified": {**point_summary(md, ident, ident.chi2), "fixed": {"k": ident.k, "M_s": ident.m_s}},
         "refit": {label: study.run_summary(md, r, ident.chi2) for label, r in runs.items()},
         "valley": {
-            "fisher": valley_fisher(runner, md, base, ident),
+            "fisher": fisher,
             "trace": [point_summary(md, f, ident.chi2) for f in trace],
             "resonant_end": None if resonant is None else study.resonant_summary(resonant, plan.m_s_main, spectrum),
         },
-        "window_checks": [window_check(runner, rec, base, ident, w) for w in plan.window_checks_s],
+        "window_checks": windows,
         "spectrum": study.spectrum_summary(spectrum, ident),
         "maps": [map_summary(d, spectrum, md, SEED_B) for d in maps],
         "energy_flow": {label: energy_flow_summary(f) for label, f in flows.items()},
-        "map_runs": int(sum(d.b.size + 1 for d in maps)),
+        "map_runs": int(sum(d.b.size for d in maps) + 1),  # one run without suspension serves every map
         "map_wall_time_s": map_wall,
         "null_means": NULL_MEANS,
     }

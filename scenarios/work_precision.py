@@ -8,8 +8,16 @@ final-horizon error and maximum error over the horizon (max over phi1, phi2, ome
 against the cached reference, :mod:`double_pendulum.analysis.reference`; the cases, errors and
 the choice per band are in :mod:`double_pendulum.analysis.work_precision`), energy drift (frictionless: max
 |E_total - E0| / E0; with dissipation: max |energy_residual| / E0), RHS evaluations and steps
-(FMU outputs), CPU time (median of the repeats, with the spread). Failed or unstable
-configurations are kept in the table with their status and message.
+(FMU outputs), CPU time (process time of the run; the median of 1-5 repeats: runs are repeated while
+they took under 0.5 s CPU in all, so cheap runs, whose timing decides close races, are timed several
+times and expensive ones once). Failed or unstable configurations are kept in the table with their
+status and message.
+
+Cost: the configurations and the three references (cached, see
+:mod:`double_pendulum.analysis.reference`) run on parallel worker processes, one per core, about
+2 minutes CPU in all without cached references. ``thorough=True`` (``--thorough``) adds Rodas4 at
+rtol 1e-12 (40 s CPU on the stiff case alone; it wins no band) and times every configuration at
+least 3 times.
 
 Outputs: ``work_precision.csv``, one log-log plot per case (max error against CPU time, one line
 per method), ``report.md`` naming the fastest method per accuracy band and case.
@@ -18,16 +26,24 @@ per method), ``report.md`` naming the fastest method per accuracy band and case.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from double_pendulum import plots
-from double_pendulum.analysis.reference import Reference, reference_solution
+from double_pendulum.analysis.progress import step
+from double_pendulum.analysis.reference import STATE_OUTPUTS, Reference, cached_reference, reference_solution
+from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.analysis.work_precision import (
     BASE_COMM_STEP,
     CASES,
     COMM_STEPS,
+    THOROUGH_TIMING,
+    TIMING,
     Case,
+    Timing,
     accuracy_columns,
     best_per_band,
     failure_columns,
@@ -41,54 +57,118 @@ from double_pendulum.solvers import METHODS
 
 DESCRIPTION = "error against CPU time for every solver, tolerance and communication step (through fmpy)"
 
+OUTPUTS = (*STATE_OUTPUTS, "E_total", "energy_residual", "solver_rhs_evaluations", "solver_steps")
+"""The outputs a configuration needs for its errors, drift and counts."""
 
-def run_config(runner: FmuRunner, case: Case, ref: Reference, solver: str, setting: dict, comm: float, horizon: float,
-               repeats: int) -> dict[str, Any]:
-    """Run one configuration ``repeats`` times; return its table row."""
-    start = {**case.start, "solver": solver, **setting}
-    row: dict[str, Any] = {"case": case.name, "solver": solver, **setting, "comm_step_s": comm, "horizon_s": horizon}
-    cpu = []
+
+@dataclass(frozen=True)
+class Config:
+    """One run of the table: a case, a solver with its setting, a communication step, a horizon."""
+
+    case: Case
+    solver: str
+    setting: dict[str, float]
+    comm: float
+    horizon: float
+    timing: Timing
+
+    def cost(self) -> float:
+        """A rough estimate of the run's CPU time (to start the expensive runs first)."""
+        per_step = self.setting.get("fixed_step") or self.setting.get("rtol", 1e-8) ** (1 / 5) * 0.05
+        implicit = 8.0 if self.solver in ("rodas4", "gauss4", "gauss2") else 1.0
+        stiff = 20.0 if self.case.dissipative else 1.0
+        return self.horizon * (implicit * stiff / per_step + 1.0 / self.comm)
+
+
+def run_config(runner: FmuRunner, config: Config) -> tuple[dict[str, Any], np.ndarray | None]:
+    """Run one configuration (repeated as its :class:`Timing` says); its row (no errors yet) and result."""
+    case = config.case
+    start = {**case.start, "solver": config.solver, **config.setting}
+    row: dict[str, Any] = {"case": case.name, "solver": config.solver, **config.setting,
+                           "comm_step_s": config.comm, "horizon_s": config.horizon}
+    cpu: list[float] = []
     result = None
     try:
-        for _ in range(repeats):
+        while config.timing.more(cpu):
             t0 = time.process_time()
-            result = runner.simulate(start, stop_time=horizon, output_interval=comm)
+            result = runner.simulate(start, stop_time=config.horizon, output_interval=config.comm, outputs=OUTPUTS)
             cpu.append(time.process_time() - t0)
         row["status"] = "ok"
     except FmuRunError as error:
-        return {**row, **failure_columns(error)}
-    return {**row, **timing_columns(cpu), **accuracy_columns(result, case, ref, comm)}
+        return {**row, **failure_columns(error)}, None
+    return {**row, **timing_columns(cpu)}, result
 
 
-def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
-    """Sweep every solver on every case; write the table, plots and the report."""
-    repeats = 1 if quick else 3
+def _task(runner: FmuRunner, task: tuple[str, Any]) -> Any:
+    """Worker: a reference (``("reference", (case, horizon))``) or a configuration (``("config", Config)``)."""
+    kind, item = task
+    if kind == "reference":
+        case, horizon = item
+        return reference_solution(case.start, horizon, BASE_COMM_STEP)
+    return run_config(runner, item)
+
+
+def configurations(quick: bool, thorough: bool) -> list[Config]:
+    """Every configuration of the sweep, case by case, solver by solver."""
     solvers = ("dop853", "rk4") if quick else tuple(METHODS)
-    cases = CASES[:1] if quick else CASES
-    rows: list[dict[str, Any]] = []
-    floors: dict[str, float] = {}
-    for case in cases:
+    timing = THOROUGH_TIMING if thorough else TIMING
+    out = []
+    for case in CASES[:1] if quick else CASES:
         horizon = case.quick_horizon if quick else case.horizon
-        ref = reference_solution(case.start, horizon, BASE_COMM_STEP)
-        floors[case.name] = ref.error_floor
         for solver in solvers:
-            sweep = settings_for(solver, quick)
-            for setting in sweep:
-                rows.append(run_config(runner, case, ref, solver, setting, BASE_COMM_STEP, horizon, repeats))
+            sweep = settings_for(solver, quick, thorough)
+            out += [Config(case, solver, setting, BASE_COMM_STEP, horizon, timing) for setting in sweep]
             if not quick:  # communication-step sweep at the middle setting
                 mid = sweep[len(sweep) // 2]
-                for comm in COMM_STEPS:
-                    if comm != BASE_COMM_STEP:
-                        rows.append(run_config(runner, case, ref, solver, mid, comm, horizon, repeats))
+                out += [Config(case, solver, mid, comm, horizon, timing)
+                        for comm in COMM_STEPS if comm != BASE_COMM_STEP]
+    return out
+
+
+def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool = False) -> dict:
+    """Sweep every solver on every case; write the table, plots and the report."""
+    configs = configurations(quick, thorough)
+    horizons = {c.case.name: (c.case, c.horizon) for c in configs}
+    refs: dict[str, Reference] = {}
+    tasks: list[tuple[str, Any]] = []
+    costs: list[float] = []
+    for name, (case, horizon) in horizons.items():
+        cached = cached_reference(case.start, horizon, BASE_COMM_STEP)
+        if cached is not None:
+            refs[name] = cached
+        else:
+            tasks.append(("reference", (case, horizon)))
+            costs.append(1e9)  # the references are the longest tasks: start them first
+    missing = [t[1][0].name for t in tasks]
+    step(f"{len(configs)} configurations through fmpy" + (
+        f", and the references of {', '.join(missing)} (computed once, then cached)" if missing else
+        " (references cached)"))
+    tasks += [("config", c) for c in configs]
+    costs += [c.cost() for c in configs]
+    results = runner_map(_task, tasks, runner, max_workers=1 if quick else None, costs=costs,
+                         label="work_precision", unit="run")
+    for (kind, item), value in zip(tasks, results):
+        if kind == "reference":
+            refs[item[0].name] = value
+    rows: list[dict[str, Any]] = []
+    for config, (row, result) in zip(configs, results[len(missing):]):
+        if result is not None:
+            row.update(accuracy_columns(result, config.case, refs[config.case.name], config.comm))
+        rows.append(row)
+    step("tables, plots and the report")
+    floors = {name: refs[name].error_floor for name in horizons}
+    for name, (_case, horizon) in horizons.items():
         plots.plot_work_precision(
-            [r for r in rows if r["case"] == case.name and r["comm_step_s"] == BASE_COMM_STEP],
-            out_dir / f"work_precision_{case.name}.png", title=f"{case.name} (horizon {horizon:g} s)",
+            [r for r in rows if r["case"] == name and r["comm_step_s"] == BASE_COMM_STEP],
+            out_dir / f"work_precision_{name}.png", title=f"{name} (horizon {horizon:g} s)",
         )
     best = {case: best_per_band(rows, case, floor) for case, floor in floors.items()}
+    timing = THOROUGH_TIMING if thorough else TIMING
     write_table_csv(out_dir / "work_precision.csv", rows)
-    write_text(out_dir / "report.md", report(rows, best, floors, quick))
-    summary = {"scenario": "work_precision", "quick": quick, "reference_error_floor": floors,
-               "best_per_band": best, "configurations": len(rows),
-               "failed_or_unstable": sum(r["status"] != "ok" for r in rows)}
+    write_text(out_dir / "report.md", report(rows, best, floors, quick, timing, thorough))
+    summary = {"scenario": "work_precision", "quick": quick, "thorough": thorough,
+               "reference_error_floor": floors, "best_per_band": best, "configurations": len(rows),
+               "failed_or_unstable": sum(r["status"] != "ok" for r in rows),
+               "cpu_timing": timing.describe()}
     write_json(out_dir / "summary.json", summary)
     return summary

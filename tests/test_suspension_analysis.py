@@ -210,14 +210,27 @@ def test_natural_frequency_marks_and_shown_spectrum():
 def test_decay_maps_sweeps_the_main_grid_then_coarser_ones_per_extra_mass(monkeypatch):
     calls = []
 
-    def fake_decay_map(fmu_path, base, frames, spectrum, k_grid, c_grid, m_s, max_workers=None):
-        calls.append((tuple(k_grid), tuple(c_grid), m_s, max_workers))
-        return m_s
+    def fake_sweep(fmu_path, base, frames, cases, max_workers=None):
+        calls.append((list(cases), max_workers))
+        return [{"b_E_pendulum": -float(i), "b_E_total": -float(i)} for i in range(len(cases))]
 
-    monkeypatch.setattr(decay_map, "decay_map", fake_decay_map)
+    class Spectrum:
+        def linear_response_rate(self, k, c, m_s):
+            return 0.0
+
+        def quasi_static_rate(self, k, c):
+            return 0.0
+
+    monkeypatch.setattr(decay_map, "decay_rate_sweep", fake_sweep)
     k, c = (1.0, 2.0, 3.0, 4.0, 5.0), (10.0, 20.0, 30.0)
-    maps = decay_maps("x.fmu", {}, None, None, k, c, 2.0, m_s_extra=(0.5, 8.0), extra_stride=2, max_workers=3)
-    assert maps == [2.0, 0.5, 8.0]
-    assert calls[0] == (k, c, 2.0, 3)
-    assert calls[1] == ((1.0, 3.0, 5.0), (10.0, 30.0), 0.5, 3)
-    assert calls[2][:2] == calls[1][:2]
+    maps = decay_maps("x.fmu", {}, None, Spectrum(), k, c, 2.0, m_s_extra=(0.5, 8.0), extra_stride=2, max_workers=3)
+    assert len(calls) == 1 and calls[0][1] == 3  # one sweep for every grid
+    cases = calls[0][0]
+    assert len(cases) == 1 + 15 + 6 + 6 and cases[0]["suspension"] is False  # one run without suspension, shared
+    assert [m.m_s for m in maps] == [2.0, 0.5, 8.0]
+    assert tuple(maps[0].k) == k and tuple(maps[0].c) == c
+    assert tuple(maps[1].k) == (1.0, 3.0, 5.0) and tuple(maps[1].c) == (10.0, 30.0)
+    assert tuple(maps[2].k) == tuple(maps[1].k) and tuple(maps[2].c) == tuple(maps[1].c)
+    assert all(m.b_base == 0.0 for m in maps)
+    assert maps[0].b[0, 0] == -1.0 and maps[1].b[0, 0] == -16.0 and maps[2].b[-1, -1] == -27.0
+    assert cases[16]["k_x"] == 1.0 and cases[16]["M_s"] == 0.5 and cases[16]["c_x"] == 10.0

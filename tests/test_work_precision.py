@@ -69,12 +69,22 @@ def test_energy_drift_is_relative_to_the_start_energy():
 
 
 def test_timing_and_failure_columns():
-    assert wp.timing_columns([0.3, 0.1, 0.2]) == {"cpu_time_s": 0.2, "cpu_spread": pytest.approx(1.0)}
-    assert wp.timing_columns([0.0]) == {"cpu_time_s": 0.0, "cpu_spread": 0.0}
+    assert wp.timing_columns([0.3, 0.1, 0.2]) == {"cpu_time_s": 0.2, "cpu_spread": pytest.approx(1.0), "repeats": 3}
+    assert wp.timing_columns([0.0]) == {"cpu_time_s": 0.0, "cpu_spread": 0.0, "repeats": 1}
     unstable = wp.failure_columns(RuntimeError("doStep failed. FMU says: numerical instability at t = 1 s"))
     assert unstable == {"status": "unstable", "message": "numerical instability at t = 1 s"}
     long = "doStep failed: " + "word " * 60
     assert wp.failure_columns(RuntimeError(long)) == {"status": "failed", "message": "word " * 60}  # never cut
+
+
+def test_cheap_runs_are_timed_several_times_and_expensive_ones_once():
+    timing = wp.Timing(min_repeats=1, max_repeats=5, repeat_below_s=0.5)
+    assert timing.more([]) and not timing.more([2.0])  # an expensive run: once
+    assert timing.more([0.1, 0.1]) and not timing.more([0.1] * 5)  # cheap: up to 5 times
+    assert not timing.more([0.2, 0.2, 0.2])  # until 0.5 s CPU in all
+    assert wp.THOROUGH_TIMING.more([5.0, 5.0])  # thorough: at least 3 repeats
+    assert [s["rtol"] for s in wp.settings_for("rodas4", quick=False)][-1] == 1e-10
+    assert [s["rtol"] for s in wp.settings_for("rodas4", quick=False, thorough=True)][-1] == 1e-12
 
 
 def test_best_per_band_takes_the_fastest_run_within_each_bound_above_the_floor():

@@ -10,6 +10,7 @@ import argparse
 import ast
 import importlib
 import importlib.util
+import inspect
 import json
 import shutil
 import sys
@@ -98,7 +99,12 @@ def _mark_quick(folder: Path, quick: bool) -> None:
         summary_path.write_text(json.dumps(summary, indent=2) + "\n")
 
 
-def run_scenario(module, name: str, runner, out: Path, quick: bool) -> None:
+def accepts_thorough(module) -> bool:
+    """Whether the scenario's ``run()`` takes ``thorough`` (a heavier, publication-grade setting)."""
+    return "thorough" in inspect.signature(module.run).parameters
+
+
+def run_scenario(module, name: str, runner, out: Path, quick: bool, thorough: bool = False) -> None:
     """Run one scenario into a fresh folder that replaces ``out/name`` only once it has finished.
 
     No stale file from an earlier run and no half-written folder survive: an interrupted run
@@ -110,7 +116,8 @@ def run_scenario(module, name: str, runner, out: Path, quick: bool) -> None:
     shutil.rmtree(staging, ignore_errors=True)
     staging.mkdir()
     try:
-        module.run(runner, staging, quick=quick)
+        options = {"thorough": True} if thorough and accepts_thorough(module) else {}
+        module.run(runner, staging, quick=quick, **options)
         _mark_quick(staging, quick)
     except KeyboardInterrupt:
         shutil.rmtree(staging, ignore_errors=True)
@@ -158,24 +165,41 @@ def cmd_variables(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cpu_seconds() -> float:
+    """CPU time [s] of this process and of its finished worker processes (user + system; the workers of
+    :mod:`double_pendulum.analysis.sweep` are spawned as this process's children)."""
+    total = time.process_time()
+    try:
+        import resource
+    except ImportError:  # not on POSIX: this process only
+        return total
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return total + children.ru_utime + children.ru_stime
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     names = _check_scenario(args.scenario)
+    if args.quick and args.thorough:
+        raise CliError("--quick and --thorough exclude each other")
     out = _writable_folder(args.out)
     failed = []
     with _load_fmu(args.fmu, args.rebuild) as runner:
         for number, name in enumerate(names, start=1):
             print(f"[{number}/{len(names)}] {name}: {scenario_description(name)} ...", flush=True)
             module = importlib.import_module(f"double_pendulum.scenarios.{name}")
-            start = time.perf_counter()
+            start, cpu_start = time.perf_counter(), _cpu_seconds()
+            if args.thorough and not accepts_thorough(module):
+                print(f"  ({name} has no --thorough setting: its normal run)", flush=True)
             try:
-                run_scenario(module, name, runner, out, args.quick)
+                run_scenario(module, name, runner, out, args.quick, args.thorough)
             except KeyboardInterrupt:
                 raise
             except Exception as error:  # report, keep what was written, go on with the next
                 failed.append(name)
                 print(f"{name}: FAILED: {error} (partial results in {out / (name + '.failed')})", file=sys.stderr)
                 continue
-            print(f"{name}: wrote {out / name} in {time.perf_counter() - start:.1f} s", flush=True)
+            print(f"{name}: wrote {out / name} in {time.perf_counter() - start:.1f} s "
+                  f"(CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
     if failed:
         print(f"{len(failed)} of {len(names)} scenarios failed: {', '.join(failed)}", file=sys.stderr)
     return 1 if failed else 0
@@ -211,7 +235,10 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("--fmu", default=str(DEFAULT_FMU_PATH),
                        help=f"FMU to use, built if missing or older than the sources (default: {DEFAULT_FMU_PATH})")
     p_run.add_argument("--rebuild", action="store_true", help="rebuild the FMU first")
-    p_run.add_argument("--quick", action="store_true", help="short runs, for smoke tests")
+    p_run.add_argument("--quick", action="store_true", help="short runs, for smoke tests (about 30 s for all)")
+    p_run.add_argument("--thorough", action="store_true",
+                       help="heavier, publication-grade settings where a scenario has them (chaos, "
+                       "work_precision); the others run as usual")
     p_run.set_defaults(func=cmd_run)
 
     p_list = sub.add_parser("list", help="list the scenarios", description="List the scenarios.")

@@ -493,6 +493,7 @@ def flip_time_map(
         progress=progress,
         label="flip map",
         weights=[r.size for r in rows],
+        unit="row",
     )
     wall = time.perf_counter() - start
     times = np.empty(g1.shape)

@@ -154,6 +154,25 @@ class DecayMap:
         return out
 
 
+def _map_from_rates(
+    rates: Sequence[dict[str, float]], spectrum: ForceSpectrum, k_grid: Sequence[float], c_grid: Sequence[float],
+    m_s: float,
+) -> DecayMap:
+    """A :class:`DecayMap` from the rates of the run without suspension (first) and of the grid (c fastest)."""
+    shape = (len(k_grid), len(c_grid))
+    k_arr, c_arr = np.asarray(k_grid, dtype=float), np.asarray(c_grid, dtype=float)
+    return DecayMap(
+        m_s=m_s,
+        k=k_arr,
+        c=c_arr,
+        b=np.array([r["b_E_pendulum"] for r in rates[1:]]).reshape(shape),
+        b_total=np.array([r["b_E_total"] for r in rates[1:]]).reshape(shape),
+        b_linear=np.array([[spectrum.linear_response_rate(k, c, m_s) for c in c_arr] for k in k_arr]),
+        b_quasi_static=np.array([[spectrum.quasi_static_rate(k, c) for c in c_arr] for k in k_arr]),
+        b_base=rates[0]["b_E_pendulum"],
+    )
+
+
 def decay_map(
     fmu_path: str | Path,
     base: Mapping[str, Any],
@@ -167,18 +186,7 @@ def decay_map(
     """Sweep (k, c) at ``m_s`` through the FMU (plus one run without suspension) and predict each point."""
     cases = [{**MAP_SETTINGS, "suspension": False}] + sweep_cases(k_grid, c_grid, m_s)
     rates = decay_rate_sweep(fmu_path, base, frames, cases, max_workers)
-    shape = (len(k_grid), len(c_grid))
-    k_arr, c_arr = np.asarray(k_grid, dtype=float), np.asarray(c_grid, dtype=float)
-    return DecayMap(
-        m_s=m_s,
-        k=k_arr,
-        c=c_arr,
-        b=np.array([r["b_E_pendulum"] for r in rates[1:]]).reshape(shape),
-        b_total=np.array([r["b_E_total"] for r in rates[1:]]).reshape(shape),
-        b_linear=np.array([[spectrum.linear_response_rate(k, c, m_s) for c in c_arr] for k in k_arr]),
-        b_quasi_static=np.array([[spectrum.quasi_static_rate(k, c) for c in c_arr] for k in k_arr]),
-        b_base=rates[0]["b_E_pendulum"],
-    )
+    return _map_from_rates(rates, spectrum, k_grid, c_grid, m_s)
 
 
 def decay_maps(
@@ -194,11 +202,22 @@ def decay_maps(
     max_workers: int | None = None,
 ) -> list[DecayMap]:
     """The main (k, c) map at ``m_s_main`` [kg], then coarser ones at each of ``m_s_extra`` [kg] on every
-    ``extra_stride``-th value of both grids (see :func:`decay_map`)."""
-    maps = [decay_map(fmu_path, base, frames, spectrum, k_grid, c_grid, m_s_main, max_workers)]
-    k_coarse, c_coarse = k_grid[::extra_stride], c_grid[::extra_stride]
-    for m_s in m_s_extra:
-        maps.append(decay_map(fmu_path, base, frames, spectrum, k_coarse, c_coarse, m_s, max_workers))
+    ``extra_stride``-th value of both grids (see :func:`decay_map`).
+
+    All grids run in one sweep (one set of worker processes) with one run without suspension, which every
+    map shares (the same start values, so the same run).
+    """
+    grids = [(k_grid, c_grid, m_s_main)]
+    grids += [(k_grid[::extra_stride], c_grid[::extra_stride], m_s) for m_s in m_s_extra]
+    cases = [{**MAP_SETTINGS, "suspension": False}]
+    for k, c, m_s in grids:
+        cases += sweep_cases(k, c, m_s)
+    rates = decay_rate_sweep(fmu_path, base, frames, cases, max_workers)
+    maps, i = [], 1
+    for k, c, m_s in grids:
+        n = len(k) * len(c)
+        maps.append(_map_from_rates([rates[0], *rates[i:i + n]], spectrum, k, c, m_s))
+        i += n
     return maps
 
 

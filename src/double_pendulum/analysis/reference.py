@@ -3,14 +3,21 @@
 A reference is the in-process simulation with DOP853 at rtol = 1e-13 (our integrator, on the
 output grid), cross-checked against SciPy's Radau (a different, implicit method) at rtol = 1e-12
 on the same vector field. Their largest difference is the reference's *error floor*: errors
-below it cannot be resolved. References are cached as ``.npz`` files keyed by a hash of the case,
-in ``.cache/references/`` (not committed).
+below it cannot be resolved. The Radau cross-check is the expensive part (10-35 s CPU per case).
+
+References are cached as ``.npz`` files in ``references/`` under the cache folder
+(:func:`cache_dir`: ``$DOUBLE_PENDULUM_CACHE`` if set, else ``.cache/`` in the working directory;
+not committed), named by a hash of the case (start values, horizon, output interval), the
+reference settings and the runtime sources (``model/``, ``solvers/``, ``component/``): a change of
+the equations or the integrators computes them anew. Delete the folder to force that by hand.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,7 +29,27 @@ from ..component.cosimulation import DoublePendulumCoSimulation
 from ..fmu.simulate import simulate
 
 STATE_OUTPUTS = ("phi1", "phi2", "omega1", "omega2")
-CACHE_DIR = Path(".cache") / "references"
+CACHE_ENV = "DOUBLE_PENDULUM_CACHE"
+REFERENCE_SETTINGS = {"solver": "dop853", "rtol": 1e-13, "atol": 1e-15, "max_steps": 1e8}
+CROSS_CHECK = {"method": "Radau", "rtol": 1e-12, "atol": 1e-14}
+_RUNTIME = ("model", "solvers", "component")
+
+
+def cache_dir() -> Path:
+    """The folder of cached references: ``$DOUBLE_PENDULUM_CACHE/references`` or ``.cache/references``."""
+    return Path(os.environ.get(CACHE_ENV) or ".cache") / "references"
+
+
+@functools.lru_cache(maxsize=1)
+def runtime_hash() -> str:
+    """Hash of the runtime sources (model, solvers, component): references depend on nothing else."""
+    root = Path(__file__).resolve().parents[1]
+    digest = hashlib.sha256()
+    for package in _RUNTIME:
+        for path in sorted((root / package).rglob("*.py")):
+            digest.update(path.relative_to(root).as_posix().encode())
+            digest.update(path.read_bytes())
+    return digest.hexdigest()[:16]
 
 
 @dataclass(frozen=True)
@@ -36,7 +63,9 @@ class Reference:
 
 
 def _key(start: Mapping[str, Any], stop_time: float, interval: float) -> str:
-    text = json.dumps({"start": dict(start), "stop": stop_time, "interval": interval}, sort_keys=True)
+    text = json.dumps({"start": dict(start), "stop": stop_time, "interval": interval,
+                       "reference": REFERENCE_SETTINGS, "cross_check": CROSS_CHECK, "runtime": runtime_hash()},
+                      sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
@@ -50,25 +79,45 @@ def _scipy_cross_check(start: Mapping[str, Any], times: np.ndarray) -> np.ndarra
     sim.initialise()
     f = sim.model.vector_field
     y0 = np.array(sim.integrator.y)
-    sol = solve_ivp(lambda t, y: f(t, list(y)), (times[0], times[-1]), y0, method="Radau", rtol=1e-12,
-                    atol=1e-14, t_eval=times)
+    sol = solve_ivp(lambda t, y: f(t, list(y)), (times[0], times[-1]), y0, method=CROSS_CHECK["method"],
+                    rtol=CROSS_CHECK["rtol"], atol=CROSS_CHECK["atol"], t_eval=times)
     if not sol.success:
         raise RuntimeError(f"reference cross-check failed: {sol.message}")
     return sol.y[:4]
 
 
-def reference_solution(
-    start: Mapping[str, Any], stop_time: float, interval: float, cache_dir: Path = CACHE_DIR
-) -> Reference:
-    """Return (and cache) the reference for ``start`` on ``0, interval, ..., stop_time``."""
-    path = Path(cache_dir) / f"{_key(start, stop_time, interval)}.npz"
-    if path.is_file():
+def _path(start: Mapping[str, Any], stop_time: float, interval: float, folder: Path | None) -> Path:
+    return Path(folder if folder is not None else cache_dir()) / f"{_key(start, stop_time, interval)}.npz"
+
+
+def cached_reference(
+    start: Mapping[str, Any], stop_time: float, interval: float, cache_dir: Path | None = None
+) -> Reference | None:
+    """The cached reference for the case, or None if it was not computed yet (with these sources)."""
+    path = _path(start, stop_time, interval, cache_dir)
+    if not path.is_file():
+        return None
+    try:
         data = np.load(path)
         return Reference(data["time"], {n: data[n] for n in STATE_OUTPUTS}, data["energy"], float(data["floor"]))
-    tight = {**start, "solver": "dop853", "rtol": 1e-13, "atol": 1e-15, "max_steps": 1e8}
+    except (OSError, KeyError, ValueError):  # a damaged file: compute anew
+        return None
+
+
+def reference_solution(
+    start: Mapping[str, Any], stop_time: float, interval: float, cache_dir: Path | None = None
+) -> Reference:
+    """Return (and cache) the reference for ``start`` on ``0, interval, ..., stop_time``."""
+    cached = cached_reference(start, stop_time, interval, cache_dir)
+    if cached is not None:
+        return cached
+    tight = {**start, **REFERENCE_SETTINGS}
     ref = simulate(tight, stop_time=stop_time, output_interval=interval)
     check = _scipy_cross_check(tight, ref["time"])
     floor = float(max(np.max(np.abs(ref[n] - check[i])) for i, n in enumerate(STATE_OUTPUTS)))
+    path = _path(start, stop_time, interval, cache_dir)
     path.parent.mkdir(parents=True, exist_ok=True)
-    np.savez(path, time=ref["time"], energy=ref["E_total"], floor=floor, **{n: ref[n] for n in STATE_OUTPUTS})
+    partial = path.with_name(f".{path.stem}.{os.getpid()}.npz")  # written whole, then renamed
+    np.savez(partial, time=ref["time"], energy=ref["E_total"], floor=floor, **{n: ref[n] for n in STATE_OUTPUTS})
+    os.replace(partial, path)
     return Reference(ref["time"], {n: ref[n] for n in STATE_OUTPUTS}, ref["E_total"], floor)

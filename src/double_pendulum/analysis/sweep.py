@@ -7,9 +7,11 @@ cases. The cases are split into contiguous chunks; each worker process extracts 
 chunks one case after another.
 
 * Locally (default) the chunks go to a :class:`concurrent.futures.ProcessPoolExecutor` with one
-  process per core (``max_workers=None``), started by ``forkserver`` so no threads of the calling
-  process are forked; ``max_workers=1`` runs in the calling process. As with any spawned worker
-  processes, a script that calls this must guard its top level with ``if __name__ == "__main__":``.
+  process per core (``max_workers=None``), started by ``spawn`` so no threads of the calling
+  process are forked and the workers are the caller's own children (their CPU time counts in the
+  caller's ``RUSAGE_CHILDREN`` and in ``time``); ``max_workers=1`` runs in the calling process. As
+  with any spawned worker processes, a script that calls this must guard its top level with
+  ``if __name__ == "__main__":``.
 * With ``scheduler="tcp://host:8786"`` (or a ``distributed.Client``) they go to a Dask cluster,
   as in FMPy's own parameter-variation example. The FMU file itself is sent to the workers once
   (``Client.scatter(..., broadcast=True)``), so they need not share a file system; they need this
@@ -40,9 +42,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from tqdm.auto import tqdm
 
 from ..fmu.runner import FmuRunError, FmuRunner
+from .progress import progress_bar as _progress_bar
 
 CHUNKS_PER_WORKER = 4
 
@@ -105,10 +107,10 @@ def _call(func: Callable[..., Any], item: Any, shared: Any) -> Any:
     return func(item) if shared is None else func(item, shared)
 
 
-def progress_bar(total: int, label: str, *, enabled: bool | None = None) -> tqdm:
-    """A tqdm bar on stderr counting ``total`` items; ``enabled=None`` shows it only on a terminal."""
-    return tqdm(total=total, desc=label, disable=None if enabled is None else not enabled,
-                file=sys.stderr, mininterval=0.5, unit="run", dynamic_ncols=True)
+def progress_bar(total: int, label: str, *, enabled: bool | None = None, unit: str = "run") -> Any:
+    """A progress counter on stderr (:func:`double_pendulum.analysis.progress.progress_bar`): a tqdm bar
+    on a terminal or in a notebook, a few plain lines for long loops otherwise."""
+    return _progress_bar(total, label, enabled=enabled, unit=unit)
 
 
 def parallel_map(
@@ -121,6 +123,7 @@ def parallel_map(
     progress: bool | None = None,
     label: str = "parallel",
     weights: Sequence[int] | None = None,
+    unit: str = "run",
 ) -> tuple[list[Any], int]:
     """Apply ``func`` to every item in parallel; return ``(results in item order, workers used)``.
 
@@ -131,7 +134,7 @@ def parallel_map(
     """
     weights = list(weights) if weights is not None else [1] * len(items)
     results: list[Any] = [None] * len(items)
-    with progress_bar(sum(weights), label, enabled=progress) as bar:
+    with progress_bar(sum(weights), label, enabled=progress, unit=unit) as bar:
         if scheduler is not None:
             return _dask_map(func, items, shared, scheduler, bar, weights, results)
         workers = min(default_workers() if max_workers is None else max_workers, max(len(items), 1))
@@ -140,7 +143,7 @@ def parallel_map(
                 results[i] = _call(func, item, shared)
                 bar.update(weights[i])
             return results, 1
-        context = multiprocessing.get_context("forkserver" if os.name == "posix" else "spawn")
+        context = multiprocessing.get_context("spawn")
         with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
             with _without_fmu_resources_on_path():  # workers start on these submits
                 futures = {pool.submit(_call, func, item, shared): i for i, item in enumerate(items)}
@@ -226,6 +229,50 @@ def _run_chunk(work: SweepChunk, source: FmuSource) -> list[Any]:
         except FmuRunError as error:
             raise FmuRunError(f"sweep case {index} {dict(case)}: {error}", error.partial_result) from error
         out.append(work.reduce(result) if work.reduce is not None else result)
+    return out
+
+
+def _run_with_runner(task: tuple[Callable[..., Any], Any], source: FmuSource) -> Any:
+    """Worker: ``func(runner, item)`` with this process's runner for ``source``."""
+    func, item = task
+    runner, lock = _worker_runner(source)
+    with lock:
+        return func(runner, item)
+
+
+def runner_map(
+    func: Callable[[FmuRunner, Any], Any],
+    items: Sequence[Any],
+    runner: FmuRunner,
+    *,
+    max_workers: int | None = None,
+    label: str = "runs",
+    progress: bool | None = None,
+    costs: Sequence[float] | None = None,
+    unit: str = "run",
+) -> list[Any]:
+    """``[func(runner, item) for item in items]`` on local worker processes, each with its own runner.
+
+    ``func`` must be a module-level function; with one worker (``max_workers=1`` or a single core)
+    it runs here with ``runner``. ``costs`` (estimated run times, any unit) make the workers start
+    with the most expensive items, so none is left running alone at the end; results are returned
+    in item order either way. A progress bar counts the items.
+    """
+    workers = min(default_workers() if max_workers is None else max_workers, max(len(items), 1))
+    if workers <= 1:
+        out = []
+        with progress_bar(len(items), label, enabled=progress, unit=unit) as bar:
+            for item in items:
+                out.append(func(runner, item))
+                bar.update(1)
+        return out
+    order = sorted(range(len(items)), key=lambda i: -costs[i]) if costs is not None else list(range(len(items)))
+    source = FmuSource.from_path(runner.fmu_path, embed=False)
+    results, _ = parallel_map(_run_with_runner, [(func, items[i]) for i in order], shared=source,
+                              max_workers=workers, progress=progress, label=label, unit=unit)
+    out: list[Any] = [None] * len(items)
+    for i, result in zip(order, results):
+        out[i] = result
     return out
 
 

@@ -39,6 +39,7 @@ from .start_state import (
     track_window,
 )
 from .suspension_identification import START_FIT_FRAMES, Identification, IdentifiedModel
+from .sweep import runner_map
 
 THRESHOLDS_M = (0.01, 0.05)
 """Position errors [m] whose first crossing defines the prediction horizons."""
@@ -180,11 +181,16 @@ def chaos_spread(
     rng = np.random.default_rng(seed)
     states = rng.multivariate_normal(fit.state, fit.cov, size=size)
     ref = output_matrix(central.result)[:, 2:]
-    distances = []
-    for state in states:
-        r = simulate_frames(runner, {**FIT_SETTINGS, **values, **state_start_values(state)}, fit.t0, n_frames)
-        distances.append(np.linalg.norm(output_matrix(r)[:, 2:] - ref, axis=1))
+    items = [({**FIT_SETTINGS, **values, **state_start_values(state)}, fit.t0, n_frames, ref) for state in states]
+    distances = runner_map(_spread_distance, items, runner, label="start-state ensemble")
     return np.arange(n_frames) * FRAME_INTERVAL, np.median(np.array(distances), axis=0)
+
+
+def _spread_distance(runner: FmuRunner, item: tuple[dict[str, Any], float, int, np.ndarray]) -> np.ndarray:
+    """Worker: the lower bob's distance [m] per frame of one ensemble run from the central prediction."""
+    start, t0, n_frames, ref = item
+    r = simulate_frames(runner, start, t0, n_frames)
+    return np.linalg.norm(output_matrix(r)[:, 2:] - ref, axis=1)
 
 
 def chaos_horizons(spread: tuple[np.ndarray, np.ndarray]) -> dict[str, float | None]:
@@ -208,12 +214,16 @@ def window_sensitivity(
     windows: Sequence[int],
 ) -> list[dict[str, Any]]:
     """Horizons of least-squares starts fitted to other numbers of frames (``windows``)."""
-    out = []
-    for frames in windows:
-        fit = least_squares_start(runner, rec, i0, values, frames)
-        p = predict(runner, f"lsq{frames}", values, fit.state, rec, i0, n_frames)
-        out.append({"fit_frames": frames, "chi2_red": fit.chi2_red, "rms_residual_m": fit.rms_residual, **p.horizons()})
-    return out
+    return runner_map(_window_fit, [(rec, i0, dict(values), n_frames, frames) for frames in windows], runner,
+                      label="fit windows", unit="fit")
+
+
+def _window_fit(runner: FmuRunner, item: tuple[Reconstruction, int, dict[str, Any], int, int]) -> dict[str, Any]:
+    """Worker: the least-squares start fitted to ``frames`` frames and its prediction's horizons."""
+    rec, i0, values, n_frames, frames = item
+    fit = least_squares_start(runner, rec, i0, values, frames)
+    p = predict(runner, f"lsq{frames}", values, fit.state, rec, i0, n_frames)
+    return {"fit_frames": frames, "chi2_red": fit.chi2_red, "rms_residual_m": fit.rms_residual, **p.horizons()}
 
 
 # --- the track's floor ---------------------------------------------------------------------------
