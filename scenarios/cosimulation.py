@@ -62,6 +62,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict[str, A
              for s, u, m, h in itertools.product(plan["starts"], plan["suspensions"], methods, plan["steps"])
              if h >= plan["min_step"][m]]
     rows, workers = parallel_map(study.split_run, items, label="cosimulation", max_workers=None if not quick else 1)
+    rows = study.drop_failed_engines(rows, missing)
     references = {(s, u): study.monolith(study.case_values(s, u), plan["stop"])
                   for s, u in itertools.product(plan["starts"], plan["suspensions"])}
     study.add_errors(rows, references)
@@ -84,8 +85,10 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict[str, A
         "order_coupling_energy": study.orders(rows, "coupling_energy_J"),
         "cheapest_to_1e-4_rad": study.cheapest(rows, 1e-4),
         "unstable_runs": [r["message"] for r in rows if not r["stable"]],
-        "stability": {scheme: {"zeta": plan["zeta"], "measured_limit": study.measured_limit(points, scheme),
-                               "derived_limit": {hw: critical_mass_ratio(hw, plan["zeta"], scheme)
+        "stability": {scheme: {"zeta": plan["zeta"],
+                               "measured_limit": {f"h_omega_{hw:g}": bracket
+                                                  for hw, bracket in study.measured_limit(points, scheme).items()},
+                               "derived_limit": {f"h_omega_{hw:g}": critical_mass_ratio(hw, plan["zeta"], scheme)
                                                  for hw in plan["h_omegas"]},
                                "derived_limit_small_step": 1.0} for scheme in MAP_SCHEMES},
         "cpu_s_by_method": {m: sum(r["cpu_s"] for r in rows if r["method"] == m) for m in methods},

@@ -25,8 +25,13 @@ from fmpy.util import read_csv
 from double_pendulum.cli import main
 from double_pendulum.results_io import read_results_csv, read_table_csv
 
-TABLES = {"stability.csv", "work_precision.csv"}
-"""The record tables (text columns); every other CSV is numeric."""
+TABLES = {"stability.csv", "work_precision.csv", "acheson_bands.csv", "acheson_map.csv", "kapitza_bisection.csv",
+          "resonance_peaks.csv"}
+"""The record tables (text, Boolean or missing cells); every other CSV is numeric."""
+REPORTS = {"energy_decay", "loss_identification", "measured_vs_sim", "stability", "suspension_transfer",
+           "work_precision",
+           "cosimulation", "base_excitation"}
+"""The scenarios that write a report.md."""
 
 MISSING_WORDS = re.compile(r"\b(nan|NaN|None|null)\b")
 EMPTY_CELL = re.compile(r"\|\s*\|")
@@ -103,8 +108,7 @@ def _nested(node: Any) -> Iterator[tuple[str, Any]]:
             yield from _nested(value)
 
 
-@pytest.mark.parametrize("scenario", [s for s in SCENARIOS if s in {
-    "energy_decay", "measured_vs_sim", "stability", "suspension_transfer", "work_precision"}])
+@pytest.mark.parametrize("scenario", [s for s in SCENARIOS if s in REPORTS])
 def test_report_has_numbers_where_numbers_belong(quick_out, scenario):
     text = (quick_out / scenario / "report.md").read_text()
     assert text.strip()
@@ -116,7 +120,7 @@ def test_report_has_numbers_where_numbers_belong(quick_out, scenario):
 
 def test_every_scenario_that_writes_a_report_is_checked(quick_out):
     with_report = {p.parent.name for p in quick_out.glob("*/report.md")}
-    assert with_report == {"energy_decay", "measured_vs_sim", "stability", "suspension_transfer", "work_precision"}
+    assert with_report == REPORTS
 
 
 def _csv_files(out: Path) -> list[Path]:
@@ -145,3 +149,6 @@ def test_record_tables_read_with_the_table_reader_and_pandas(quick_out):
         assert list(frame.columns) == list(rows[0])
         assert all(isinstance(r["cpu_time_s"], float) for r in rows if r["status"] in ("ok", "finished"))
         assert all(isinstance(r["case"], str) and r["case"] for r in rows)
+    for path in sorted((quick_out / "base_excitation").glob("*.csv")):
+        if path.name in TABLES:
+            assert len(read_table_csv(path)) == len(pandas.read_csv(path)) > 0, path

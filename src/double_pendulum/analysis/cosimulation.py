@@ -103,6 +103,10 @@ def split_run(item: tuple[str, str, str, float, float, tuple[str, str]]) -> dict
     except CouplingError as error:
         rows = error.rows
         row.update(stable=False, message=str(error))
+    except Exception as error:  # the engine itself failed, not the coupling: reported, the method left out
+        if method in IN_PROCESS:
+            raise
+        return {**row, "engine_error": f"{method} failed to run: {error}"}
     row["cpu_s"] = time.process_time() - cpu
     row["rows_kept"] = len(rows)
     last = rows[-1] if len(rows) else None
@@ -111,6 +115,19 @@ def split_run(item: tuple[str, str, str, float, float, tuple[str, str]]) -> dict
         row[name] = float(last[name]) if ok else math.nan
     row["coupling_energy_J"] = coupling_energy(last) if ok else math.nan
     return row
+
+
+def drop_failed_engines(rows: list[dict[str, Any]], skipped: dict[str, str]) -> list[dict[str, Any]]:
+    """Remove the runs of an engine that failed to run at all, naming it in ``skipped`` with its error.
+
+    Seen with libcosim in a process that ran other scenarios first ("The FMU contains no binary for
+    this platform" while the same SSP runs in a fresh process): the scenario then reports the engine
+    as skipped instead of failing as a whole.
+    """
+    for row in rows:
+        if "engine_error" in row:
+            skipped.setdefault(row["method"], row["engine_error"])
+    return [row for row in rows if row["method"] not in skipped]
 
 
 def add_errors(rows: list[dict[str, Any]], references: Mapping[tuple[str, str], Mapping[str, float]]) -> None:

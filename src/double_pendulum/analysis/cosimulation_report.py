@@ -36,10 +36,10 @@ def report_text(summary: dict[str, Any], rows: list[dict[str, Any]]) -> str:
     limit = ["| scheme | h omega | derived mu_c | measured mu_c (between last bounded and first unbounded) |",
              "|---|---|---|---|"]
     for scheme, st in summary["stability"].items():
-        for hw, mu_c in st["derived_limit"].items():
-            bracket = st["measured_limit"].get(hw)
+        for key, mu_c in st["derived_limit"].items():  # keys "h_omega_<value>"
+            bracket = st["measured_limit"].get(key)
             measured = f"{bracket[0]:g} - {bracket[1]:g}" if bracket else "-"
-            limit.append(f"| {scheme} | {hw:g} | {_fmt(mu_c)} | {measured} |")
+            limit.append(f"| {scheme} | {key.removeprefix('h_omega_')} | {_fmt(mu_c)} | {measured} |")
     parts = [
         "# Co-simulation of the pendulum on its suspension",
         "",

@@ -126,6 +126,8 @@ def error_budget(rec: Reconstruction, sigma: np.ndarray) -> dict[str, Any]:
         "a_J": a,
         "b_per_s": b,
         "rows": rows,
+        "null_means": {"a_shift_J": "no shift: the statistical row is a spread, not a systematic change",
+                       "b_shift_per_s": "no shift: the statistical row is a spread, not a systematic change"},
         "total_a_J": total_a,
         "total_b_per_s": total_b,
         "total_a_relative": total_a / a,
@@ -143,7 +145,7 @@ def budget_table(budget: Mapping[str, Any]) -> str:
     for r in budget["rows"]:
         lines.append(f"| {r['source']} | {fmt(r['a_J'], a, 1e3)} | {fmt(r['b_per_s'], b, 1e4)} | {r['how']} |")
     lines.append(f"| **total (quadrature)** | {fmt(budget['total_a_J'], a, 1e3)} | "
-                 f"{fmt(budget['total_b_per_s'], b, 1e4)} | |")  # fmt: skip
+                 f"{fmt(budget['total_b_per_s'], b, 1e4)} | square root of the sum of the squared rows |")  # fmt: skip
     s = budget["seed"]
     lines.append(f"| the seed's quoted error | {s['a_relative'] * s['a_J'] * 1e3:.2f} ({s['a_relative']:.2%}) | "
                  f"{s['b_relative'] * abs(s['b_per_s']) * 1e4:.2f} ({s['b_relative']:.2%}) | "
