@@ -26,7 +26,7 @@ from double_pendulum.cli import main
 from double_pendulum.results_io import read_results_csv, read_table_csv
 
 TABLES = {"stability.csv", "work_precision.csv", "acheson_bands.csv", "acheson_map.csv", "kapitza_bisection.csv",
-          "resonance_peaks.csv"}
+          "resonance_peaks.csv", "resonance_curve.csv", "runs.csv", "stability_map.csv"}
 """The record tables (text, Boolean or missing cells); every other CSV is numeric."""
 REPORTS = {"energy_decay", "loss_identification", "measured_vs_sim", "stability", "suspension_transfer",
            "work_precision",
@@ -149,6 +149,6 @@ def test_record_tables_read_with_the_table_reader_and_pandas(quick_out):
         assert list(frame.columns) == list(rows[0])
         assert all(isinstance(r["cpu_time_s"], float) for r in rows if r["status"] in ("ok", "finished"))
         assert all(isinstance(r["case"], str) and r["case"] for r in rows)
-    for path in sorted((quick_out / "base_excitation").glob("*.csv")):
+    for path in sorted([*(quick_out / "base_excitation").glob("*.csv"), *(quick_out / "cosimulation").glob("*.csv")]):
         if path.name in TABLES:
             assert len(read_table_csv(path)) == len(pandas.read_csv(path)) > 0, path
