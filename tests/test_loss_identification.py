@@ -44,13 +44,17 @@ def _synthetic_track(seed: int = 7) -> ms.Track:
 
 
 @pytest.fixture(scope="module")
-def synthetic_fit() -> tuple[li.ModelFit, float]:
+def synthetic_problem() -> li.FitProblem:
     rec = ms.reconstruct(_synthetic_track(), rods=SEED_RIGID_LINKS)
     # The synthetic track starts in free motion: begin at the first frame with a defined energy
     # (the seed's hand release ends later, where every derivative stencil fits).
     rec = dataclasses.replace(rec, release_frame=max(rec.release_frame, int(np.argmax(rec.energy_valid))))
-    problem = li.problem_from_track(rec, li.measured(rec))
-    fit = li.fit_loss_model("air+drag", problem)
+    return li.problem_from_track(rec, li.measured(rec))
+
+
+@pytest.fixture(scope="module")
+def synthetic_fit(synthetic_problem) -> tuple[li.ModelFit, float]:
+    fit = li.fit_loss_model("air+drag", synthetic_problem)
     return fit, li.common_factor([fit])
 
 
@@ -101,3 +105,17 @@ def test_a_fit_above_its_nested_model_counts_as_not_converged():
     rows = li.comparison_rows(fits, 1.0)
     assert [r["model"] for r in rows] == ["air+drag", "air", "air+drag+viscous"]
     assert not rows[-1]["converged"] and rows[-1]["akaike_weight"] == 0.0
+
+
+
+def test_a_nested_model_warm_started_from_its_parent_ends_no_worse(synthetic_problem, synthetic_fit):
+    """air+drag+bearing from the air+drag optimum: the added friction starts with a negligible loss and
+    Gauss-Newton only accepts steps that lower chi2, so the larger model cannot end above its parent
+    (it would then count as not converged and drop out of the comparison)."""
+    parent, _ = synthetic_fit
+    item = li.fit_item_of("air+drag+bearing", [parent])
+    assert item.start[:2] == pytest.approx(tuple(parent.theta))
+    assert item.start[2] == pytest.approx(li.WARM_START_FRACTION * li.MECHANISMS["bearing"].parameters[0].ref)
+    fit = li.fit_loss_model(item.model, synthetic_problem, start=item.start, max_nfev=8)
+    assert fit.chi2 <= parent.chi2 * (1.0 + 1e-3)
+    assert li.converged(fit, [parent, fit])

@@ -393,8 +393,9 @@ def fit_item(item: FitItem, problem: FitProblem) -> ModelFit:
     return fit_loss_model(item.model, problem, start=item.start)
 
 
-WARM_START_FRACTION = 0.1
-"""An added mechanism starts at this fraction of its reference value (a small extra loss)."""
+WARM_START_FRACTION = 1e-3
+"""An added mechanism starts at this fraction of its reference value: a loss far below the others, so
+the nested model starts at its parent's chi2 (up to ~1e-3 of the parent's loss)."""
 
 
 def warm_start(model: str, parent: ModelFit) -> tuple[float, ...]:
@@ -406,23 +407,27 @@ def warm_start(model: str, parent: ModelFit) -> tuple[float, ...]:
     return tuple(float(known.get(p.name, WARM_START_FRACTION * p.ref)) for p in parameters_of(model))
 
 
+def fit_item_of(model: str, fits: Sequence[ModelFit]) -> FitItem:
+    """The fit item of ``model``: warm-started from the best-fitting (lowest chi2) of ``fits`` whose
+    mechanisms it contains (:func:`warm_start`), from the references if none."""
+    mine = set(model.split("+"))
+    parents = [f for f in fits if set(f.model.split("+")) < mine]
+    return FitItem(model, warm_start(model, min(parents, key=lambda f: f.chi2)) if parents else None)
+
+
 def fit_models(
     models: Sequence[str], problem: FitProblem, max_workers: int | None = None
 ) -> tuple[list[ModelFit], int]:
-    """Fit every model: first those of at most two mechanisms from the references, then the larger ones
-    warm-started from the best-fitting smaller model they contain (:func:`warm_start`)."""
+    """Fit every model, in rounds by its number of mechanisms: one-mechanism models from the
+    references, each larger one warm-started from the best-fitting model of an earlier round that it
+    contains (:func:`fit_item_of`); the models of a round are fitted in parallel."""
     from .sweep import parallel_map  # noqa: PLC0415 - process pools only when identifying
 
-    small = [m for m in models if len(m.split("+")) <= 2]
-    large = [m for m in models if m not in small]
-    fits, workers = parallel_map(fit_item, [FitItem(m) for m in small], shared=problem, max_workers=max_workers,
-                                 label="loss models")  # fmt: skip
-    if large:
-        items = []
-        for m in large:
-            parents = [f for f in fits if set(f.model.split("+")) <= set(m.split("+"))]
-            items.append(FitItem(m, warm_start(m, min(parents, key=lambda f: f.chi2)) if parents else None))
-        more, _ = parallel_map(fit_item, items, shared=problem, max_workers=max_workers, label="loss models")
+    fits: list[ModelFit] = []
+    workers = 1
+    for size in sorted({len(m.split("+")) for m in models}):
+        items = [fit_item_of(m, fits) for m in models if len(m.split("+")) == size]
+        more, workers = parallel_map(fit_item, items, shared=problem, max_workers=max_workers, label="loss models")
         fits += more
     return fits, workers
 
