@@ -14,13 +14,14 @@ whole record also in quick mode: the first 8 s alone leave the two losses uniden
   masses as in the seed, and with the identified model;
 - **least-squares start (state only)**: (phi1, phi2, omega1, omega2) at t0 fitted to the positions of
   the first :data:`FIT_FRAMES` frames (1/3 s) through the FMU, identified model;
-- **least-squares start and geometry**: the state fitted together with the pivot's offset (x, y) [m]
-  from the measurement's circle-fit pivot and the lower rod's length l2 [m]
-  (:data:`~double_pendulum.analysis.track_comparison.FREE_GEOMETRY`) to the first :data:`GEOMETRY_FIT_FRAMES`
-  frames (1.5 s) after t0, identified model.
+- **least-squares start and geometry**: the state fitted together with the camera's rotation against
+  gravity [rad], the pivot's offset (x, y) [m] from the measurement's circle-fit pivot and the lower
+  rod's length l2 [m] (:data:`~double_pendulum.analysis.track_comparison.FREE_GEOMETRY`) to the first
+  :data:`GEOMETRY_FIT_FRAMES` frames (1.5 s) after t0, identified model.
 
 Positions are compared relative to the pivot fitted by the measurement (circle fit of the upper
-bob); the FMU's origin is the pivot at rest, shifted by the fitted pivot offset where one was fitted.
+bob); the FMU's origin is the pivot at rest; where geometry is fitted, its positions are turned by the
+fitted rotation about the pivot and shifted by the fitted pivot offset.
 
 Prediction horizon: the first time after t0 at which the position error |r_sim - r_track| [m]
 exceeds 2 cm and 5 cm, for the lower bob and for both bobs (the larger of the two errors), on the

@@ -10,6 +10,7 @@ exponent (regular or chaotic, as the number says).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
@@ -58,8 +59,15 @@ def horizon_rows(s: Mapping[str, Any]) -> str:
 
 
 def geometry_text(geometry: Mapping[str, float], stderr: Mapping[str, float]) -> str:
-    """'pivot_offset_x = 13.5 +- 0.6 mm, ...' for the fitted geometry [m]."""
-    return ", ".join(f"{k} = {1e3 * v:.1f} +- {1e3 * stderr[k]:.1f} mm" for k, v in geometry.items())
+    """'view_rotation = 2.58 +- 0.15 deg, pivot_offset_x = 0.4 +- 0.9 mm, ...' for the fitted geometry
+    (angles [rad] in degrees, lengths [m] in mm)."""
+    parts = []
+    for k, v in geometry.items():
+        if k == "view_rotation":
+            parts.append(f"{k} = {math.degrees(v):.2f} +- {math.degrees(stderr[k]):.2f} deg")
+        else:
+            parts.append(f"{k} = {1e3 * v:.1f} +- {1e3 * stderr[k]:.1f} mm")
+    return ", ".join(parts)
 
 
 def sensitivity_rows(s: Mapping[str, Any]) -> str:
@@ -68,7 +76,7 @@ def sensitivity_rows(s: Mapping[str, Any]) -> str:
     main = s["starts"]["least_squares_geometry"]
     main_row = {
         "fit_frames": main["n_frames"], "chi2_red": main["chi2_red"], "rms_residual_m": main["rms_residual"],
-        "geometry_m": main["geometry_m"], **s["horizons_smoothed_s"][MAIN_RUN], "main": True,
+        "geometry": main["geometry"], **s["horizons_smoothed_s"][MAIN_RUN], "main": True,
     }
     table = sorted([*s.get("fit_window_sensitivity", []), main_row], key=lambda r: r["fit_frames"])
     if len(table) == 1:
@@ -76,15 +84,16 @@ def sensitivity_rows(s: Mapping[str, Any]) -> str:
     rows = [
         f"| {r['fit_frames']}{' (used)' if r.get('main') else ''} | {r['fit_frames'] / 29.97:.2f} "
         f"| {r['chi2_red']:.0f} | {1e3 * r['rms_residual_m']:.1f} "
-        f"| {1e3 * r['geometry_m']['pivot_offset_x']:.1f}, {1e3 * r['geometry_m']['pivot_offset_y']:.1f} "
-        f"| {1e3 * r['geometry_m']['l2']:.1f} "
+        f"| {math.degrees(r['geometry']['view_rotation']):.2f} "
+        f"| {1e3 * r['geometry']['pivot_offset_x']:.1f}, {1e3 * r['geometry']['pivot_offset_y']:.1f} "
+        f"| {1e3 * r['geometry']['l2']:.1f} "
         f"| {fmt_horizon(r['lower_bob_2cm_s'], span)} | {fmt_horizon(r['lower_bob_5cm_s'], span)} "
         f"| {fmt_horizon(r['both_bobs_5cm_s'], span)} |"
         for r in table
     ]
-    head = ("| frames fitted | window [s] | chi2_red | rms residual [mm] | pivot offset x, y [mm] | l2 [mm] "
-            "| lower bob 2 cm [s] | lower bob 5 cm [s] | both 5 cm [s] |")
-    return "\n".join([head, "|---|---|---|---|---|---|---|---|---|", *rows])
+    head = ("| frames fitted | window [s] | chi2_red | rms residual [mm] | camera rotation [deg] "
+            "| pivot offset x, y [mm] | l2 [mm] | lower bob 2 cm [s] | lower bob 5 cm [s] | both 5 cm [s] |")
+    return "\n".join([head, "|---|---|---|---|---|---|---|---|---|---|", *rows])
 
 
 def state_rows(s: Mapping[str, Any]) -> str:
@@ -173,7 +182,7 @@ Start at the frame nearest the seed's t0 = 0.8 s (t0 = {s["t0_s"]:.4f} s, frame 
 {span:.1f} s, compare the bob positions with the track frame by frame. Positions relative to the pivot
 fitted by the measurement (circle fit of the upper bob, at x = {1e3 * s["pivot_origin_m"]["x"]:.2f} mm,
 y = {1e3 * s["pivot_origin_m"]["y"]:.2f} mm in the track's coordinates); the FMU's origin is the pivot at rest,
-shifted by the fitted pivot offset where one is fitted.
+its positions turned and shifted by the fitted camera rotation and pivot offset where these are fitted.
 
 Model: the seed's pendulum with its acrylic rods ({m["rods"]["m_rod1"]:.3f} kg and {m["rods"]["m_rod2"]:.3f} kg
 plates of {m["rods"]["L_rod1"]:.2f} m and {m["rods"]["L_rod2"]:.2f} m), l1 = {m["lengths_m"]["l1"]:.4f} m,
@@ -193,9 +202,11 @@ The state-only start reproduces its {lsq["n_frames"]} frames with an rms positio
 {1e3 * lsq["rms_residual"]:.1f} mm (chi2_red = {lsq["chi2_red"]:.0f} with the rod-jitter noise as errors; the
 standard errors are scaled by chi2_red); its rates differ from the reconstruction's by {change["omega1_0"]:+.2f} and
 {change["omega2_0"]:+.2f} rad/s. Fitted together with the geometry over {geo["n_frames"]} frames
-({geo["n_frames"] / 29.97:.2f} s after t0): {geometry_text(geo["geometry_m"], geo["geometry_stderr_m"])}
-(pivot offset from the circle-fit pivot; standard errors scaled by chi2_red = {geo["chi2_red"]:.0f}); rms residual
-{1e3 * geo["rms_residual"]:.1f} mm. Correlations above 0.9 in size: {correlation_text(geo)}. l1 is left at the
+({geo["n_frames"] / 29.97:.2f} s after t0): {geometry_text(geo["geometry"], geo["geometry_stderr"])}
+(view_rotation: the FMU's positions turned counter-clockwise about the pivot, a camera whose vertical is
+not along gravity; pivot offset from the circle-fit pivot; standard errors scaled by
+chi2_red = {geo["chi2_red"]:.0f}); rms residual {1e3 * geo["rms_residual"]:.1f} mm.
+Correlations above 0.9 in size: {correlation_text(geo)}. l1 is left at the
 track's value: fitted as well it trades off against the pivot's height.
 
 ## Prediction horizons

@@ -22,7 +22,8 @@ Times are on the frame grid :math:`t_i = t_0 + n_i\,\Delta t`; frames may be mis
 Free geometry. ``geometry`` names further parameters fitted together with the state (one more
 Jacobian column each): ``pivot_offset_x``, ``pivot_offset_y`` [m] shift the FMU's positions (its
 origin is the pivot at rest) by the pivot's offset from the pivot the positions are measured from
-(:data:`PIVOT_SHIFTS`, positions only; not the FMU's ``pivot_x`` input); any other name is an FMU
+(:data:`PIVOT_SHIFTS`, positions only; not the FMU's ``pivot_x`` input), ``view_rotation`` [rad]
+turns them about the pivot (:data:`VIEW_ROTATION`); any other name is an FMU
 start value of the model, e.g. the rod lengths ``l1``, ``l2`` [m], started from ``model_values``
 (or 0). The covariance then covers state and geometry (``StartStateFit.full_cov``), and chi2_red
 divides by n - 4 - len(geometry).
@@ -53,6 +54,13 @@ DIFF_STEP = 1e-6
 0.3 um, far above the integration error at :data:`FIT_SETTINGS`, far below the position noise."""
 PIVOT_SHIFTS: dict[str, tuple[str, ...]] = {"pivot_offset_x": ("x1", "x2"), "pivot_offset_y": ("y1", "y2")}
 """Free geometry parameters that shift FMU position outputs [m] (the pivot's offset), by the outputs they shift."""
+VIEW_ROTATION = "view_rotation"
+"""Free geometry parameter [rad]: the FMU's bob positions turned counter-clockwise about the pivot
+(before the pivot shift), e.g. a camera whose vertical is not along gravity."""
+POSITION_TRANSFORMS: tuple[str, ...] = (*PIVOT_SHIFTS, VIEW_ROTATION)
+GEOMETRY_UNITS = {"pivot_offset_x": "m", "pivot_offset_y": "m", VIEW_ROTATION: "rad", "l1": "m", "l2": "m"}
+"""Units of the usual free geometry (``StartStateFit.as_dict``)."""
+"""Free geometry that moves the FMU's positions instead of entering the FMU as a start value."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -101,8 +109,9 @@ class StartStateFit:
         geometry = {}
         if self.geometry:
             geometry = {
-                "geometry_m": {k: float(v) for k, v in self.geometry.items()},
-                "geometry_stderr_m": {k: float(v) for k, v in self.geometry_stderr.items()},
+                "geometry": {k: float(v) for k, v in self.geometry.items()},
+                "geometry_stderr": {k: float(v) for k, v in self.geometry_stderr.items()},
+                "geometry_units": {k: GEOMETRY_UNITS.get(k, "as the FMU start value") for k in self.geometry},
                 "parameters": list(self.names),
             }
         return {
@@ -130,15 +139,25 @@ def state_start_values(state: Sequence[float]) -> dict[str, float]:
 
 
 def split_geometry(geometry: Mapping[str, float]) -> tuple[dict[str, float], dict[str, float]]:
-    """Free geometry values split into FMU start values and pivot shifts [m] (:data:`PIVOT_SHIFTS`)."""
-    start = {k: float(v) for k, v in geometry.items() if k not in PIVOT_SHIFTS}
-    shifts = {k: float(v) for k, v in geometry.items() if k in PIVOT_SHIFTS}
+    """Free geometry values split into FMU start values and position transforms (:data:`POSITION_TRANSFORMS`)."""
+    start = {k: float(v) for k, v in geometry.items() if k not in POSITION_TRANSFORMS}
+    shifts = {k: float(v) for k, v in geometry.items() if k in POSITION_TRANSFORMS}
     return start, shifts
 
 
 def shift_outputs(matrix: np.ndarray, outputs: Sequence[str], shifts: Mapping[str, float]) -> np.ndarray:
-    """Output ``matrix`` (columns ``outputs``) with the pivot ``shifts`` [m] added to the positions they move."""
+    """Output ``matrix`` (columns ``outputs``) with the position transforms applied: the bob positions
+    turned by :data:`VIEW_ROTATION` [rad] about the pivot, then the pivot ``shifts`` [m] added."""
     out = np.array(matrix, dtype=float)
+    shifts = dict(shifts)
+    angle = shifts.pop(VIEW_ROTATION, 0.0)
+    if angle:
+        c, s = np.cos(angle), np.sin(angle)
+        for x, y in (("x1", "y1"), ("x2", "y2")):
+            if x not in outputs or y not in outputs:
+                raise ValueError(f"{VIEW_ROTATION} turns {x}, {y}, which are not among the outputs {tuple(outputs)}")
+            i, j = list(outputs).index(x), list(outputs).index(y)
+            out[:, i], out[:, j] = c * matrix[:, i] - s * matrix[:, j], s * matrix[:, i] + c * matrix[:, j]
     for name, value in shifts.items():
         for col in PIVOT_SHIFTS[name]:
             if col not in outputs:

@@ -17,8 +17,9 @@ distance between the bobs alone varies by about +-1 cm), so the headline horizon
 median over :data:`SMOOTHING_S` = 0.25 s (:func:`smoothed`); the raw horizons are kept beside them.
 
 A start may be fitted together with free geometry (:func:`least_squares_start` with ``geometry``,
-:data:`FREE_GEOMETRY`: the pivot's offset from the measurement's circle-fit pivot and the lower rod's
-length l2); a prediction then runs with the fitted l2 and is shifted by the fitted pivot offset.
+:data:`FREE_GEOMETRY`: the camera's rotation against gravity, the pivot's offset from the measurement's
+circle-fit pivot and the lower rod's length l2); a prediction then runs with the fitted l2 and its
+positions are turned and shifted by the fitted rotation and offset.
 The losses are those of the ``loss_identification`` scenario's best model (:func:`identified_losses`).
 
 Two floors limit the horizon: the track's own rod-length error
@@ -61,9 +62,10 @@ THRESHOLDS_M = (0.02, 0.05)
 """Position errors [m] whose first crossing defines the prediction horizons (raw and smoothed)."""
 SMOOTHING_S = 0.25
 """Width [s] of the centred moving median that smooths the per-frame error (about 7 frames)."""
-FREE_GEOMETRY: tuple[str, ...] = ("pivot_offset_x", "pivot_offset_y", "l2")
-"""Geometry fitted with the start state: the pivot's offset [m] from the circle-fit pivot and l2 [m]
-(l1 is nearly degenerate with pivot_offset_y over a few swings and is left at the track's value)."""
+FREE_GEOMETRY: tuple[str, ...] = ("view_rotation", "pivot_offset_x", "pivot_offset_y", "l2")
+"""Geometry fitted with the start state: the camera's rotation against gravity [rad] (the FMU's positions
+turned about the pivot), the pivot's offset [m] from the circle-fit pivot and l2 [m]. l1 is left at the
+track's value: freed as well, it trades off against the pivot's height over a few swings."""
 LOSS_MODEL = "air+drag"
 """The best loss model of the ``loss_identification`` scenario (air drag with a free factor on rho_air,
 a bearing drag torque at both joints), fitted again here by its own functions."""
@@ -339,7 +341,8 @@ def _window_fit(runner: FmuRunner, item: tuple[Any, ...]) -> dict[str, Any]:
     fit = least_squares_start(runner, rec, i0, values, frames, geometry, warm)
     p = predict(runner, f"lsq{frames}", values, fit.state, rec, i0, n_frames, fit.geometry)
     return {"fit_frames": frames, "fit_window_s": frames * FRAME_INTERVAL, "chi2_red": fit.chi2_red,
-            "rms_residual_m": fit.rms_residual, "geometry_m": dict(fit.geometry), **p.smoothed_horizons()}
+            "rms_residual_m": fit.rms_residual, "geometry": dict(fit.geometry),
+            "geometry_units": fit.as_dict()["geometry_units"], **p.smoothed_horizons()}
 
 
 # --- the regime ----------------------------------------------------------------------------------
@@ -472,13 +475,13 @@ def measured_coordinates(
 
 
 def simulated_coordinates(rec: Reconstruction, prediction: Prediction) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Times [s] and the FMU's bob coordinates [m] shifted by the fitted pivot (and the prediction's own
-    pivot offset, if it fitted one) into the track's coordinates."""
+    """Times [s] and the FMU's bob coordinates [m] moved into the track's coordinates: turned and shifted
+    by the prediction's own fitted geometry (if any), then shifted by the measurement's circle-fit pivot."""
     pivot = rec.geometry.pivot
-    dx, dy = prediction.geometry.get("pivot_offset_x", 0.0), prediction.geometry.get("pivot_offset_y", 0.0)
-    shift = {"x1": pivot.xc + dx, "y1": pivot.yc + dy, "x2": pivot.xc + dx, "y2": pivot.yc + dy}
-    result = prediction.result
-    return np.asarray(result["time"]), {n: np.asarray(result[n]) + shift[n] for n in shift}
+    _, transforms = split_geometry(prediction.geometry)
+    moved = shift_outputs(output_matrix(prediction.result), POSITION_OUTPUTS, transforms)
+    origin = {"x1": pivot.xc, "y1": pivot.yc, "x2": pivot.xc, "y2": pivot.yc}
+    return np.asarray(prediction.result["time"]), {n: moved[:, i] + origin[n] for i, n in enumerate(POSITION_OUTPUTS)}
 
 
 def error_curves(
