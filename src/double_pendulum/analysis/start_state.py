@@ -18,12 +18,21 @@ finite-difference Jacobian J (one FMU run per column). Covariance
 passed through unchanged; the suspension, if on, starts at rest in its equilibrium.
 
 Times are on the frame grid :math:`t_i = t_0 + n_i\,\Delta t`; frames may be missing (``offsets``).
+
+Free geometry. ``geometry`` names further parameters fitted together with the state (one more
+Jacobian column each): ``pivot_offset_x``, ``pivot_offset_y`` [m] shift the FMU's positions (its
+origin is the pivot at rest) by the pivot's offset from the pivot the positions are measured from
+(:data:`PIVOT_SHIFTS`, positions only; not the FMU's ``pivot_x`` input), ``view_rotation`` [rad]
+turns them about the pivot (:data:`VIEW_ROTATION`); any other name is an FMU
+start value of the model, e.g. the rod lengths ``l1``, ``l2`` [m], started from ``model_values``
+(or 0). The covariance then covers state and geometry (``StartStateFit.full_cov``), and chi2_red
+divides by n - 4 - len(geometry).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -43,6 +52,15 @@ FIT_SETTINGS: dict[str, Any] = {"solver": "dop853", "rtol": 1e-10, "atol": 1e-12
 DIFF_STEP = 1e-6
 """Relative finite-difference step of the Jacobian (scipy's ``diff_step``): 1e-6 rad moves a bob by
 0.3 um, far above the integration error at :data:`FIT_SETTINGS`, far below the position noise."""
+PIVOT_SHIFTS: dict[str, tuple[str, ...]] = {"pivot_offset_x": ("x1", "x2"), "pivot_offset_y": ("y1", "y2")}
+"""Free geometry parameters that shift FMU position outputs [m] (the pivot's offset), by the outputs they shift."""
+VIEW_ROTATION = "view_rotation"
+"""Free geometry parameter [rad]: the FMU's bob positions turned counter-clockwise about the pivot
+(before the pivot shift), e.g. a camera whose vertical is not along gravity."""
+POSITION_TRANSFORMS: tuple[str, ...] = (*PIVOT_SHIFTS, VIEW_ROTATION)
+GEOMETRY_UNITS = {"pivot_offset_x": "m", "pivot_offset_y": "m", VIEW_ROTATION: "rad", "l1": "m", "l2": "m"}
+"""Units of the usual free geometry (``StartStateFit.as_dict``)."""
+"""Free geometry that moves the FMU's positions instead of entering the FMU as a start value."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -58,23 +76,50 @@ class StartStateFit:
     n_frames: int
     rms_residual: float
     n_fmu_runs: int
+    geometry: Mapping[str, float] = field(default_factory=dict)
+    geometry_stderr: Mapping[str, float] = field(default_factory=dict)
+    full_cov: np.ndarray | None = None
+
+    @property
+    def names(self) -> tuple[str, ...]:
+        """Names of all fitted parameters: the state's start values, then the free geometry."""
+        return (*STATE_NAMES, *self.geometry)
+
+    @property
+    def values(self) -> np.ndarray:
+        """All fitted parameters in :attr:`names` order."""
+        return np.concatenate([self.state, np.fromiter(self.geometry.values(), float, len(self.geometry))])
+
+    @property
+    def covariance(self) -> np.ndarray:
+        """Covariance of all fitted parameters (:attr:`names` order); the state's ``cov`` without geometry."""
+        return self.cov if self.full_cov is None else self.full_cov
 
     @property
     def chi2_red(self) -> float:
-        """chi2 / (n - 4)."""
-        return self.chi2 / max(self.n_residuals - len(self.state), 1)
+        """chi2 / (n - number of fitted parameters)."""
+        return self.chi2 / max(self.n_residuals - len(self.names), 1)
 
     def start_values(self) -> dict[str, float]:
         """The state as FMU start values ``phi1_0 .. omega2_0``."""
         return state_start_values(self.state)
 
     def as_dict(self) -> dict[str, Any]:
-        """Plain dictionary (for JSON)."""
+        """Plain dictionary (for JSON); the geometry entries only if geometry was fitted."""
+        geometry = {}
+        if self.geometry:
+            geometry = {
+                "geometry": {k: float(v) for k, v in self.geometry.items()},
+                "geometry_stderr": {k: float(v) for k, v in self.geometry_stderr.items()},
+                "geometry_units": {k: GEOMETRY_UNITS.get(k, "as the FMU start value") for k in self.geometry},
+                "parameters": list(self.names),
+            }
         return {
             "t0_s": self.t0,
             "state": dict(zip(STATE_NAMES, map(float, self.state))),
             "stderr": dict(zip(STATE_NAMES, map(float, self.stderr))),
-            "correlation": _correlation(self.cov).tolist(),
+            **geometry,
+            "correlation": _correlation(self.covariance).tolist(),
             "chi2": self.chi2,
             "chi2_red": self.chi2_red,
             "n_frames": self.n_frames,
@@ -91,6 +136,34 @@ def _correlation(cov: np.ndarray) -> np.ndarray:
 def state_start_values(state: Sequence[float]) -> dict[str, float]:
     """Map ``(phi1, phi2, omega1, omega2)`` [rad, rad/s] to the FMU's start values."""
     return {name: float(v) for name, v in zip(STATE_NAMES, state)}
+
+
+def split_geometry(geometry: Mapping[str, float]) -> tuple[dict[str, float], dict[str, float]]:
+    """Free geometry values split into FMU start values and position transforms (:data:`POSITION_TRANSFORMS`)."""
+    start = {k: float(v) for k, v in geometry.items() if k not in POSITION_TRANSFORMS}
+    shifts = {k: float(v) for k, v in geometry.items() if k in POSITION_TRANSFORMS}
+    return start, shifts
+
+
+def shift_outputs(matrix: np.ndarray, outputs: Sequence[str], shifts: Mapping[str, float]) -> np.ndarray:
+    """Output ``matrix`` (columns ``outputs``) with the position transforms applied: the bob positions
+    turned by :data:`VIEW_ROTATION` [rad] about the pivot, then the pivot ``shifts`` [m] added."""
+    out = np.array(matrix, dtype=float)
+    shifts = dict(shifts)
+    angle = shifts.pop(VIEW_ROTATION, 0.0)
+    if angle:
+        c, s = np.cos(angle), np.sin(angle)
+        for x, y in (("x1", "y1"), ("x2", "y2")):
+            if x not in outputs or y not in outputs:
+                raise ValueError(f"{VIEW_ROTATION} turns {x}, {y}, which are not among the outputs {tuple(outputs)}")
+            i, j = list(outputs).index(x), list(outputs).index(y)
+            out[:, i], out[:, j] = c * matrix[:, i] - s * matrix[:, j], s * matrix[:, i] + c * matrix[:, j]
+    for name, value in shifts.items():
+        for col in PIVOT_SHIFTS[name]:
+            if col not in outputs:
+                raise ValueError(f"{name} shifts {col}, which is not among the fitted outputs {tuple(outputs)}")
+            out[:, list(outputs).index(col)] += value
+    return out
 
 
 def simulate_frames(
@@ -128,6 +201,8 @@ def fit_start_state(
     outputs: Sequence[str] = POSITION_OUTPUTS,
     dt: float = FRAME_INTERVAL,
     absolute_sigma: bool = False,
+    geometry: Sequence[str] = (),
+    geometry_guess: Mapping[str, float] | None = None,
 ) -> StartStateFit:
     """Fit ``(phi1, phi2, omega1, omega2)`` at ``t0`` [s] to measured frames (see the module docstring).
 
@@ -137,37 +212,47 @@ def fit_start_state(
     ``guess``: start of the iteration (e.g. the reconstruction's angles and rates at t0);
     ``model_values``: every other FMU start value (mechanisms, lengths); the solver defaults to
     :data:`FIT_SETTINGS`. ``absolute_sigma``: take ``sigma`` as the true errors (else scale the
-    covariance by chi2 / (n - 4)).
+    covariance by chi2 / (n - p)). ``geometry``: names of free geometry parameters fitted with the
+    state (module docstring), started from ``geometry_guess``, else ``model_values``, else 0.
     """
     offsets = np.asarray(offsets, dtype=int)
     data = np.asarray(data, dtype=float)
     sigma = np.broadcast_to(np.asarray(sigma, dtype=float), data.shape)
     base = {**FIT_SETTINGS, **dict(model_values or {})}
     n_frames = int(offsets.max()) + 1
+    names = tuple(geometry)
+    known = {**base, **dict(geometry_guess or {})}
+    x0 = np.concatenate([np.asarray(guess, dtype=float), [float(known.get(n, 0.0)) for n in names]])
     runs = [0]
 
-    def residuals(state: np.ndarray) -> np.ndarray:
+    def residuals(x: np.ndarray) -> np.ndarray:
         runs[0] += 1
-        sim = simulate_frames(runner, {**base, **state_start_values(state)}, t0, n_frames, dt=dt, outputs=outputs)
-        return ((output_matrix(sim, outputs)[offsets] - data) / sigma).ravel()
+        start, shifts = split_geometry(dict(zip(names, x[4:])))
+        values = {**base, **start, **state_start_values(x[:4])}
+        sim = simulate_frames(runner, values, t0, n_frames, dt=dt, outputs=outputs)
+        return ((shift_outputs(output_matrix(sim, outputs)[offsets], outputs, shifts) - data) / sigma).ravel()
 
-    res = least_squares(residuals, np.asarray(guess, dtype=float), method="lm", diff_step=DIFF_STEP, x_scale="jac")
+    res = least_squares(residuals, x0, method="lm", diff_step=DIFF_STEP, x_scale="jac")
     chi2 = float(res.fun @ res.fun)
     m = res.fun.size
     cov = np.linalg.inv(res.jac.T @ res.jac)
     if not absolute_sigma:
         cov = cov * chi2 / max(m - len(res.x), 1)
     resid = res.fun.reshape(data.shape) * sigma
+    err = np.sqrt(np.diag(cov))
     return StartStateFit(
         t0=float(t0),
-        state=res.x.copy(),
-        stderr=np.sqrt(np.diag(cov)),
-        cov=cov,
+        state=res.x[:4].copy(),
+        stderr=err[:4],
+        cov=cov[:4, :4],
         chi2=chi2,
         n_residuals=m,
         n_frames=len(offsets),
         rms_residual=float(np.sqrt(np.mean(resid**2))),
         n_fmu_runs=runs[0],
+        geometry=dict(zip(names, map(float, res.x[4:]))),
+        geometry_stderr=dict(zip(names, map(float, err[4:]))),
+        full_cov=cov if names else None,
     )
 
 

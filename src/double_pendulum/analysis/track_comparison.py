@@ -11,21 +11,36 @@ FMU's origin is the pivot's rest position). The position errors [m] are
     e_{both} = \max(e_1, e_2),
 
 and the prediction horizon for a threshold is the first time after :math:`t_0` at which an error
-exceeds it (:func:`horizon`). Two floors limit it: the track's own rod-length error
+exceeds it (:func:`horizon`). The per-frame error carries the track's frame-to-frame jitter (the
+distance between the bobs alone varies by about +-1 cm), so the headline horizons
+(:meth:`Prediction.smoothed_horizons`, 2 cm and 5 cm) use the error smoothed by a centred moving
+median over :data:`SMOOTHING_S` = 0.25 s (:func:`smoothed`); the raw horizons are kept beside them.
+
+A start may be fitted together with free geometry (:func:`least_squares_start` with ``geometry``,
+:data:`FREE_GEOMETRY`: the camera's rotation against gravity, the pivot's offset from the measurement's
+circle-fit pivot and the lower rod's length l2); a prediction then runs with the fitted l2 and its
+positions are turned and shifted by the fitted rotation and offset.
+The losses are those of the ``loss_identification`` scenario's best model (:func:`identified_losses`).
+
+Two floors limit the horizon: the track's own rod-length error
 :math:`\big|\,|r_2 - r_1| - l_2\big|` (:func:`rod_length_floor`), which no rigid-rod model can match,
 and chaos, the spread of runs from start states drawn from the fitted start's covariance
-(:func:`chaos_spread`).
+(:func:`chaos_spread`). :func:`regime` tells regular from chaotic motion at the fitted start's
+energy by the largest Lyapunov exponent.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from ..fmu.runner import FmuRunner
+from ..model.parameters import SEED_RIGID_LINKS, PendulumParameters
+from . import chaos, loss_identification, lyapunov_study
+from .ensemble import batch_energy, initial_states, pendulum_field
 from .measurement import FRAME_INTERVAL, Reconstruction
 from .start_state import (
     FIT_SETTINGS,
@@ -34,23 +49,42 @@ from .start_state import (
     StartStateFit,
     fit_start_state,
     output_matrix,
+    shift_outputs,
     simulate_frames,
+    split_geometry,
     state_start_values,
     track_window,
 )
-from .suspension_identification import START_FIT_FRAMES, Identification, IdentifiedModel
+from .suspension_identification import START_FIT_FRAMES
 from .sweep import runner_map
 
-THRESHOLDS_M = (0.01, 0.05)
-"""Position errors [m] whose first crossing defines the prediction horizons."""
+THRESHOLDS_M = (0.02, 0.05)
+"""Position errors [m] whose first crossing defines the prediction horizons (raw and smoothed)."""
+SMOOTHING_S = 0.25
+"""Width [s] of the centred moving median that smooths the per-frame error (about 7 frames)."""
+FREE_GEOMETRY: tuple[str, ...] = ("view_rotation", "pivot_offset_x", "pivot_offset_y", "l2")
+"""Geometry fitted with the start state: the camera's rotation against gravity [rad] (the FMU's positions
+turned about the pivot), the pivot's offset [m] from the circle-fit pivot and l2 [m]. l1 is left at the
+track's value: freed as well, it trades off against the pivot's height over a few swings."""
+LOSS_MODEL = "air+drag"
+"""The best loss model of the ``loss_identification`` scenario (air drag with a free factor on rho_air,
+a bearing drag torque at both joints), fitted again here by its own functions."""
+LYAPUNOV_RENORM_S = 0.1
+"""Renormalisation interval [s] of the Lyapunov estimate (:func:`regime`)."""
+LYAPUNOV_STEP_S = 2e-3
+"""RK4 step [s] of the Lyapunov estimate (:func:`regime`; the step the ``chaos`` scenario's checks support)."""
+REGULAR_DECAY = 0.5
+"""The motion counts as regular if the running exponent at T has fallen below this fraction of its
+value at T/4 (1/T-like decay: the tangent grows linearly); a converging positive exponent stays near 1."""
 ENSEMBLE_SEED = 20240611
 """Seed of the random start states of :func:`chaos_spread`."""
 RUN_OUTPUTS: tuple[str, ...] = (*POSITION_OUTPUTS, "phi1", "phi2", "omega1", "omega2", "E_pendulum")
 """FMU outputs recorded for each prediction (positions [m], angles [rad], rates [rad/s], energy [J])."""
 RUN_TITLES = {
     "seed_start_frictionless": "seed's start, frictionless model",
-    "seed_start_identified": "seed's start, identified model (losses, suspension)",
-    "lsq_start_identified": "least-squares start, identified model",
+    "seed_start_identified": "seed's start, identified losses",
+    "lsq_start_identified": "least-squares start (state only), identified losses",
+    "lsq_geometry_identified": "least-squares start and geometry, identified losses",
 }
 """Plain words for the prediction labels (which also name their CSV files) in figures."""
 
@@ -70,11 +104,27 @@ def horizon(t: np.ndarray, error: np.ndarray, threshold: float) -> float | None:
     return float(t[above[0]]) if len(above) else None
 
 
+def smoothed(t: np.ndarray, error: np.ndarray, window_s: float = SMOOTHING_S) -> np.ndarray:
+    """Centred moving median of ``error`` over the samples within +-``window_s``/2 [s] of each time ``t`` [s]
+    (missing frames simply leave fewer samples; the window shrinks at the ends)."""
+    t = np.asarray(t, dtype=float)
+    error = np.asarray(error, dtype=float)
+    lo = np.searchsorted(t, t - window_s / 2 - 1e-9, side="left")
+    hi = np.searchsorted(t, t + window_s / 2 + 1e-9, side="right")
+    return np.array([np.median(error[a:b]) for a, b in zip(lo, hi)])
+
+
+def horizon_keys(thresholds: Sequence[float] = THRESHOLDS_M) -> list[str]:
+    """Summary keys of the horizons per threshold: ``lower_bob_2cm_s``, ``both_bobs_2cm_s``, ..."""
+    return [f"{bob}_{100 * th:g}cm_s" for th in thresholds for bob in ("lower_bob", "both_bobs")]
+
+
 @dataclass(frozen=True, eq=False)
 class Prediction:
     """One FMU run from t0 compared with the track on its valid frames.
 
-    ``t`` [s] since t0; errors [m] of the upper bob ``e1``, the lower bob ``e2`` and both (the larger).
+    ``t`` [s] since t0; errors [m] of the upper bob ``e1``, the lower bob ``e2`` and both (the larger);
+    ``geometry``: the fitted geometry it ran with (start values and pivot shifts [m]).
     """
 
     label: str
@@ -83,6 +133,7 @@ class Prediction:
     t: np.ndarray
     e1: np.ndarray
     e2: np.ndarray
+    geometry: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def e_both(self) -> np.ndarray:
@@ -95,6 +146,17 @@ class Prediction:
         for th in thresholds:
             out[f"lower_bob_{100 * th:g}cm_s"] = horizon(self.t, self.e2, th)
             out[f"both_bobs_{100 * th:g}cm_s"] = horizon(self.t, self.e_both, th)
+        return out
+
+    def smoothed_horizons(
+        self, thresholds: Sequence[float] = THRESHOLDS_M, window_s: float = SMOOTHING_S
+    ) -> dict[str, float | None]:
+        """As :meth:`horizons` on the errors smoothed by :func:`smoothed` over ``window_s`` [s]."""
+        e2, both = smoothed(self.t, self.e2, window_s), smoothed(self.t, self.e_both, window_s)
+        out = {}
+        for th in thresholds:
+            out[f"lower_bob_{100 * th:g}cm_s"] = horizon(self.t, e2, th)
+            out[f"both_bobs_{100 * th:g}cm_s"] = horizon(self.t, both, th)
         return out
 
     def rms_lower_bob_error(self, until_s: float) -> float:
@@ -117,17 +179,58 @@ def reconstructed_state(rec: Reconstruction, i0: int) -> np.ndarray:
     return np.array([rec.phi1[i0], rec.phi2[i0], rec.omega1[i0], rec.omega2[i0]])
 
 
-def model_values(identified: IdentifiedModel) -> dict[str, Any]:
-    """The identified model's start values without its start state (lengths, losses, suspension)."""
-    return {k: v for k, v in identified.values.items() if k not in STATE_NAMES}
+@dataclass(frozen=True, eq=False)
+class IdentifiedLosses:
+    """The loss model fitted to the measured energy decay: FMU start values of the pendulum (rods) and
+    losses, the parameter table (value, stderr, unit), the record fitted [s] and the FMU runs it took."""
+
+    model: str
+    pendulum: dict[str, Any]
+    losses: dict[str, Any]
+    parameters: dict[str, dict[str, Any]]
+    record_s: float
+    n_runs: int
+
+    @property
+    def values(self) -> dict[str, Any]:
+        """Every FMU start value except the state: pendulum, losses and the friction regularisation."""
+        return {**self.pendulum, **self.losses, "omega_reg": loss_identification.OMEGA_REG}
+
+
+def identified_losses(rec: Reconstruction, window_s: float | None = None) -> IdentifiedLosses:
+    """Fit :data:`LOSS_MODEL` to the measured energy decay of ``rec`` (a reconstruction with rods),
+    in-process, with the ``loss_identification`` scenario's functions; ``window_s``: only the first
+    seconds after the release (None: the whole record)."""
+    md = loss_identification.measured(rec, window_s)
+    problem = loss_identification.problem_from_track(rec, md)
+    fit = loss_identification.fit_loss_model(LOSS_MODEL, problem)
+    factor = loss_identification.common_factor([fit])
+    pendulum = {k: problem.base[k] for k in ("l1", "l2", "m1", "m2", *SEED_RIGID_LINKS)}
+    return IdentifiedLosses(
+        model=LOSS_MODEL,
+        pendulum=pendulum,
+        losses=loss_identification.model_values(LOSS_MODEL, fit.theta),
+        parameters=loss_identification.parameter_table(fit, factor),
+        record_s=float(problem.t[-1] - problem.t[0]),
+        n_runs=fit.n_runs,
+    )
 
 
 def least_squares_start(
-    runner: FmuRunner, rec: Reconstruction, i0: int, values: Mapping[str, Any], n_frames: int = START_FIT_FRAMES
+    runner: FmuRunner,
+    rec: Reconstruction,
+    i0: int,
+    values: Mapping[str, Any],
+    n_frames: int = START_FIT_FRAMES,
+    geometry: Sequence[str] = (),
+    warm: StartStateFit | None = None,
 ) -> StartStateFit:
-    """Start state at frame ``i0`` fitted to the positions of ``n_frames`` frames, started from the reconstruction."""
+    """Start state at frame ``i0`` (and the free ``geometry``, e.g. :data:`FREE_GEOMETRY`) fitted to the
+    positions of ``n_frames`` frames, from the reconstruction (pivot offsets from 0, lengths from ``values``)."""
     w = track_window(rec, i0, n_frames)
-    return fit_start_state(runner, w.t0, w.offsets, w.positions, w.sigma_positions, w.guess, values)
+    guess, geometry_guess = (w.guess, None) if warm is None else (warm.state, warm.geometry)
+    return fit_start_state(runner, w.t0, w.offsets, w.positions, w.sigma_positions, guess, values,
+                           geometry=geometry, geometry_guess=geometry_guess)
 
 
 def start_fit_summary(fit: StartStateFit, guess: np.ndarray) -> dict[str, Any]:
@@ -146,17 +249,21 @@ def predict(
     rec: Reconstruction,
     i0: int,
     n_frames: int,
+    geometry: Mapping[str, float] | None = None,
 ) -> Prediction:
-    """Run the FMU from frame ``i0`` with ``state`` for ``n_frames`` frames and compare with the track."""
+    """Run the FMU from frame ``i0`` with ``state`` for ``n_frames`` frames and compare with the track;
+    ``geometry`` (fitted start values such as l2 and pivot shifts [m]) overrides ``values`` and moves the positions."""
+    geometry = dict(geometry or {})
+    start, shifts = split_geometry(geometry)
     result = simulate_frames(
         runner,
-        {**FIT_SETTINGS, **values, **state_start_values(state)},
+        {**FIT_SETTINGS, **values, **start, **state_start_values(state)},
         float(rec.t[i0]),
         n_frames,
         outputs=RUN_OUTPUTS,
     )
     window = track_window(rec, i0, n_frames)
-    d = output_matrix(result)[window.offsets] - window.positions
+    d = shift_outputs(output_matrix(result), POSITION_OUTPUTS, shifts)[window.offsets] - window.positions
     return Prediction(
         label=label,
         state=np.asarray(state, dtype=float),
@@ -164,6 +271,7 @@ def predict(
         t=window.offsets * FRAME_INTERVAL,
         e1=np.hypot(d[:, 0], d[:, 1]),
         e2=np.hypot(d[:, 2], d[:, 3]),
+        geometry=geometry,
     )
 
 
@@ -176,33 +284,39 @@ def chaos_spread(
     size: int,
     seed: int = ENSEMBLE_SEED,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Median distance [m] of the lower bob between runs from states drawn from the fit's covariance
-    and the central run, per frame (times [s] since t0): how fast the start state's own uncertainty grows."""
+    """Median distance [m] of the lower bob between runs drawn from the fit's covariance (state and
+    any fitted geometry) and the central run, per frame (times [s] since t0): how fast the fit's own
+    uncertainty grows."""
     rng = np.random.default_rng(seed)
-    states = rng.multivariate_normal(fit.state, fit.cov, size=size)
-    ref = output_matrix(central.result)[:, 2:]
-    items = [({**FIT_SETTINGS, **values, **state_start_values(state)}, fit.t0, n_frames, ref) for state in states]
+    draws = rng.multivariate_normal(fit.values, fit.covariance, size=size)
+    _, central_shifts = split_geometry(central.geometry)
+    ref = shift_outputs(output_matrix(central.result), POSITION_OUTPUTS, central_shifts)[:, 2:]
+    items = []
+    for x in draws:
+        start, shifts = split_geometry(dict(zip(fit.names[4:], x[4:])))
+        items.append(({**FIT_SETTINGS, **values, **start, **state_start_values(x[:4])}, shifts, fit.t0, n_frames, ref))
     distances = runner_map(_spread_distance, items, runner, label="start-state ensemble")
     return np.arange(n_frames) * FRAME_INTERVAL, np.median(np.array(distances), axis=0)
 
 
-def _spread_distance(runner: FmuRunner, item: tuple[dict[str, Any], float, int, np.ndarray]) -> np.ndarray:
+def _spread_distance(runner: FmuRunner, item: tuple[dict[str, Any], dict[str, float], float, int, np.ndarray]):
     """Worker: the lower bob's distance [m] per frame of one ensemble run from the central prediction."""
-    start, t0, n_frames, ref = item
+    start, shifts, t0, n_frames, ref = item
     r = simulate_frames(runner, start, t0, n_frames)
-    return np.linalg.norm(output_matrix(r)[:, 2:] - ref, axis=1)
+    return np.linalg.norm(shift_outputs(output_matrix(r), POSITION_OUTPUTS, shifts)[:, 2:] - ref, axis=1)
 
 
 def chaos_horizons(spread: tuple[np.ndarray, np.ndarray]) -> dict[str, float | None]:
     """First time [s] the ensemble's spread of the lower bob exceeds each of :data:`THRESHOLDS_M`, keyed like
-    ``lower_bob_1cm_s`` (None: not within the prediction window, see :func:`null_means`)."""
+    ``lower_bob_2cm_s`` (None: not within the prediction window, see :func:`null_means`)."""
     return {f"lower_bob_{100 * th:g}cm_s": horizon(*spread, th) for th in THRESHOLDS_M}
 
 
 def null_means(prediction_s: float) -> dict[str, str]:
     """What a null horizon in the summary means, by summary key."""
     never = f"the error or spread did not exceed the threshold within the {prediction_s:.1f} s prediction window"
-    return {"horizons_s": never, "chaos_horizons_s": never, "fit_window_sensitivity": never}
+    return {"horizons_smoothed_s": never, "horizons_raw_s": never, "chaos_horizons_s": never,
+            "fit_window_sensitivity": never}
 
 
 def window_sensitivity(
@@ -212,18 +326,59 @@ def window_sensitivity(
     values: Mapping[str, Any],
     n_frames: int,
     windows: Sequence[int],
+    geometry: Sequence[str] = FREE_GEOMETRY,
+    warm: StartStateFit | None = None,
 ) -> list[dict[str, Any]]:
-    """Horizons of least-squares starts fitted to other numbers of frames (``windows``)."""
-    return runner_map(_window_fit, [(rec, i0, dict(values), n_frames, frames) for frames in windows], runner,
-                      label="fit windows", unit="fit")
+    """Smoothed horizons of least-squares starts (with the free ``geometry``) fitted to other numbers of frames,
+    each started from the fit ``warm`` if given (fewer iterations), else from the reconstruction."""
+    items = [(rec, i0, dict(values), n_frames, frames, tuple(geometry), warm) for frames in windows]
+    return runner_map(_window_fit, items, runner, label="fit windows", unit="fit")
 
 
-def _window_fit(runner: FmuRunner, item: tuple[Reconstruction, int, dict[str, Any], int, int]) -> dict[str, Any]:
-    """Worker: the least-squares start fitted to ``frames`` frames and its prediction's horizons."""
-    rec, i0, values, n_frames, frames = item
-    fit = least_squares_start(runner, rec, i0, values, frames)
-    p = predict(runner, f"lsq{frames}", values, fit.state, rec, i0, n_frames)
-    return {"fit_frames": frames, "chi2_red": fit.chi2_red, "rms_residual_m": fit.rms_residual, **p.horizons()}
+def _window_fit(runner: FmuRunner, item: tuple[Any, ...]) -> dict[str, Any]:
+    """Worker: the least-squares start fitted to ``frames`` frames, its geometry and its prediction's horizons."""
+    rec, i0, values, n_frames, frames, geometry, warm = item
+    fit = least_squares_start(runner, rec, i0, values, frames, geometry, warm)
+    p = predict(runner, f"lsq{frames}", values, fit.state, rec, i0, n_frames, fit.geometry)
+    return {"fit_frames": frames, "fit_window_s": frames * FRAME_INTERVAL, "chi2_red": fit.chi2_red,
+            "rms_residual_m": fit.rms_residual, "geometry": dict(fit.geometry),
+            "geometry_units": fit.as_dict()["geometry_units"], **p.smoothed_horizons()}
+
+
+# --- the regime ----------------------------------------------------------------------------------
+
+
+def regime(params: PendulumParameters, state: Sequence[float], t_end: float) -> dict[str, Any]:
+    """Regular or chaotic at the energy of ``state`` (frictionless ``params``, rods included)?
+
+    The largest Lyapunov exponent by Benettin's method (:func:`double_pendulum.analysis.chaos.lyapunov_benettin`,
+    RK4 at :data:`LYAPUNOV_STEP_S`, renormalised every :data:`LYAPUNOV_RENORM_S`) over ``t_end`` [s]; the motion is
+    called regular if the running exponent at T = ``t_end`` has fallen below :data:`REGULAR_DECAY` of its
+    value at T/4 (the 1/T decay of a tangent that grows linearly), chaotic otherwise. The energy is
+    compared with the least energy that lets the lower rod flip, V(0, pi).
+    """
+    y0 = initial_states(*state)
+    res = chaos.lyapunov_benettin(pendulum_field(params), y0, t_end, renorm_interval=LYAPUNOV_RENORM_S,
+                                  integration=chaos.Integration("rk4", h=LYAPUNOV_STEP_S))
+    running = res.running[:, 0, 0]
+    quarter = float(running[np.argmin(np.abs(res.times - t_end / 4))])
+    final = float(running[-1])
+    regular = final < REGULAR_DECAY * quarter or final <= 0.0
+    energy = float(batch_energy(y0, params)[0])
+    e_flip = chaos.flip_energy_bounds(params)[1]
+    return {
+        "verdict": "regular" if regular else "chaotic",
+        "largest_lyapunov_exponent_per_s": final,
+        "averaging_time_s": float(res.times[-1]),
+        "exponent_at_quarter_time_per_s": quarter,
+        "checkpoints": lyapunov_study.convergence_checkpoints(res.times, running),
+        "energy_J": energy,
+        "lower_rod_flip_energy_J": e_flip,
+        "energy_over_flip_energy": energy / e_flip,
+        "method": (f"Benettin, frictionless, rods included, RK4 h = {1e3 * LYAPUNOV_STEP_S:g} ms, "
+                   f"renormalised every {LYAPUNOV_RENORM_S:g} s; "
+                   f"regular if lambda(T) < {REGULAR_DECAY:g} lambda(T/4)"),
+    }
 
 
 # --- the track's floor ---------------------------------------------------------------------------
@@ -265,14 +420,17 @@ def rod_floor_summary(rec: Reconstruction, i0: int, n_frames: int) -> dict[str, 
 # --- tables and plot data --------------------------------------------------------------------------
 
 
-def model_summary(rec: Reconstruction, identification: Identification, lengths: Mapping[str, float]) -> dict[str, Any]:
-    """The predicting model: rod ``lengths`` [m], total bob mass [kg], losses, the identified suspension."""
-    ident = identification
+def model_summary(losses: IdentifiedLosses) -> dict[str, Any]:
+    """The predicting model: lengths [m], bob and rod masses [kg], plate lengths [m], the identified losses."""
+    p = losses.pendulum
     return {
-        "lengths_m": lengths,
-        "masses_kg": rec.params.m1 + rec.params.m2,
-        "losses": "air drag (bobs + rods) and bearing friction at the defaults; suspension identified",
-        "suspension": {"k_N_per_m": ident.k, "M_s_kg": ident.m_s, "c_N_s_per_m": ident.c, "c_stderr": ident.c_stderr},
+        "lengths_m": {"l1": p["l1"], "l2": p["l2"]},
+        "bob_masses_kg": p["m1"] + p["m2"],
+        "rods": {k: p[k] for k in SEED_RIGID_LINKS},
+        "loss_model": losses.model,
+        "loss_parameters": losses.parameters,
+        "loss_fit_record_s": losses.record_s,
+        "loss_fit_runs": losses.n_runs,
     }
 
 
@@ -317,19 +475,24 @@ def measured_coordinates(
 
 
 def simulated_coordinates(rec: Reconstruction, prediction: Prediction) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """Times [s] and the FMU's bob coordinates [m] shifted by the fitted pivot into the track's coordinates."""
+    """Times [s] and the FMU's bob coordinates [m] moved into the track's coordinates: turned and shifted
+    by the prediction's own fitted geometry (if any), then shifted by the measurement's circle-fit pivot."""
     pivot = rec.geometry.pivot
-    shift = {"x1": pivot.xc, "y1": pivot.yc, "x2": pivot.xc, "y2": pivot.yc}
-    result = prediction.result
-    return np.asarray(result["time"]), {n: np.asarray(result[n]) + shift[n] for n in shift}
+    _, transforms = split_geometry(prediction.geometry)
+    moved = shift_outputs(output_matrix(prediction.result), POSITION_OUTPUTS, transforms)
+    origin = {"x1": pivot.xc, "y1": pivot.yc, "x2": pivot.xc, "y2": pivot.yc}
+    return np.asarray(prediction.result["time"]), {n: moved[:, i] + origin[n] for i, n in enumerate(POSITION_OUTPUTS)}
 
 
 def error_curves(
     predictions: Sequence[Prediction], spread: tuple[np.ndarray, np.ndarray]
 ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Curves (t [s] since t0, error [m]) for the error plot: each run's lower bob, the last run's
-    both bobs, and the chaos spread."""
-    curves = {f"{run_title(p.label)}: lower bob": (p.t, p.e2) for p in predictions}
-    curves.update({f"{run_title(p.label)}: larger of both bobs": (p.t, p.e_both) for p in predictions[-1:]})
-    curves["chaos: spread of runs from the fitted start's uncertainty (median)"] = spread
+    """Curves (t [s] since t0, error [m]) for the error plot: each run's lower-bob error smoothed by
+    :func:`smoothed` (the last run's per-frame error drawn first, under its smoothed one), and the spread."""
+    curves: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    for i, p in enumerate(predictions):
+        if i == len(predictions) - 1:
+            curves[f"{run_title(p.label)}: lower bob, per frame"] = (p.t, p.e2)
+        curves[f"{run_title(p.label)}: lower bob, smoothed"] = (p.t, smoothed(p.t, p.e2))
+    curves["fit's uncertainty: spread of runs drawn from its covariance (median)"] = spread
     return curves

@@ -44,6 +44,7 @@ def plot_prediction_errors(
     path: str | Path,
     *,
     floor: tuple[np.ndarray, np.ndarray] | None = None,
+    title: str = "distance between the simulated and the measured bob position",
 ) -> Path:
     """Position error [m] over time since the start [s], log scale, with horizontal ``thresholds`` [m];
     ``floor`` (t, error) is drawn grey (e.g. the track's own deviation from a rigid rod)."""
@@ -55,8 +56,7 @@ def plot_prediction_errors(
         ax.semilogy(floor[0], np.maximum(floor[1], 1e-5), ".", color="0.6", ms=2, label=label)
     for th, ls in zip(thresholds, ("--", "-.", ":")):
         ax.axhline(th, color="k", ls=ls, lw=0.9, label=f"{100 * th:g} cm")
-    ax.set(xlabel="time since the start t - t0 [s]", ylabel="position error [m]",
-           title="distance between the simulated and the measured bob position")
+    ax.set(xlabel="time since the start t - t0 [s]", ylabel="position error [m]", title=title)
     legend_outside(ax)
     ax.grid(alpha=0.3, which="both")
     return save(fig, path)
