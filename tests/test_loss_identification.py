@@ -105,6 +105,9 @@ def test_a_fit_above_its_nested_model_counts_as_not_converged():
     rows = li.comparison_rows(fits, 1.0)
     assert [r["model"] for r in rows] == ["air+drag", "air", "air+drag+viscous"]
     assert not rows[-1]["converged"] and rows[-1]["akaike_weight"] == 0.0
+    assert rows[-1]["not_ranked_because"].startswith("the fit stalled")
+    assert "not_ranked_because" not in rows[0]
+    assert "c_suspension -> infinity" in li.not_ranked_because("air+suspension")
 
 
 
@@ -113,9 +116,29 @@ def test_a_nested_model_warm_started_from_its_parent_ends_no_worse(synthetic_pro
     Gauss-Newton only accepts steps that lower chi2, so the larger model cannot end above its parent
     (it would then count as not converged and drop out of the comparison)."""
     parent, _ = synthetic_fit
-    item = li.fit_item_of("air+drag+bearing", [parent])
-    assert item.start[:2] == pytest.approx(tuple(parent.theta))
-    assert item.start[2] == pytest.approx(li.WARM_START_FRACTION * li.MECHANISMS["bearing"].parameters[0].ref)
-    fit = li.fit_loss_model(item.model, synthetic_problem, start=item.start, max_nfev=8)
+    (start,) = li.fit_item_of("air+drag+bearing", [parent]).starts
+    assert start[:2] == pytest.approx(tuple(parent.theta))
+    assert start[2] == pytest.approx(li.WARM_START_FRACTION * li.MECHANISMS["bearing"].parameters[0].ref)
+    fit = li.fit_loss_model("air+drag+bearing", synthetic_problem, start=start, max_nfev=8)
     assert fit.chi2 <= parent.chi2 * (1.0 + 1e-3)
     assert li.converged(fit, [parent, fit])
+
+
+def test_models_within_two_aic_of_the_best_are_named_as_equally_supported():
+    rows = [
+        {"model": "air+drag", "delta_aic": 0.0, "converged": True, "shares": {"air drag": 0.4}},
+        {"model": "air+viscous", "delta_aic": 1.2, "converged": True, "shares": {"viscous joint damping": 0.9}},
+        {"model": "air", "delta_aic": 23.5, "converged": True, "shares": {"air drag": 1.0}},
+        {"model": "air+suspension", "delta_aic": 0.5, "converged": False, "shares": {"damped suspension": 1.0}},
+    ]
+    out = li.equally_supported(rows)
+    assert list(out["models"]) == ["air+viscous"]
+    assert "air+viscous (delta AIC 1.2: viscous joint damping 90%)" in out["text"]
+    assert li.equally_supported(rows[:1] + rows[2:])["models"] == {}
+
+
+def test_the_suspension_joins_a_fitted_model_at_each_damping_of_its_scan():
+    parent = li.ModelFit("air", np.array([2.5]), 1.0, 100, np.zeros((100, 1)), np.zeros(100), 1.0, 1)
+    starts = li.fit_item_of("air+suspension", [parent]).starts
+    assert starts == tuple((2.5, c) for c in li.MECHANISMS["suspension"].parameters[0].warm_scan)
+    assert li.fit_item_of("air", [parent]).starts == ()

@@ -47,6 +47,7 @@ rho_air, i.e. all drag coefficients).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -85,6 +86,9 @@ class Parameter:
     ref: float
     bounds: tuple[float, float]
     description: str
+    warm_scan: tuple[float, ...] = ()
+    """Values tried when the parameter joins a fitted model (:func:`warm_starts`) where its loss is not
+    monotonic in it; empty: it joins at :data:`WARM_START_FRACTION` of ``ref``, a negligible loss."""
 
 
 @dataclass(frozen=True)
@@ -140,7 +144,8 @@ MECHANISMS: dict[str, Mechanism] = {
                    Parameter("tau_b2", "N.m", 1e-3, (1e-7, 1.0), "bearing drag torque, elbow")), _drag2),
         Mechanism("suspension", "damped suspension", "W_suspension",
                   (Parameter("c_suspension", "N.s/m", 20.0, (1e-2, 1e5),
-                             f"suspension damping c_x = c_y at k = {SUSPENSION_K:g} N/m, M_s = {SUSPENSION_M:g} kg"),),
+                             f"suspension damping c_x = c_y at k = {SUSPENSION_K:g} N/m, M_s = {SUSPENSION_M:g} kg",
+                             warm_scan=(3.0, 10.0, 30.0, 100.0, 300.0, 1000.0)),),
                   _suspension),
     )
 }  # fmt: skip
@@ -382,15 +387,23 @@ def fit_loss_model(
 
 @dataclass(frozen=True)
 class FitItem:
-    """A model to fit and its start values (None: the parameters' references)."""
+    """A model to fit and its candidate start values (none: the parameters' references); with several,
+    the fit starts from the one with the lowest chi2."""
 
     model: str
-    start: tuple[float, ...] | None = None
+    starts: tuple[tuple[float, ...], ...] = ()
 
 
 def fit_item(item: FitItem, problem: FitProblem) -> ModelFit:
-    """:func:`fit_loss_model` for :func:`~double_pendulum.analysis.sweep.parallel_map`."""
-    return fit_loss_model(item.model, problem, start=item.start)
+    """:func:`fit_loss_model` for :func:`~double_pendulum.analysis.sweep.parallel_map`, from the best of
+    ``item.starts`` (one run each when there are several)."""
+    start = None
+    if len(item.starts) == 1:
+        start = item.starts[0]
+    elif item.starts:
+        chi2 = [float(np.sum(problem.residuals(item.model, s) ** 2)) for s in item.starts]
+        start = item.starts[int(np.argmin(chi2))]
+    return fit_loss_model(item.model, problem, start=start)
 
 
 WARM_START_FRACTION = 1e-3
@@ -398,21 +411,25 @@ WARM_START_FRACTION = 1e-3
 the nested model starts at its parent's chi2 (up to ~1e-3 of the parent's loss)."""
 
 
-def warm_start(model: str, parent: ModelFit) -> tuple[float, ...]:
-    """Start values of ``model`` from a nested ``parent`` fit: shared parameters at the parent's optimum,
-    the added ones at :data:`WARM_START_FRACTION` of their references. A nested model then starts no
-    worse than its parent, so its chi2 cannot end above the parent's through a poor start (the
-    suspension's loss is not monotonic in c: from the references Gauss-Newton can stall)."""
+def warm_starts(model: str, parent: ModelFit) -> tuple[tuple[float, ...], ...]:
+    """Candidate start values of ``model`` from a nested ``parent`` fit: shared parameters at the parent's
+    optimum, an added one at :data:`WARM_START_FRACTION` of its reference, or at each value of its
+    ``warm_scan`` (the suspension: its loss vanishes only as c goes to 0, where the undamped suspension
+    trades energy with the pendulum, or to infinity, where it is rigid; in between it peaks). A nested
+    model then starts no worse than its parent where a negligible loss exists, so its chi2 cannot end
+    above the parent's through a poor start."""
     known = dict(zip(parent.names, parent.theta))
-    return tuple(float(known.get(p.name, WARM_START_FRACTION * p.ref)) for p in parameters_of(model))
+    choices = [(float(known[p.name]),) if p.name in known else (p.warm_scan or (WARM_START_FRACTION * p.ref,))
+               for p in parameters_of(model)]  # fmt: skip
+    return tuple(itertools.product(*choices))
 
 
 def fit_item_of(model: str, fits: Sequence[ModelFit]) -> FitItem:
     """The fit item of ``model``: warm-started from the best-fitting (lowest chi2) of ``fits`` whose
-    mechanisms it contains (:func:`warm_start`), from the references if none."""
+    mechanisms it contains (:func:`warm_starts`), from the references if none."""
     mine = set(model.split("+"))
     parents = [f for f in fits if set(f.model.split("+")) < mine]
-    return FitItem(model, warm_start(model, min(parents, key=lambda f: f.chi2)) if parents else None)
+    return FitItem(model, warm_starts(model, min(parents, key=lambda f: f.chi2)) if parents else ())
 
 
 def fit_models(
@@ -450,6 +467,18 @@ def converged(fit: ModelFit, fits: Sequence[ModelFit]) -> bool:
     return not nested or fit.chi2 <= min(nested) + CONVERGENCE_TOLERANCE
 
 
+def not_ranked_because(model: str) -> str:
+    """Why a model whose chi2 ended above a nested model's (:func:`converged`) is not ranked: a mechanism
+    with a ``warm_scan`` (the suspension) reaches its nested limit only outside the scanned values;
+    any other fit stalled."""
+    scanned = [p for p in parameters_of(model) if p.warm_scan]
+    if not scanned:
+        return "the fit stalled: chi2 above a model nested in it"
+    p = scanned[0]
+    return (f"chi2 above the model nested in it for every {p.name} tried ({p.warm_scan[0]:g} to "
+            f"{p.warm_scan[-1]:g} {p.unit}, then Gauss-Newton): the nested model is its limit {p.name} -> infinity")
+
+
 def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, Any]]:
     """One row per model, sorted by the corrected AIC: parameters with errors, chi2, AIC, BIC, Akaike weight.
 
@@ -476,6 +505,7 @@ def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, A
             "delta_bic": crit[f.model][1] - best_bic,
             "akaike_weight": float(w),
             "converged": ok[f.model],
+            **({} if ok[f.model] else {"not_ranked_because": not_ranked_because(f.model)}),
             "energy_scale_kappa": f.kappa,
             "shares": f.extra.get("shares", {}),
             **f.extra.get("decay", {}),
@@ -701,6 +731,26 @@ def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     return {"suspension_dominates": dominates, "answer": text, "suspension_share_by_model": with_susp}
 
 
+EQUALLY_SUPPORTED_DAIC = 2.0
+"""Models within this AIC of the best are supported about as well by the data (Burnham & Anderson)."""
+
+
+def equally_supported(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The converged models other than the best within :data:`EQUALLY_SUPPORTED_DAIC` of its AIC: delta AIC
+    and loss shares by model, and a plain sentence (the energy record alone cannot rank them)."""
+    rivals = {r["model"]: {"delta_aic": r["delta_aic"], "shares": r["shares"]}
+              for r in rows[1:] if r["converged"] and r["delta_aic"] < EQUALLY_SUPPORTED_DAIC}  # fmt: skip
+    if not rivals:
+        text = f"No other model comes within {EQUALLY_SUPPORTED_DAIC:g} of the best model's AIC."
+    else:
+        parts = "; ".join(f"{m} (delta AIC {v['delta_aic']:.1f}: "
+                          + ", ".join(f"{k} {x:.0%}" for k, x in v["shares"].items()) + ")"
+                          for m, v in rivals.items())  # fmt: skip
+        text = (f"Supported about as well (delta AIC < {EQUALLY_SUPPORTED_DAIC:g}): {parts}. The energy record "
+                f"alone does not rank these against {rows[0]['model']}; the split of the loss between them is open.")
+    return {"models": rivals, "text": text}
+
+
 def goal_checks(numbers: Mapping[str, float], halves: Mapping[str, Any]) -> dict[str, Any]:
     """The issue's goal: b_sim within 2 % of b_measured, p_sim within 2 p_measured_stderr, no trend."""
     b_dev = numbers["b_sim_per_s"] / numbers["b_measured_per_s"] - 1.0
@@ -765,6 +815,7 @@ def identify_losses(runner: Any, *, quick: bool = False, max_workers: int | None
         "measured_loss_J": loss,
         "simulated_loss_J": float(sum(float(result[w][-1]) for w in works)),
         **suspension_answer(rows),
+        "equally_supported": equally_supported(rows),
         "air_drag_at_defaults": air_share_at_defaults(problem, loss),
         "models": rows,
         "suspension_fixed": {"k_N_per_m": SUSPENSION_K, "M_s_kg": SUSPENSION_M},

@@ -30,7 +30,7 @@ def model_table(rows: list[Mapping[str, Any]]) -> str:
                            for n, p in r["parameters"].items())
         shares = ", ".join(f"{k} {v:.0%}" for k, v in r["shares"].items())
         if not r.get("converged", True):
-            shares += " (fit did not converge: chi2 above a model nested in it; not ranked)"
+            shares += f" (not ranked: {r['not_ranked_because']})"
         lines.append(f"| {r['model']} | {params} | {r['chi2_red']:.3f} | {r['delta_aic']:.1f} | {r['delta_bic']:.1f} "
                      f"| {r['akaike_weight']:.3f} | {r.get('b_sim_per_s', float('nan')):.5f} "
                      f"| {r.get('p_sim', float('nan')):.2f} | {shares} |")  # fmt: skip
@@ -113,6 +113,8 @@ multiplied by sqrt(F).
 ## Best model: {s['best_model']}
 
 {parameter_lines(s)}
+
+{s['equally_supported']['text']}
 
 Correlations: {correlation_text(s)}.
 
