@@ -142,3 +142,15 @@ def test_the_suspension_joins_a_fitted_model_at_each_damping_of_its_scan():
     starts = li.fit_item_of("air+suspension", [parent]).starts
     assert starts == tuple((2.5, c) for c in li.MECHANISMS["suspension"].parameters[0].warm_scan)
     assert li.fit_item_of("air", [parent]).starts == ()
+
+
+def test_gauss_newton_says_why_it_stopped():
+    a = np.array([[1.0, 0.5], [0.2, 2.0], [1.0, 1.0]])
+    target = a @ np.array([3.0, -1.0])
+
+    def residuals(x: np.ndarray) -> np.ndarray:
+        return a @ x - target
+
+    x, _, stop = li.gauss_newton(residuals, np.array([1.0, 1.0]))
+    assert stop == "converged" and x == pytest.approx([3.0, -1.0], abs=1e-4)
+    assert li.gauss_newton(residuals, np.array([1.0, 1.0]), max_runs=2)[2] == "run limit"

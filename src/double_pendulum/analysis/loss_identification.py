@@ -310,7 +310,7 @@ class ModelFit:
 
 def gauss_newton(
     residuals: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, max_runs: int = 30, xtol: float = 1e-2
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, str]:
     r"""Minimise :math:`|r(x)|^2` by damped Gauss-Newton with a forward-difference Jacobian.
 
     Each iteration: :math:`J_{:j} = (r(x + h e_j) - r(x))/h` (h = :data:`DIFF_STEP`, one run per
@@ -318,7 +318,9 @@ def gauss_newton(
     while :math:`|r|^2` grows (:math:`\lambda` = 1e-6 guards near-degenerate directions). Stops when
     :math:`\max|\Delta x_j| <` ``xtol`` (1 % of a reference value, far below the parameters' errors)
     or after ``max_runs`` runs.
-    The problem is nearly linear in x, so two or three iterations suffice. Returns x and J at x.
+    The problem is nearly linear in x, so two or three iterations suffice. Returns x, J at x and why it
+    stopped: ``"converged"`` (step below ``xtol``), ``"run limit"`` or ``"no descent"`` (six halvings of
+    the step did not lower chi2).
     """
     x = np.asarray(x0, dtype=float).copy()
     r0 = residuals(x)
@@ -328,8 +330,10 @@ def gauss_newton(
         runs += len(x)
         a = jac.T @ jac
         dx = -np.linalg.pinv(a + 1e-6 * np.diag(np.diag(a))) @ (jac.T @ r0)  # pinv: a column may vanish at a bound
-        if np.max(np.abs(dx)) < xtol or runs >= max_runs:
-            return x, jac
+        if np.max(np.abs(dx)) < xtol:
+            return x, jac, "converged"
+        if runs >= max_runs:
+            return x, jac, "run limit"
         for _ in range(6):
             r_new = residuals(x + dx)
             runs += 1
@@ -337,7 +341,7 @@ def gauss_newton(
                 break
             dx *= 0.5
         else:
-            return x, jac
+            return x, jac, "no descent"
         x, r0 = x + dx, r_new
 
 
@@ -373,13 +377,13 @@ def fit_loss_model(
         runs[0] += 1
         return problem.residuals(model, theta_of(x))
 
-    x, jac = gauss_newton(resid, theta0[free] / ref[free], max_runs=max_nfev)
+    x, jac, stop = gauss_newton(resid, theta0[free] / ref[free], max_runs=max_nfev)
     theta = theta_of(x)
     works = sorted({m.work for m in mechanisms_of(model)})
     result = problem.simulate(model_values(model, theta), outputs=("E_pendulum", *works))
     r, kappa = problem.scaled_residuals(np.asarray(result["E_pendulum"])[problem.offsets])
     e_fit = problem.energy + r * problem.sigma  # kappa E_sim on the frames
-    extra = {"shares": shares(result, model), "decay": {
+    extra = {"shares": shares(result, model), "stop": stop, "decay": {
         "b_sim_per_s": fit_model("exponential", problem.t, e_fit, problem.sigma).value("b"),
         "p_sim": decay_shape(problem.t, e_fit, problem.sigma)["p"]}}  # fmt: skip
     return ModelFit(model, theta, float(r @ r), len(r), jac, r, kappa, runs[0] + 1, extra=extra)
@@ -510,6 +514,7 @@ def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, A
             "shares": f.extra.get("shares", {}),
             **f.extra.get("decay", {}),
             "n_runs": f.n_runs,
+            "fit_stopped": f.extra.get("stop", "converged"),
         }
         for f, w in zip(ordered, weights)
     ]

@@ -29,6 +29,8 @@ def model_table(rows: list[Mapping[str, Any]]) -> str:
         params = ", ".join(f"{n} = {_pm(p['value'], p['stderr'])}{_unit(p['unit'])}"
                            for n, p in r["parameters"].items())
         shares = ", ".join(f"{k} {v:.0%}" for k, v in r["shares"].items())
+        if r.get("fit_stopped", "converged") != "converged":
+            shares += f" (fit stopped: {r['fit_stopped']}, its chi2 may lie above the model's minimum)"
         if not r.get("converged", True):
             shares += f" (not ranked: {r['not_ranked_because']})"
         lines.append(f"| {r['model']} | {params} | {r['chi2_red']:.3f} | {r['delta_aic']:.1f} | {r['delta_bic']:.1f} "
