@@ -35,7 +35,8 @@ def plot_energy_fit(
 
 
 def plot_loss_shares(rows: list[Mapping[str, Any]], path: str | Path) -> Path:
-    """Each model's shares of the dissipated work as stacked horizontal bars (best model on top), with dAIC."""
+    """Each model's shares of the dissipated work as stacked horizontal bars (best model on top), with dAIC
+    (and "not ranked" where its fit ended above a model nested in it)."""
     labels = sorted({name for r in rows for name in r["shares"]})
     fig, ax = plt.subplots(figsize=(10, 0.55 * len(rows) + 1.8))
     y = np.arange(len(rows))[::-1]
@@ -47,7 +48,8 @@ def plot_loss_shares(rows: list[Mapping[str, Any]], path: str | Path) -> Path:
             if v > 0.06:
                 ax.text(li + v / 2, yi, f"{v:.0%}", ha="center", va="center", fontsize=8, color="white")
         left += vals
-    ax.set_yticks(y, [f"{r['model']}  (dAIC {r['delta_aic']:.0f})" for r in rows])
+    ax.set_yticks(y, [f"{r['model']}  (dAIC {r['delta_aic']:.0f}{'' if r.get('converged', True) else ', not ranked'})"
+                      for r in rows])
     ax.set(xlim=(0, 1), xlabel="share of the energy dissipated over the record [1]",
            title="Loss shares per model (best model on top)")  # fmt: skip
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1 - 0.6 / len(rows)), ncol=3, fontsize=8)
