@@ -7,7 +7,8 @@ pendulum with its acrylic rods (:data:`~double_pendulum.model.parameters.SEED_RI
 losses of the ``loss_identification`` scenario's best model, air drag with a free factor on rho_air
 plus a bearing drag torque at both joints, fitted here again to the measured energy decay by that
 scenario's own functions (:func:`double_pendulum.analysis.track_comparison.identified_losses`, on the
-whole record also in quick mode: the first 8 s alone leave the two losses unidentified). Four runs:
+whole record also in quick mode: the first 8 s alone leave the two losses unidentified; the fit is
+cached, so after ``loss_identification`` it is read, not repeated). Four runs:
 
 - **seed start**: angles and rates of the frame nearest t0 from the measurement reconstruction
   (angles from the positions, rates from the Savitzky-Golay derivative), run frictionless with point

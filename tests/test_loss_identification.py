@@ -86,7 +86,7 @@ def test_profile_interval_interpolates_the_crossings():
 
 
 def test_best_model_on_the_real_data_quick(runner):
-    """Quick settings (first 8 s, two models): the best model's shares sum to 1 and the claim is stated."""
+    """Quick settings (two models, no profiles): the best model's shares sum to 1 and the claim is stated."""
     s = li.identify_losses(runner, quick=True, max_workers=1).summary
     assert s["best_model"] in li.QUICK_MODELS
     assert sum(s["shares"].values()) == pytest.approx(1.0, abs=1e-12)

@@ -47,7 +47,9 @@ rho_air, i.e. all drag coefficients).
 
 from __future__ import annotations
 
+import hashlib
 import itertools
+import json
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -59,6 +61,7 @@ from ..fmu.simulate import simulate
 from ..model.parameters import SEED_RIGID_LINKS, AirDragParameters
 from .decay_fit import AUTOCORRELATION_LAG_S, MODELS, effective_sample_factor, fit_model
 from .measurement import FPS, FRAME_INTERVAL, Reconstruction, load_track, reconstruct
+from .result_cache import cached
 from .suspension_identification import MeasuredDecay, decay_shape, fit_release_state, measured_decay
 
 OMEGA_REG = 0.01
@@ -166,9 +169,6 @@ FULL_MODELS: tuple[str, ...] = (
 """Models of the full identification: mechanisms joined by '+'."""
 QUICK_MODELS: tuple[str, ...] = ("air+drag", "air+suspension")
 """Models of the quick identification."""
-QUICK_WINDOW_S = 8.0
-"""Seconds after the release fitted by the quick identification."""
-
 
 def mechanisms_of(model: str) -> list[Mechanism]:
     """The mechanisms of a model name such as ``"air+drag"``."""
@@ -233,6 +233,13 @@ class FitProblem:
             output_interval=FRAME_INTERVAL,
             outputs=tuple(outputs),
         )
+
+    def digest(self) -> str:
+        """Hash of the measurement and the pendulum: what a fit of this problem depends on."""
+        h = hashlib.sha256(json.dumps({"t0": self.t0, "base": self.base}, sort_keys=True).encode())
+        for a in (self.offsets, self.t, self.energy, self.sigma):
+            h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+        return h.hexdigest()[:16]
 
     def scaled_residuals(self, e_sim: np.ndarray) -> tuple[np.ndarray, float]:
         """Normalised residuals r and the calibration kappa (module docstring) of a simulated energy."""
@@ -354,8 +361,25 @@ def fit_loss_model(
 ) -> ModelFit:
     """Fit ``model`` to ``problem`` (least squares in x = theta/ref); ``fixed``: index -> value held.
 
-    ``start``: start values of theta (default the references). Returns the fit at the optimum.
+    ``start``: start values of theta (default the references). Returns the fit at the optimum. Fits
+    are cached on disk (:func:`~double_pendulum.analysis.result_cache.cached`, kind ``loss_fits``)
+    under the model, the start, the held values, the run budget and the problem's digest: a repeated
+    run, or another scenario fitting the same model from the same start, reads the same fit.
     """
+    key = {"model": model, "fixed": sorted((int(i), float(v)) for i, v in (fixed or {}).items()),
+           "start": None if start is None else [float(v) for v in start], "max_nfev": max_nfev,
+           "problem": problem.digest()}  # fmt: skip
+    return cached("loss_fits", key, lambda: _fit_loss_model(model, problem, fixed, start, max_nfev))
+
+
+def _fit_loss_model(
+    model: str,
+    problem: FitProblem,
+    fixed: Mapping[int, float] | None,
+    start: Sequence[float] | None,
+    max_nfev: int,
+) -> ModelFit:
+    """:func:`fit_loss_model` without the cache."""
     params = parameters_of(model)
     fixed = dict(fixed or {})
     ref = np.array([p.ref for p in params])
@@ -774,11 +798,13 @@ def goal_checks(numbers: Mapping[str, float], halves: Mapping[str, Any]) -> dict
 def identify_losses(runner: Any, *, quick: bool = False, max_workers: int | None = None) -> LossIdentification:
     """Fit every model (:data:`FULL_MODELS`, quick: :data:`QUICK_MODELS`) in parallel with the in-process
     component, compare them, profile the best one (not in quick mode) and re-run it through ``runner``
-    (the FMU) for the headline numbers. ``quick`` fits only the first :data:`QUICK_WINDOW_S` seconds."""
+    (the FMU) for the headline numbers. Both modes fit the whole record (the first 8 s alone leave the losses
+    unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim`` fits the same
+    ``air+drag`` from the same start, so it reads the quick mode's fit."""
     from .sweep import parallel_map  # noqa: PLC0415 - process pools only when identifying
 
     rec = seed_reconstruction()
-    md = measured(rec, QUICK_WINDOW_S if quick else None)
+    md = measured(rec)
     problem = problem_from_track(rec, md)
     models = QUICK_MODELS if quick else FULL_MODELS
     fits, workers = fit_models(models, problem, max_workers)

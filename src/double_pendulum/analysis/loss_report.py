@@ -94,7 +94,7 @@ def report_text(s: Mapping[str, Any]) -> str:
     air = s["air_drag_at_defaults"]
     err = s.get("shares_stderr", {})
     shares = ", ".join(f"{k} {v:.0%} +- {err.get(k, 0.0):.0%}" for k, v in s["shares"].items())
-    mode = " (quick mode: two models, the first 8 s, no profiles)" if s["quick"] else ""
+    mode = " (quick mode: two models, no profiles)" if s["quick"] else ""
     return f"""# Loss identification: which mechanisms drain the seed's pendulum?
 
 The measured energy of the seed's pendulum (camera track, Table 1; rigid links with 70 g acrylic

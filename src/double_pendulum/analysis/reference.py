@@ -14,7 +14,6 @@ the equations or the integrators computes them anew. Delete the folder to force 
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 import os
@@ -27,9 +26,9 @@ import numpy as np
 
 from ..component.cosimulation import DoublePendulumCoSimulation
 from ..fmu.simulate import simulate
+from .result_cache import cache_root, sources_hash
 
 STATE_OUTPUTS = ("phi1", "phi2", "omega1", "omega2")
-CACHE_ENV = "DOUBLE_PENDULUM_CACHE"
 REFERENCE_SETTINGS = {"solver": "dop853", "rtol": 1e-13, "atol": 1e-15, "max_steps": 1e8}
 CROSS_CHECK = {"method": "Radau", "rtol": 1e-12, "atol": 1e-14}
 _RUNTIME = ("model", "solvers", "component")
@@ -37,19 +36,12 @@ _RUNTIME = ("model", "solvers", "component")
 
 def cache_dir() -> Path:
     """The folder of cached references: ``$DOUBLE_PENDULUM_CACHE/references`` or ``.cache/references``."""
-    return Path(os.environ.get(CACHE_ENV) or ".cache") / "references"
+    return cache_root() / "references"
 
 
-@functools.lru_cache(maxsize=1)
 def runtime_hash() -> str:
     """Hash of the runtime sources (model, solvers, component): references depend on nothing else."""
-    root = Path(__file__).resolve().parents[1]
-    digest = hashlib.sha256()
-    for package in _RUNTIME:
-        for path in sorted((root / package).rglob("*.py")):
-            digest.update(path.relative_to(root).as_posix().encode())
-            digest.update(path.read_bytes())
-    return digest.hexdigest()[:16]
+    return sources_hash(_RUNTIME)
 
 
 @dataclass(frozen=True)
