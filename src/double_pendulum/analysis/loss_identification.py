@@ -315,6 +315,11 @@ class ModelFit:
         return self.chi2 / factor + 2.0 * self.k, self.chi2 / factor + self.k * math.log(n_eff)
 
 
+CHI2_TOLERANCE = 0.05
+"""A Gauss-Newton step that promises less than this decrease of chi2 ends the fit: one standard error
+of a parameter is a chi2 change of about F (1.3), so 0.05 moves no result by more than 0.2 of its error."""
+
+
 def gauss_newton(
     residuals: Callable[[np.ndarray], np.ndarray], x0: np.ndarray, *, max_runs: int = 30, xtol: float = 1e-2
 ) -> tuple[np.ndarray, np.ndarray, str]:
@@ -323,8 +328,10 @@ def gauss_newton(
     Each iteration: :math:`J_{:j} = (r(x + h e_j) - r(x))/h` (h = :data:`DIFF_STEP`, one run per
     parameter), step :math:`\Delta x = -(J^T J + \lambda\,\mathrm{diag} J^T J)^{-1} J^T r`, halved
     while :math:`|r|^2` grows (:math:`\lambda` = 1e-6 guards near-degenerate directions). Stops when
-    :math:`\max|\Delta x_j| <` ``xtol`` (1 % of a reference value, far below the parameters' errors)
-    or after ``max_runs`` runs.
+    :math:`\max|\Delta x_j| <` ``xtol`` (1 % of a reference value, far below the parameters' errors),
+    or when the step's predicted decrease of :math:`|r|^2` (linear model) is below
+    :data:`CHI2_TOLERANCE` (along a valley of strongly correlated parameters the step can stay large
+    while chi2 is flat to within the integration noise), or after ``max_runs`` runs.
     The problem is nearly linear in x, so two or three iterations suffice. Returns x, J at x and why it
     stopped: ``"converged"`` (step below ``xtol``), ``"run limit"`` or ``"no descent"`` (six halvings of
     the step did not lower chi2).
@@ -337,7 +344,8 @@ def gauss_newton(
         runs += len(x)
         a = jac.T @ jac
         dx = -np.linalg.pinv(a + 1e-6 * np.diag(np.diag(a))) @ (jac.T @ r0)  # pinv: a column may vanish at a bound
-        if np.max(np.abs(dx)) < xtol:
+        predicted = float(r0 @ r0 - np.sum((r0 + jac @ dx) ** 2))
+        if np.max(np.abs(dx)) < xtol or predicted < CHI2_TOLERANCE:
             return x, jac, "converged"
         if runs >= max_runs:
             return x, jac, "run limit"
