@@ -58,9 +58,9 @@ VIEW_ROTATION = "view_rotation"
 """Free geometry parameter [rad]: the FMU's bob positions turned counter-clockwise about the pivot
 (before the pivot shift), e.g. a camera whose vertical is not along gravity."""
 POSITION_TRANSFORMS: tuple[str, ...] = (*PIVOT_SHIFTS, VIEW_ROTATION)
+"""Free geometry that moves the FMU's positions instead of entering the FMU as a start value."""
 GEOMETRY_UNITS = {"pivot_offset_x": "m", "pivot_offset_y": "m", VIEW_ROTATION: "rad", "l1": "m", "l2": "m"}
 """Units of the usual free geometry (``StartStateFit.as_dict``)."""
-"""Free geometry that moves the FMU's positions instead of entering the FMU as a start value."""
 
 
 @dataclass(frozen=True, eq=False)
