@@ -114,6 +114,17 @@ def smoothed(t: np.ndarray, error: np.ndarray, window_s: float = SMOOTHING_S) ->
     return np.array([np.median(error[a:b]) for a, b in zip(lo, hi)])
 
 
+def _horizons(
+    t: np.ndarray, lower: np.ndarray, both: np.ndarray, thresholds: Sequence[float]
+) -> dict[str, float | None]:
+    """:func:`horizon` of the lower bob's and both bobs' errors [m] per threshold, keyed as :func:`horizon_keys`."""
+    out = {}
+    for th in thresholds:
+        out[f"lower_bob_{100 * th:g}cm_s"] = horizon(t, lower, th)
+        out[f"both_bobs_{100 * th:g}cm_s"] = horizon(t, both, th)
+    return out
+
+
 def horizon_keys(thresholds: Sequence[float] = THRESHOLDS_M) -> list[str]:
     """Summary keys of the horizons per threshold: ``lower_bob_2cm_s``, ``both_bobs_2cm_s``, ..."""
     return [f"{bob}_{100 * th:g}cm_s" for th in thresholds for bob in ("lower_bob", "both_bobs")]
@@ -142,22 +153,14 @@ class Prediction:
 
     def horizons(self, thresholds: Sequence[float] = THRESHOLDS_M) -> dict[str, float | None]:
         """First time [s] after t0 the lower bob's / both bobs' error exceeds each threshold (None: never)."""
-        out = {}
-        for th in thresholds:
-            out[f"lower_bob_{100 * th:g}cm_s"] = horizon(self.t, self.e2, th)
-            out[f"both_bobs_{100 * th:g}cm_s"] = horizon(self.t, self.e_both, th)
-        return out
+        return _horizons(self.t, self.e2, self.e_both, thresholds)
 
     def smoothed_horizons(
         self, thresholds: Sequence[float] = THRESHOLDS_M, window_s: float = SMOOTHING_S
     ) -> dict[str, float | None]:
         """As :meth:`horizons` on the errors smoothed by :func:`smoothed` over ``window_s`` [s]."""
         e2, both = smoothed(self.t, self.e2, window_s), smoothed(self.t, self.e_both, window_s)
-        out = {}
-        for th in thresholds:
-            out[f"lower_bob_{100 * th:g}cm_s"] = horizon(self.t, e2, th)
-            out[f"both_bobs_{100 * th:g}cm_s"] = horizon(self.t, both, th)
-        return out
+        return _horizons(self.t, e2, both, thresholds)
 
     def rms_lower_bob_error(self, until_s: float) -> float:
         """sqrt(mean(e2^2)) [m] over the frames with t <= ``until_s`` [s] after t0."""
