@@ -14,6 +14,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
+from .measurement import FPS
+
 LABELS = {
     "seed_start_frictionless": "seed start (reconstruction at t0), frictionless point masses",
     "seed_start_identified": "seed start, identified model",
@@ -82,7 +84,7 @@ def sensitivity_rows(s: Mapping[str, Any]) -> str:
     if len(table) == 1:
         return "(full run only)"
     rows = [
-        f"| {r['fit_frames']}{' (used)' if r.get('main') else ''} | {r['fit_frames'] / 29.97:.2f} "
+        f"| {r['fit_frames']}{' (used)' if r.get('main') else ''} | {r['fit_frames'] / FPS:.2f} "
         f"| {r['chi2_red']:.0f} | {1e3 * r['rms_residual_m']:.1f} "
         f"| {math.degrees(r['geometry']['view_rotation']):.2f} "
         f"| {1e3 * r['geometry']['pivot_offset_x']:.1f}, {1e3 * r['geometry']['pivot_offset_y']:.1f} "
@@ -202,7 +204,7 @@ The state-only start reproduces its {lsq["n_frames"]} frames with an rms positio
 {1e3 * lsq["rms_residual"]:.1f} mm (chi2_red = {lsq["chi2_red"]:.0f} with the rod-jitter noise as errors; the
 standard errors are scaled by chi2_red); its rates differ from the reconstruction's by {change["omega1_0"]:+.2f} and
 {change["omega2_0"]:+.2f} rad/s. Fitted together with the geometry over {geo["n_frames"]} frames
-({geo["n_frames"] / 29.97:.2f} s after t0): {geometry_text(geo["geometry"], geo["geometry_stderr"])}
+({geo["n_frames"] / FPS:.2f} s after t0): {geometry_text(geo["geometry"], geo["geometry_stderr"])}
 (view_rotation: the FMU's positions turned counter-clockwise about the pivot, a camera whose vertical is
 not along gravity; pivot offset from the circle-fit pivot; standard errors scaled by
 chi2_red = {geo["chi2_red"]:.0f}); rms residual {1e3 * geo["rms_residual"]:.1f} mm.
