@@ -177,15 +177,13 @@ def _cpu_seconds() -> float:
     return total + children.ru_utime + children.ru_stime
 
 
-def cmd_run(args: argparse.Namespace) -> int:
-    names = _check_scenario(args.scenario)
-    if args.quick and args.thorough:
-        raise CliError("--quick and --thorough exclude each other")
-    out = _writable_folder(args.out)
+def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: Path) -> list[str]:
+    """Run the scenarios one after another in this process; return the names of those that failed."""
     failed = []
     with _load_fmu(args.fmu, args.rebuild) as runner:
         for number, name in enumerate(names, start=1):
-            print(f"[{number}/{len(names)}] {name}: {scenario_description(name)} ...", flush=True)
+            index = args.index or f"{number}/{len(names)}"
+            print(f"[{index}] {name}: {scenario_description(name)} ...", flush=True)
             module = importlib.import_module(f"double_pendulum.scenarios.{name}")
             start, cpu_start = time.perf_counter(), _cpu_seconds()
             if args.thorough and not accepts_thorough(module):
@@ -200,6 +198,34 @@ def cmd_run(args: argparse.Namespace) -> int:
                 continue
             print(f"{name}: wrote {out / name} in {time.perf_counter() - start:.1f} s "
                   f"(CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
+    return failed
+
+
+def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path, jobs: int) -> list[str]:
+    """Build the FMU if needed, then run the scenarios in child processes, ``jobs`` at a time."""
+    from .scenario_pool import run_in_children
+
+    _load_fmu(args.fmu, args.rebuild).close()  # build once here, and fail early on an unusable FMU
+    print(f"running {len(names)} scenarios, {jobs} at a time in their own processes, the longest first",
+          flush=True)
+    return run_in_children(names, out, Path(args.fmu), quick=args.quick, thorough=args.thorough, jobs=jobs)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    names = _check_scenario(args.scenario)
+    if args.quick and args.thorough:
+        raise CliError("--quick and --thorough exclude each other")
+    if args.jobs is not None and args.jobs < 1:
+        raise CliError(f"--jobs must be at least 1, got {args.jobs}")
+    out = _writable_folder(args.out)
+    from .scenario_pool import default_jobs
+
+    jobs = min(len(names), args.jobs or default_jobs())
+    start, cpu_start = time.perf_counter(), _cpu_seconds()
+    failed = _run_in_children(names, args, out, jobs) if jobs > 1 else _run_in_this_process(names, args, out)
+    if len(names) > 1:
+        print(f"{len(names) - len(failed)} of {len(names)} scenarios wrote {out} in "
+              f"{time.perf_counter() - start:.1f} s (CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
     if failed:
         print(f"{len(failed)} of {len(names)} scenarios failed: {', '.join(failed)}", file=sys.stderr)
     return 1 if failed else 0
@@ -227,7 +253,8 @@ def build_parser() -> argparse.ArgumentParser:
         help="run a scenario (or 'all') through the FMU with fmpy",
         description="Run a scenario through the FMU with fmpy; write CSV files, plots, summary.json "
         "and a report into OUT/SCENARIO/.",
-        epilog="scenarios:\n" + scenario_listing() + "\n  all                    every scenario above, in this order",
+        epilog="scenarios:\n" + scenario_listing()
+        + "\n  all                    every scenario above, one per core at a time (see --jobs)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p_run.add_argument("scenario", metavar="SCENARIO", help="scenario name (see below), or 'all'")
@@ -239,6 +266,10 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("--thorough", action="store_true",
                        help="heavier, publication-grade settings where a scenario has them (chaos, "
                        "work_precision); the others run as usual")
+    p_run.add_argument("--jobs", type=int, default=None, metavar="N",
+                       help="scenarios at a time, each in its own process (default: one per core; "
+                       "1 runs them one after another in this process)")
+    p_run.add_argument("--index", default=None, help=argparse.SUPPRESS)  # "k/N" in a child's header line
     p_run.set_defaults(func=cmd_run)
 
     p_list = sub.add_parser("list", help="list the scenarios", description="List the scenarios.")
@@ -259,7 +290,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"{PROG}: interrupted; finished scenarios are kept, the unfinished one is discarded",
+        print(f"{PROG}: interrupted; finished scenarios are kept, unfinished ones are discarded",
               file=sys.stderr)
         return 130
 

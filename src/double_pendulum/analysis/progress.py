@@ -6,6 +6,7 @@
   bar becomes plain lines on stderr, one per 10 % of the loop and only for loops that last longer
   than :data:`QUIET_SECONDS`, so a log shows the progress of the long loops in a few lines.
 * :func:`track` wraps an iterable in :func:`progress_bar`.
+* :func:`write_line` prints a line while a bar is shown, without breaking the bar.
 
 ``DOUBLE_PENDULUM_PROGRESS`` overrides the choice: ``bar`` (always a tqdm bar), ``lines`` (always
 plain lines), ``off`` (no progress at all; :func:`step` lines are still printed).
@@ -37,6 +38,13 @@ LINE_EVERY_S = 60.0
 def step(text: str) -> None:
     """Say what the scenario does now: one line on stdout (flushed)."""
     print(f"  - {text}", flush=True)
+
+
+def write_line(text: str, stream: Any = None) -> None:
+    """Print ``text`` on ``stream`` (default stdout) without breaking a tqdm bar shown meanwhile."""
+    stream = sys.stdout if stream is None else stream
+    tqdm.write(text, file=stream)
+    stream.flush()
 
 
 def _in_notebook() -> bool:
