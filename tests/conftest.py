@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import json
+import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -24,6 +27,36 @@ def runner(fmu_path: Path):
     """An fmpy runner for the session's FMU."""
     with FmuRunner(fmu_path) as r:
         yield r
+
+
+@pytest.fixture(scope="session")
+def quick_results(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Every scenario run once in quick mode (``double-pendulum run all --quick``) for the whole session.
+
+    The scenarios' own tests read their results from here instead of running them again. With
+    pytest-xdist the workers share one run: the first worker that needs it runs it under a file lock
+    in the session's common temporary folder, the others wait and read it.
+    """
+    import fcntl
+
+    from double_pendulum.cli import main
+
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base  # one folder per session
+    out, done = shared / "quick_results", shared / "quick_results.done"
+    with open(shared / "quick_results.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.is_file():
+            shutil.rmtree(out, ignore_errors=True)
+            assert main(["run", "all", "--quick", "--fmu", str(fmu_path), "--out", str(out)]) == 0
+            done.write_text("")
+    return out
+
+
+def quick_scenario(results: Path, name: str) -> tuple[Path, dict]:
+    """The folder of scenario ``name`` in :func:`quick_results` and its summary."""
+    folder = results / name
+    return folder, json.loads((folder / "summary.json").read_text())
 
 
 # pythonfmu (<= 0.7.0, upstream issue NTNU-IHB/PythonFMU#228) can corrupt the heap while the

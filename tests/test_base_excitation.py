@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 import pytest
+from conftest import quick_scenario
 
 from double_pendulum.analysis import excitation_study as study
 from double_pendulum.analysis.excitation import (
@@ -109,12 +109,9 @@ def _numbers(value):
         yield value
 
 
-def test_quick_run_through_the_fmu(runner, tmp_path):
-    from double_pendulum.scenarios import base_excitation
-
-    summary = base_excitation.run(runner, tmp_path, quick=True)
-    stored = json.loads((tmp_path / "summary.json").read_text())
-    assert all(v is not None for v in _numbers(stored)), "null in summary.json"
+def test_quick_run_through_the_fmu(quick_results):
+    out, summary = quick_scenario(quick_results, "base_excitation")
+    assert all(v is not None for v in _numbers(summary)), "null in summary.json"
     numeric = {k: v for k, v in summary.items() if isinstance(v, float)}
     assert all(math.isfinite(v) for v in numeric.values())
     assert abs(summary["kapitza_relative_error"]) < 0.05
@@ -122,4 +119,4 @@ def test_quick_run_through_the_fmu(runner, tmp_path):
     assert summary["resonance_max_abs_relative_error"] < 0.05
     for name in ("kapitza_threshold.png", "acheson_map.png", "acheson_examples.png", "resonance_curve.png",
                  "acheson_map.csv", "resonance_curve.csv", "kapitza_bisection.csv", "report.md"):
-        assert (tmp_path / name).is_file(), name
+        assert (out / name).is_file(), name

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 import pytest
+from conftest import quick_scenario
 
 from double_pendulum.analysis import chaos
 from double_pendulum.analysis.ensemble import batch_energy, batch_potential_energy, initial_states, pendulum_field
@@ -185,12 +185,10 @@ def test_poincare_points_lie_on_the_section_and_the_energy_surface():
     np.testing.assert_allclose(batch_energy(pts.T, P), energy, rtol=1e-7)
 
 
-def test_chaos_scenario_writes_results_plots_and_summary(runner, tmp_path):
+def test_chaos_scenario_writes_results_plots_and_summary(quick_results):
     import double_pendulum.scenarios.chaos as scenario
 
-    summary = scenario.run(runner, tmp_path, quick=True)
-    written = json.loads((tmp_path / "summary.json").read_text())
-    assert written["lyapunov_per_s"] == pytest.approx(summary["lyapunov_per_s"])
+    tmp_path, written = quick_scenario(quick_results, "chaos")
     assert written["lyapunov_per_s"] > 0.5
     assert written["flip_map"]["bound_violations"] == 0
     assert written["fmu_vs_batch_dop853_max_angle_difference_rad_first_2s"] < 1e-6

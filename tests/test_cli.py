@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import quick_scenario
 from double_pendulum.scenarios import SCENARIOS
 
 import double_pendulum
@@ -49,15 +50,14 @@ def test_unknown_scenario_is_one_clear_line(capsys):
     assert err.count("\n") == 1 and "unknown scenario 'nope'" in err and "free_swing" in err
 
 
-def test_run_friction_budget_accounts_for_the_loss(fmu_path, tmp_path):
-    assert main(["run", "friction_budget", "--quick", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 0
-    summary = json.loads((tmp_path / "friction_budget" / "summary.json").read_text())
+def test_run_friction_budget_accounts_for_the_loss(quick_results):
+    out, summary = quick_scenario(quick_results, "friction_budget")
     shares = summary["share_of_loss_all_on"]
     assert sum(shares.values()) == pytest.approx(1.0, abs=1e-6)  # every joule accounted for
     assert all(v > 0 for v in shares.values())
     assert all(b < 0 for b in summary["decay_rate_b_per_s"].values())
     for name in ("energy_per_mechanism", "energy_budget_stacked"):
-        assert (tmp_path / "friction_budget" / f"{name}.png").is_file()
+        assert (out / f"{name}.png").is_file()
 
 
 def test_variables_prints_the_table_in_the_fmu_docs(capsys):

@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import quick_scenario
 
 from double_pendulum.analysis.cosimulation import fitted_order, stability_run
 from double_pendulum.analysis.coupling_stability import critical_mass_ratio, oscillator_step, spectral_radius
@@ -78,10 +79,8 @@ def test_fitted_order_ignores_non_finite_and_tiny_errors():
 
 
 @pytest.mark.slow
-def test_quick_scenario_writes_csv_plots_summary_and_report(runner, tmp_path):
-    from double_pendulum.scenarios import cosimulation
-
-    summary = cosimulation.run(runner, tmp_path, quick=True)
+def test_quick_scenario_writes_csv_plots_summary_and_report(quick_results):
+    tmp_path, summary = quick_scenario(quick_results, "cosimulation")
     for name in ("runs.csv", "stability_map.csv", "summary.json", "report.md", "error_vs_macro_step.png",
                  "error_vs_cpu_time.png", "coupling_energy.png", "stability_map.png"):
         assert (tmp_path / name).is_file(), name

@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 import pytest
+from conftest import quick_scenario
 
 from double_pendulum.analysis import loss_identification as li
 from double_pendulum.analysis import measurement as ms
@@ -85,9 +86,9 @@ def test_profile_interval_interpolates_the_crossings():
     assert lo == pytest.approx(2.0 - 0.5 / 3.5) and hi == pytest.approx(4.0 + 0.5 / 3.5)
 
 
-def test_best_model_on_the_real_data_quick(runner):
+def test_best_model_on_the_real_data_quick(quick_results):
     """Quick settings (two models, no profiles): the best model's shares sum to 1 and the claim is stated."""
-    s = li.identify_losses(runner, quick=True, max_workers=1).summary
+    _, s = quick_scenario(quick_results, "loss_identification")
     assert s["best_model"] in li.QUICK_MODELS
     assert sum(s["shares"].values()) == pytest.approx(1.0, abs=1e-12)
     assert all(0.0 <= v <= 1.0 for v in s["shares"].values())

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
-from double_pendulum.scenarios import measured_vs_sim as mv
+from conftest import quick_scenario
 
 from double_pendulum.analysis import track_comparison as tc
 from double_pendulum.analysis.loss_identification import ComponentRunner
@@ -200,9 +198,9 @@ def test_cause_is_model_error_when_the_fit_allows_more_than_twice_the_observed_h
     assert fmt_horizon(None, 2.0) == "> 2.0" and fmt_horizon(0.123, 2.0) == "0.12"
 
 
-def test_quick_run_compares_both_starts_with_the_track(runner, tmp_path):
-    summary = mv.run(runner, tmp_path, quick=True)
-    assert json.loads((tmp_path / "summary.json").read_text())["t0_s"] == pytest.approx(0.8, abs=0.5 / 29.97)
+def test_quick_run_compares_both_starts_with_the_track(quick_results):
+    tmp_path, summary = quick_scenario(quick_results, "measured_vs_sim")
+    assert summary["t0_s"] == pytest.approx(0.8, abs=0.5 / 29.97)
     # the least-squares start follows the first second of the track better than the reconstruction's
     rms = summary["rms_error_first_second_m"]
     assert rms["lsq_start_identified"]["lower_bob"] < rms["seed_start_identified"]["lower_bob"]

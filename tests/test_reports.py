@@ -22,7 +22,6 @@ import pytest
 from double_pendulum.scenarios import SCENARIOS
 from fmpy.util import read_csv
 
-from double_pendulum.cli import main
 from double_pendulum.results_io import read_results_csv, read_table_csv
 
 TABLES = {"stability.csv", "work_precision.csv", "acheson_bands.csv", "acheson_map.csv", "kapitza_bisection.csv",
@@ -38,11 +37,9 @@ EMPTY_CELL = re.compile(r"\|\s*\|")
 
 
 @pytest.fixture(scope="module")
-def quick_out(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """All scenarios run once in quick mode into one folder."""
-    out = tmp_path_factory.mktemp("quick")
-    assert main(["run", "all", "--quick", "--fmu", str(fmu_path), "--out", str(out)]) == 0
-    return out
+def quick_out(quick_results: Path) -> Path:
+    """All scenarios run once in quick mode into one folder (the session's shared run)."""
+    return quick_results
 
 
 def _values(node: Any, path: tuple[str, ...], explained: frozenset[str]) -> Iterator[tuple[tuple[str, ...], Any, bool]]:

@@ -8,14 +8,14 @@ import math
 
 import numpy as np
 import pytest
-from double_pendulum.scenarios import stability
+from conftest import quick_scenario
 
 from double_pendulum.analysis import stability_cases
 from double_pendulum.model.parameters import PendulumParameters
 
 
-def test_every_stability_case_meets_its_criterion(runner, tmp_path):
-    summary = stability.run(runner, tmp_path, quick=True)
+def test_every_stability_case_meets_its_criterion(quick_results):
+    tmp_path, summary = quick_scenario(quick_results, "stability")
     rows = summary["rows"]
     failed = [(r["case"], r["verdict"]) for r in rows if not r["passed"]]
     assert not failed

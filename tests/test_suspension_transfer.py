@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
+from conftest import quick_scenario
 from double_pendulum.scenarios import suspension_transfer as st
 from double_pendulum.scenarios.friction_budget import SEED_RELEASE
 
@@ -85,11 +84,8 @@ def test_stiff_suspension_loss_scales_as_c_over_k_squared_and_follows_linear_res
         assert rate == pytest.approx(spectrum.linear_response_rate(k, c, 2.0), rel=0.1)
 
 
-def test_quick_run_writes_its_files_and_closes_the_energy_budget(runner, tmp_path):
-    summary = st.run(runner, tmp_path, quick=True)
-    assert json.loads((tmp_path / "summary.json").read_text())["identified"]["c_N_s_per_m"] == pytest.approx(
-        summary["identified"]["c_N_s_per_m"]
-    )
+def test_quick_run_writes_its_files_and_closes_the_energy_budget(quick_results):
+    tmp_path, summary = quick_scenario(quick_results, "suspension_transfer")
     table = read_results_csv(tmp_path / "decay_rate_map.csv")
     assert len(table) == len(st.QUICK.k_grid) * len(st.QUICK.c_grid)
     assert np.all(table["b_suspension"] < 0)  # a damper only takes energy

@@ -7,14 +7,14 @@ import math
 
 import numpy as np
 import pytest
-from double_pendulum.scenarios import work_precision
+from conftest import quick_scenario
 
 from double_pendulum.analysis import work_precision as wp
 from double_pendulum.analysis.reference import Reference
 
 
-def test_work_precision_report_on_a_tiny_configuration(runner, tmp_path):
-    summary = work_precision.run(runner, tmp_path, quick=True)
+def test_work_precision_report_on_a_tiny_configuration(quick_results):
+    tmp_path, summary = quick_scenario(quick_results, "work_precision")
     with open(tmp_path / "work_precision.csv") as fh:
         rows = list(csv.DictReader(fh))
     assert len(rows) == summary["configurations"] >= 4
