@@ -120,12 +120,12 @@ def _energy_errors(name: str, t_end: float, window: float, **settings) -> tuple[
     return first, last
 
 
-def test_gauss4_energy_error_stays_bounded_over_1000_s_while_dop853_drifts():
-    first, last = _energy_errors("gauss4", 1000.0, 100.0, rtol=1.0, atol=1.0, fixed_step=0.02)
+def test_gauss4_energy_error_stays_bounded_over_400_s_while_dop853_drifts():
+    first, last = _energy_errors("gauss4", 400.0, 40.0, rtol=1.0, atol=1.0, fixed_step=0.02)
     assert last <= 2.0 * first
     assert last < 1e-8  # J, of E0 = 0.103 J
-    first, last = _energy_errors("dop853", 1000.0, 100.0, rtol=1e-6, atol=1e-9, fixed_step=1.0)
-    assert last > 5.0 * first  # the explicit method's energy error grows about linearly
+    first, last = _energy_errors("dop853", 400.0, 40.0, rtol=1e-6, atol=1e-9, fixed_step=1.0)
+    assert last > 5.0 * first  # the explicit method's energy error grows about linearly (9 times here)
 
 
 def test_gauss_stage_iteration_failure_raises_solver_error():
