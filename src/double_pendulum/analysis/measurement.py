@@ -38,7 +38,6 @@ from typing import NamedTuple
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.signal import savgol_coeffs
 
 from ..data import data_path
 from ..model.energy import kinetic_energy, potential_energy, total_energy
@@ -351,6 +350,8 @@ def savgol_derivative_coefficients(
     window: int = SG_WINDOW, polyorder: int = SG_POLYORDER, dt: float = FRAME_INTERVAL
 ) -> np.ndarray:
     """First-derivative Savitzky-Golay stencil [1/s], ordered from frame i - window//2 to i + window//2."""
+    from scipy.signal import savgol_coeffs  # noqa: PLC0415 - scipy.signal takes a second to import
+
     return savgol_coeffs(window, polyorder, deriv=1, delta=dt, use="dot")
 
 
