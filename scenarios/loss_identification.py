@@ -13,7 +13,13 @@ suspension, and compares them by AIC/BIC with the residuals' correlation account
   ``p_measured_stderr``, ``p_sim``, ``shares`` and the model comparison;
 - ``report.md``.
 
-``quick``: two models, no profile likelihood.
+Default: the one- and two-mechanism models (:data:`~double_pendulum.analysis.loss_identification.FULL_MODELS`)
+and the profile likelihood of the best one, about 100 s of CPU on one worker process per core (the
+worker pool is started once for every fitting round and the profile). ``thorough`` (``--thorough``)
+adds the three-mechanism models air+drag+bearing, air+drag+viscous and air+drag+suspension (about 90 s
+more CPU; in the last runs the first two ended at their parent's optimum and the third above it, so
+they change no figure of the default run). ``quick``: air+drag alone in this process, no comparison,
+no profile likelihood (a smoke run; the fit is the one ``measured_vs_sim`` reads from the cache).
 """
 
 from __future__ import annotations
@@ -29,10 +35,10 @@ from double_pendulum.results_io import table_from_columns, write_json, write_res
 DESCRIPTION = "loss mechanisms of the real pendulum identified from its measured energy (AIC/BIC, shares)"
 
 
-def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
+def run(runner: Any, out_dir: Path, *, quick: bool = False, thorough: bool = False) -> dict:
     """Identify the losses, run the best model through the FMU and write CSV, plots, summary, report."""
     out_dir = Path(out_dir)
-    ident = identify_losses(runner, quick=quick)
+    ident = identify_losses(runner, quick=quick, thorough=thorough)
     s = ident.summary
     table = table_from_columns(t=ident.t, E_measured=ident.e_measured, sigma_E=ident.sigma,
                                E_simulated=ident.e_sim, **ident.works)  # fmt: skip

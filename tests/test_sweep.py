@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
 
 from double_pendulum.analysis import chaos
-from double_pendulum.analysis.sweep import chunk, grid_cases, parallel_map, random_cases, run_sweep
+from double_pendulum.analysis.sweep import chunk, grid_cases, parallel_map, random_cases, run_sweep, worker_pool
 from double_pendulum.fmu.runner import FmuRunError
 
 OPTIONS = {"stop_time": 0.5, "output_interval": 0.05}
@@ -101,3 +103,22 @@ def test_progress_bar_counts_and_estimates(capsys):
     assert "sweep" in shown and "4/4" in shown and "100%" in shown and "run/s" in shown
     parallel_map(abs, [-1, -2], max_workers=1, label="sweep")  # stderr is not a terminal: silent by default
     assert capsys.readouterr().err == ""
+
+
+def test_a_worker_pool_serves_several_maps_with_the_same_processes():
+    """parallel_map(pool=...) runs on the pool's workers (no new processes per call), results in item order."""
+    with worker_pool(2) as pool:
+        assert pool is not None and pool.workers == 2
+        first, used = parallel_map(abs, [], pool=pool)  # nothing to do: no worker needed
+        assert first == [] and used == 1
+        a, used = parallel_map(abs, [-3, -1, -2, -5], pool=pool)
+        assert a == [3, 1, 2, 5] and used == 2
+        pids1, _ = parallel_map(_pid, list(range(6)), pool=pool)
+        pids2, _ = parallel_map(_pid, list(range(6)), pool=pool)
+    assert os.getpid() not in pids1 + pids2 and len(set(pids1) | set(pids2)) <= 2  # the same two workers
+    with worker_pool(1) as none:
+        assert none is None
+
+
+def _pid(_: int) -> int:
+    return os.getpid()

@@ -92,6 +92,8 @@ class Parameter:
     warm_scan: tuple[float, ...] = ()
     """Values tried when the parameter joins a fitted model (:func:`warm_starts`) where its loss is not
     monotonic in it; empty: it joins at :data:`WARM_START_FRACTION` of ``ref``, a negligible loss."""
+    start_from: str = ""
+    """The parameter of a nested mechanism (:attr:`Mechanism.generalises`) whose fitted value it starts at."""
 
 
 @dataclass(frozen=True)
@@ -103,6 +105,9 @@ class Mechanism:
     work: str
     parameters: tuple[Parameter, ...]
     values: Callable[[Sequence[float]], dict[str, Any]]
+    generalises: str = ""
+    """The mechanism this one contains as a special case (``drag2`` with equal torques is ``drag``): a model
+    with it nests the model with that mechanism instead (:func:`contains`)."""
 
 
 def _air(x: Sequence[float]) -> dict[str, Any]:
@@ -143,8 +148,9 @@ MECHANISMS: dict[str, Mechanism] = {
         Mechanism("drag", "bearing drag torque", "W_bearing_drag",
                   (Parameter("tau_b", "N.m", 1e-3, (1e-7, 1.0), "bearing drag torque, both joints"),), _drag),
         Mechanism("drag2", "bearing drag torque", "W_bearing_drag",
-                  (Parameter("tau_b1", "N.m", 1e-3, (1e-7, 1.0), "bearing drag torque, pivot"),
-                   Parameter("tau_b2", "N.m", 1e-3, (1e-7, 1.0), "bearing drag torque, elbow")), _drag2),
+                  (Parameter("tau_b1", "N.m", 1e-3, (1e-7, 1.0), "bearing drag torque, pivot", start_from="tau_b"),
+                   Parameter("tau_b2", "N.m", 1e-3, (1e-7, 1.0), "bearing drag torque, elbow", start_from="tau_b")),
+                  _drag2, generalises="drag"),
         Mechanism("suspension", "damped suspension", "W_suspension",
                   (Parameter("c_suspension", "N.s/m", 20.0, (1e-2, 1e5),
                              f"suspension damping c_x = c_y at k = {SUSPENSION_K:g} N/m, M_s = {SUSPENSION_M:g} kg",
@@ -162,17 +168,36 @@ FULL_MODELS: tuple[str, ...] = (
     "air+bearing",
     "air+viscous",
     "air+suspension",
+)
+"""Models of the default identification: mechanisms joined by '+'."""
+THOROUGH_MODELS: tuple[str, ...] = (
+    *FULL_MODELS,
     "air+drag+bearing",
     "air+drag+viscous",
     "air+drag+suspension",
 )
-"""Models of the full identification: mechanisms joined by '+'."""
-QUICK_MODELS: tuple[str, ...] = ("air+drag", "air+suspension")
-"""Models of the quick identification."""
+"""Models of the thorough identification: the default ones and the three-mechanism models (each the best
+model plus a third loss; in the last default run two of them ended at their parent's optimum and the
+suspension one above it, at about 90 s of CPU together)."""
+QUICK_MODELS: tuple[str, ...] = ("air+drag",)
+"""Models of the quick identification (a smoke run: the best model alone, no comparison)."""
 
 def mechanisms_of(model: str) -> list[Mechanism]:
     """The mechanisms of a model name such as ``"air+drag"``."""
     return [MECHANISMS[name] for name in model.split("+")]
+
+
+def contains(model: str, other: str) -> bool:
+    """True if ``other`` is nested in ``model`` (and not the same): each of its mechanisms is one of
+    ``model``'s or a special case of one (:attr:`Mechanism.generalises`)."""
+    mine = {name for m in mechanisms_of(model) for name in (m.name, m.generalises) if name}
+    return model != other and set(other.split("+")) <= mine and set(other.split("+")) != set(model.split("+"))
+
+
+def model_rank(model: str) -> int:
+    """Fitting round of a model: its mechanisms, a generalising one (``drag2``) counting twice, so every
+    model it contains is fitted in an earlier round and can warm-start it."""
+    return sum(2 if m.generalises else 1 for m in mechanisms_of(model))
 
 
 def parameters_of(model: str) -> list[Parameter]:
@@ -387,13 +412,16 @@ def _fit_loss_model(
     start: Sequence[float] | None,
     max_nfev: int,
 ) -> ModelFit:
-    """:func:`fit_loss_model` without the cache."""
+    """:func:`fit_loss_model` without the cache. Every run books the model's works too, so the run at the
+    optimum (the last accepted one) gives its shares and no run is repeated."""
     params = parameters_of(model)
     fixed = dict(fixed or {})
     ref = np.array([p.ref for p in params])
     theta0 = ref.copy() if start is None else np.asarray(start, dtype=float).copy()
     free = [i for i in range(len(params)) if i not in fixed]
     runs = [0]
+    works = sorted({m.work for m in mechanisms_of(model)})
+    results: dict[bytes, np.ndarray] = {}  # run result by theta, to reuse the one at the optimum
 
     lo = np.array([params[i].bounds[0] for i in free])
     hi = np.array([params[i].bounds[1] for i in free])
@@ -405,20 +433,25 @@ def _fit_loss_model(
             theta[i] = v
         return theta
 
+    def run(theta: np.ndarray) -> np.ndarray:
+        key = theta.tobytes()
+        if key not in results:
+            runs[0] += 1
+            results[key] = problem.simulate(model_values(model, theta), outputs=("E_pendulum", *works))
+        return results[key]
+
     def resid(x: np.ndarray) -> np.ndarray:
-        runs[0] += 1
-        return problem.residuals(model, theta_of(x))
+        return problem.scaled_residuals(np.asarray(run(theta_of(x))["E_pendulum"])[problem.offsets])[0]
 
     x, jac, stop = gauss_newton(resid, theta0[free] / ref[free], max_runs=max_nfev)
     theta = theta_of(x)
-    works = sorted({m.work for m in mechanisms_of(model)})
-    result = problem.simulate(model_values(model, theta), outputs=("E_pendulum", *works))
+    result = run(theta)
     r, kappa = problem.scaled_residuals(np.asarray(result["E_pendulum"])[problem.offsets])
     e_fit = problem.energy + r * problem.sigma  # kappa E_sim on the frames
     extra = {"shares": shares(result, model), "stop": stop, "decay": {
         "b_sim_per_s": fit_model("exponential", problem.t, e_fit, problem.sigma).value("b"),
         "p_sim": decay_shape(problem.t, e_fit, problem.sigma)["p"]}}  # fmt: skip
-    return ModelFit(model, theta, float(r @ r), len(r), jac, r, kappa, runs[0] + 1, extra=extra)
+    return ModelFit(model, theta, float(r @ r), len(r), jac, r, kappa, runs[0], extra=extra)
 
 
 @dataclass(frozen=True)
@@ -428,6 +461,7 @@ class FitItem:
 
     model: str
     starts: tuple[tuple[float, ...], ...] = ()
+    max_nfev: int = 30
 
 
 def fit_item(item: FitItem, problem: FitProblem) -> ModelFit:
@@ -439,7 +473,7 @@ def fit_item(item: FitItem, problem: FitProblem) -> ModelFit:
     elif item.starts:
         chi2 = [float(np.sum(problem.residuals(item.model, s) ** 2)) for s in item.starts]
         start = item.starts[int(np.argmin(chi2))]
-    return fit_loss_model(item.model, problem, start=start)
+    return fit_loss_model(item.model, problem, start=start, max_nfev=item.max_nfev)
 
 
 WARM_START_FRACTION = 1e-3
@@ -455,33 +489,52 @@ def warm_starts(model: str, parent: ModelFit) -> tuple[tuple[float, ...], ...]:
     model then starts no worse than its parent where a negligible loss exists, so its chi2 cannot end
     above the parent's through a poor start."""
     known = dict(zip(parent.names, parent.theta))
-    choices = [(float(known[p.name]),) if p.name in known else (p.warm_scan or (WARM_START_FRACTION * p.ref,))
+    choices = [(float(known[p.name]),) if p.name in known else (float(known[p.start_from]),)
+               if p.start_from in known else (p.warm_scan or (WARM_START_FRACTION * p.ref,))
                for p in parameters_of(model)]  # fmt: skip
     return tuple(itertools.product(*choices))
 
 
-def fit_item_of(model: str, fits: Sequence[ModelFit]) -> FitItem:
-    """The fit item of ``model``: warm-started from the best-fitting (lowest chi2) of ``fits`` whose
-    mechanisms it contains (:func:`warm_starts`), from the references if none."""
-    mine = set(model.split("+"))
-    parents = [f for f in fits if set(f.model.split("+")) < mine]
-    return FitItem(model, warm_starts(model, min(parents, key=lambda f: f.chi2)) if parents else ())
+SHORT_RUN_BUDGET = 12
+"""Gauss-Newton runs (after any warm scan) of a model whose fit cannot change the comparison's figures by
+more than they state: one that generalises its parent's mechanism (``air+drag2`` from ``air+drag``: the
+same optimum plus a flat valley along one extra parameter, its chi2 within ~0.05 of the parent's, so its
+delta AIC is 2.0 to the stated 0.1 however long it runs) and one with a scanned parameter (the suspension:
+in every run so far its chi2 stayed above the nested model's for every scanned c, so it is not ranked).
+Thirty runs of each bought the default run nothing but about 20 s of CPU."""
+
+
+def fit_item_of(model: str, fits: Sequence[ModelFit], *, short: bool = True) -> FitItem:
+    """The fit item of ``model``: warm-started from the best-fitting (lowest chi2) of ``fits`` nested in it
+    (:func:`contains`, :func:`warm_starts`), from the references if none; with :data:`SHORT_RUN_BUDGET`
+    runs if it generalises its parent's mechanism or scans a parameter (``short``; the thorough run: 30)."""
+    parents = [f for f in fits if contains(model, f.model)]
+    if not parents:
+        return FitItem(model)
+    parent = min(parents, key=lambda f: f.chi2)
+    params = parameters_of(model)
+    short = short and (any(p.warm_scan for p in params) or any(p.start_from in parent.names for p in params))
+    return FitItem(model, warm_starts(model, parent), SHORT_RUN_BUDGET if short else 30)
 
 
 def fit_models(
-    models: Sequence[str], problem: FitProblem, max_workers: int | None = None
+    models: Sequence[str], problem: FitProblem, max_workers: int | None = None, pool: Any = None,
+    *, short: bool = True,
 ) -> tuple[list[ModelFit], int]:
-    """Fit every model, in rounds by its number of mechanisms: one-mechanism models from the
-    references, each larger one warm-started from the best-fitting model of an earlier round that it
-    contains (:func:`fit_item_of`); the models of a round are fitted in parallel."""
+    """Fit every model, in rounds by :func:`model_rank`: one-mechanism models from the references, each
+    larger one warm-started from the best-fitting model of an earlier round nested in it
+    (:func:`fit_item_of`); the models of a round are fitted in parallel (on ``pool``'s workers if given,
+    a :func:`~double_pendulum.analysis.sweep.worker_pool`); ``short``: see :func:`fit_item_of`."""
     from .sweep import parallel_map  # noqa: PLC0415 - process pools only when identifying
 
     fits: list[ModelFit] = []
     workers = 1
-    for size in sorted({len(m.split("+")) for m in models}):
-        items = [fit_item_of(m, fits) for m in models if len(m.split("+")) == size]
-        more, workers = parallel_map(fit_item, items, shared=problem, max_workers=max_workers, label="loss models")
+    for rank in sorted({model_rank(m) for m in models}):
+        items = [fit_item_of(m, fits, short=short) for m in models if model_rank(m) == rank]
+        more, used = parallel_map(fit_item, items, shared=problem, max_workers=max_workers, label="loss models",
+                                  pool=pool)  # fmt: skip
         fits += more
+        workers = max(workers, used)
     return fits, workers
 
 
@@ -498,8 +551,7 @@ CONVERGENCE_TOLERANCE = 0.5
 def converged(fit: ModelFit, fits: Sequence[ModelFit]) -> bool:
     """False if a model nested in ``fit``'s (a subset of its mechanisms) reached a lower chi2 by more
     than :data:`CONVERGENCE_TOLERANCE`: the larger model contains that optimum, so its own fit stalled."""
-    mine = set(fit.model.split("+"))
-    nested = [f.chi2 for f in fits if f is not fit and set(f.model.split("+")) < mine]
+    nested = [f.chi2 for f in fits if f is not fit and contains(fit.model, f.model)]
     return not nested or fit.chi2 <= min(nested) + CONVERGENCE_TOLERANCE
 
 
@@ -749,8 +801,13 @@ class LossIdentification:
 
 def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """Does the suspension dominate the loss? From the suspension's share in every model that has it
-    and the best model's composition (a plain sentence and the numbers)."""
+    and the best model's composition (a plain sentence and the numbers); not asked (``None``) when no
+    fitted model has a suspension (the quick run)."""
     label = MECHANISMS["suspension"].label
+    if not any("suspension" in r["model"].split("+") for r in rows):
+        return {"suspension_dominates": None, "suspension_share_by_model": {},
+                "answer": "Not tested: no model with a suspension was fitted in this run (quick mode fits "
+                          "air+drag alone); the default run fits air+suspension."}  # fmt: skip
     with_susp = {r["model"]: r["shares"].get(label) for r in rows if label in r["shares"] and r["converged"]}
     best = rows[0]
     dominates = bool(label in best["shares"] and best["shares"][label] > 0.5)
@@ -803,27 +860,33 @@ def goal_checks(numbers: Mapping[str, float], halves: Mapping[str, Any]) -> dict
     return checks
 
 
-def identify_losses(runner: Any, *, quick: bool = False, max_workers: int | None = None) -> LossIdentification:
-    """Fit every model (:data:`FULL_MODELS`, quick: :data:`QUICK_MODELS`) in parallel with the in-process
-    component, compare them, profile the best one (not in quick mode) and re-run it through ``runner``
-    (the FMU) for the headline numbers. Both modes fit the whole record (the first 8 s alone leave the losses
-    unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim`` fits the same
-    ``air+drag`` from the same start, so it reads the quick mode's fit."""
-    from .sweep import parallel_map  # noqa: PLC0415 - process pools only when identifying
+def identify_losses(
+    runner: Any, *, quick: bool = False, thorough: bool = False, max_workers: int | None = None
+) -> LossIdentification:
+    """Fit every model (:data:`FULL_MODELS`; thorough: :data:`THOROUGH_MODELS`; quick: :data:`QUICK_MODELS`,
+    in this process) in parallel with the in-process component, compare them, profile the best one (not in
+    quick mode) and re-run it through ``runner`` (the FMU) for the headline numbers. One pool of worker
+    processes serves every round and the profile. All modes fit the whole record (the first 8 s alone
+    leave the losses unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim``
+    fits the same ``air+drag`` from the same start, so it reads the quick mode's fit."""
+    from .sweep import parallel_map, worker_pool  # noqa: PLC0415 - process pools only when identifying
 
     rec = seed_reconstruction()
     md = measured(rec)
     problem = problem_from_track(rec, md)
-    models = QUICK_MODELS if quick else FULL_MODELS
-    fits, workers = fit_models(models, problem, max_workers)
-    factor = common_factor(fits)
-    rows = comparison_rows(fits, factor)
-    best = next(f for f in fits if f.model == rows[0]["model"])
+    models = QUICK_MODELS if quick else THOROUGH_MODELS if thorough else FULL_MODELS
     profile: dict[str, Any] = {}
-    if not quick:
-        items = profile_items(best, factor)
-        chi2s, _ = parallel_map(profile_item, items, shared=problem, max_workers=max_workers, label="profile")
-        profile = profile_summary(best, factor, items, chi2s)
+    max_workers = 1 if quick else max_workers  # one model: no worker processes to start
+    with worker_pool(max_workers) as pool:
+        fits, workers = fit_models(models, problem, max_workers, pool, short=not thorough)
+        factor = common_factor(fits)
+        rows = comparison_rows(fits, factor)
+        best = next(f for f in fits if f.model == rows[0]["model"])
+        if not quick:
+            items = profile_items(best, factor)
+            chi2s, _ = parallel_map(profile_item, items, shared=problem, max_workers=max_workers, label="profile",
+                                    pool=pool)  # fmt: skip
+            profile = profile_summary(best, factor, items, chi2s)
     works = sorted({m.work for m in mechanisms_of(best.model)})
     result = problem.simulate(model_values(best.model, best.theta), outputs=("E_pendulum", *works), runner=runner)
     e_sim = np.asarray(result["E_pendulum"])[problem.offsets]
@@ -839,6 +902,8 @@ def identify_losses(runner: Any, *, quick: bool = False, max_workers: int | None
         "record_s": float(problem.t[-1] - problem.t[0]),
         "n_frames": len(problem.t),
         "quick": quick,
+        "thorough": thorough,
+        "models_fitted": list(models),
         "workers": workers,
         "best_model": best.model,
         **numbers,
@@ -859,6 +924,7 @@ def identify_losses(runner: Any, *, quick: bool = False, max_workers: int | None
         "models": rows,
         "suspension_fixed": {"k_N_per_m": SUSPENSION_K, "M_s_kg": SUSPENSION_M},
         "omega_reg_rad_per_s": OMEGA_REG,
+        "null_means": {"suspension_dominates": "not tested: no model with a suspension was fitted (quick mode)"},
         "start_state": {k: problem.base[k] for k in ("phi1_0", "phi2_0", "omega1_0", "omega2_0")},
     }
     t = problem.t
