@@ -11,7 +11,9 @@ on; b is fitted to E_pendulum (the bobs, what the camera sees) on the measured f
 Steps: identify c at the default k and M_s from the measured energy, with its valley in
 (k, c, M_s) and the decay shape p of dE/dt = -k E^p
 (:mod:`~double_pendulum.analysis.suspension_identification`); sweep b over (k, c) at a few M_s and
-check the map against the linear response to the fixed-pivot force spectrum
+check the map against the linear response to the fixed-pivot force spectrum (the default run maps
+M_s = 2 kg, the identified mass; ``--thorough`` adds coarser maps at 0.5 and 8 kg and the fits on the
+first 7 and 14 s)
 (:mod:`~double_pendulum.analysis.decay_map`, :mod:`~double_pendulum.analysis.suspension_response`);
 run the identified suspension (and the resonant one on the same iso-b curve) again and follow the
 energy into the suspension (:mod:`~double_pendulum.analysis.energy_flow`). Summary entries, tables
@@ -32,7 +34,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -105,13 +107,17 @@ FULL = Plan(
     k_grid=_k_grid(range(-3, 6)),
     c_grid=tuple(float(c) for c in np.geomspace(1.0, 3000.0, 9)),
     m_s_main=DEFAULT_SUSPENSION.M_s,
-    m_s_extra=(0.5, 8.0),
+    m_s_extra=(),
     extra_stride=2,
     window_s=None,
     valley_k_factors=(1.25, 1.5),
-    window_checks_s=(7.0, 14.0),
+    window_checks_s=(),
     max_workers=None,
 )
+THOROUGH = replace(FULL, m_s_extra=(0.5, 8.0), window_checks_s=(7.0, 14.0))
+"""``--thorough``: the main map and coarser ones (every second k and c) at M_s = 0.5 and 8 kg (50 more runs,
+the stiffest cells of the light suspension among them: about twice the map's CPU time), and c identified
+again on the first 7 and 14 s of the record (two more sequential fits)."""
 QUICK = Plan(
     k_grid=_k_grid((0, 3)),
     c_grid=(5.0, 200.0),
@@ -146,11 +152,12 @@ TASK_COST = {"trace": 12.0, "window": 6.0, "fisher": 3.0, "frames": 1.5, "flow":
 """Rough CPU seconds per task (to start the long ones first)."""
 
 
-def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
-    """Identify, sweep, check, write CSVs, plots, summary and report (see the module docstring)."""
+def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool = False) -> dict:
+    """Identify, sweep, check, write CSVs, plots, summary and report (see the module docstring);
+    ``thorough``: the maps at the other suspension masses too (:data:`THOROUGH`)."""
     wall0 = time.perf_counter()
     out_dir = Path(out_dir)
-    plan = QUICK if quick else FULL
+    plan = QUICK if quick else THOROUGH if thorough else FULL
 
     # identification of c at the default k, M_s; the map b(k, c); c refitted along its valley
     step("fitting the release state and the damping c to the measured energy (sequential FMU runs)")
@@ -197,6 +204,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     summary: dict[str, Any] = {
         "scenario": "suspension_transfer",
         "quick": quick,
+        "thorough": thorough,
         "energy_fitted": "E_pendulum (the bobs' energy, what the camera measures)",
         "settings": {"map": MAP_SETTINGS, "fits": FIT_SETTINGS, "losses": LOSSES},
         "measured": study.measured_summary(md, SEED_B),

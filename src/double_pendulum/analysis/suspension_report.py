@@ -88,6 +88,7 @@ b of E_pendulum and of E_total differ by at most {main["max_abs_b_E_pendulum_min
 | M_s [kg] | grid | b without suspension [1/s] | stiffest k reaching the measured b [N/m] | iso-b points (measured b) |
 |---|---|---|---|---|
 {chr(10).join(lines)}
+{_other_masses_text(s)}
 
 **The suspensions that explain the measured b form a curve, not a point.** The suspension has to add
 {needed:.4f} 1/s. {_branches_text(s)}
@@ -122,6 +123,16 @@ that largest loss:
 Where it does not, the lightly damped end wiggles: the resonant loss depends on the chaotic
 trajectory's spectrum near omega_n, which changes from run to run.
 """
+
+
+def _other_masses_text(s: Mapping[str, Any]) -> str:
+    """Where the maps at other suspension masses are: here, or with ``--thorough``."""
+    if len(s["maps"]) > 1:
+        return "\nThe other masses are mapped on every second k and c of the main grid."
+    if s.get("quick"):
+        return ""
+    return ("\nThe default run maps the identified mass only; ``--thorough`` adds coarser maps at M_s = 0.5 and "
+            "8 kg (50 runs, about twice the map's CPU time).")
 
 
 def _branches_text(s: Mapping[str, Any]) -> str:
@@ -267,7 +278,7 @@ errors (measured: b = {m["b_per_s"]:.5f} +- {m["b_per_s_stderr_autocorr"]:.5f} 1
 |---|---|---|---|---|---|---|
 {rows}
 
-The same fit on the first seconds only (same start, same k, M_s; full run only):
+The same fit on the first 7 and 14 s only (same start, same k, M_s; run with ``--thorough``):
 
 | frames | measured b [1/s] | c [N s/m] | refit b [1/s] | vs measured |
 |---|---|---|---|---|
