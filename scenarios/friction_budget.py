@@ -18,7 +18,6 @@ within a tenth of their standard error of those fitted to outputs every 10 ms (t
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +25,7 @@ import numpy as np
 from double_pendulum import plots
 from double_pendulum.analysis.decay_fit import fit_model
 from double_pendulum.analysis.progress import step
-from double_pendulum.analysis.sweep import runner_map
+from double_pendulum.analysis.sweep import runner_map, timed_simulate
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv
 
@@ -63,14 +62,6 @@ def _decay_rate(result: np.ndarray) -> dict[str, float]:
     }
 
 
-def _timed_run(runner: FmuRunner, item: tuple[dict, float]) -> tuple[np.ndarray, float]:
-    """Worker: one run with the mechanisms ``switches`` on, and its CPU time [s]."""
-    switches, stop_time = item
-    t0 = time.process_time()
-    r = runner.simulate({**SEED_RELEASE, **SETTINGS, **switches}, stop_time=stop_time, output_interval=OUTPUT_INTERVAL)
-    return r, time.process_time() - t0
-
-
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     """Run every mechanism alone and all together; write CSVs, plots and the summary."""
     stop_time = 5.0 if quick else STOP_TIME
@@ -84,8 +75,9 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
         "runs": {},
     }
     step(f"{len(RUNS)} runs of {stop_time:g} s through fmpy on parallel processes")
-    timed = runner_map(_timed_run, [(switches, stop_time) for switches in RUNS.values()], runner,
-                       max_workers=1 if quick else None, label="friction_budget runs",
+    options = {"stop_time": stop_time, "output_interval": OUTPUT_INTERVAL}
+    items = [({**SEED_RELEASE, **SETTINGS, **switches}, options) for switches in RUNS.values()]
+    timed = runner_map(timed_simulate, items, runner, max_workers=1 if quick else None, label="friction_budget runs",
                        costs=[len(s) + 1.0 for s in RUNS.values()])
     for (label, switches), (r, cpu) in zip(RUNS.items(), timed):
         write_results_csv(out_dir / f"{label}.csv", r, runner.units)
