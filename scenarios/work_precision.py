@@ -3,21 +3,23 @@
 For each case (a regular start over 30 s, a chaotic start over 3 s -- before the reference itself
 diverges --, and a stiff light suspension over 2 s) and each solver, a sweep of tolerances
 (adaptive methods) or step sizes (fixed-step methods) runs **through fmpy** at a 10 ms
-communication step, and one mid setting per solver also at 1 ms and 100 ms. Recorded per run:
+communication step, and one mid setting per solver also at 100 ms. Recorded per run:
 final-horizon error and maximum error over the horizon (max over phi1, phi2, omega1, omega2
 against the cached reference, :mod:`double_pendulum.analysis.reference`; the cases, errors and
 the choice per band are in :mod:`double_pendulum.analysis.work_precision`), energy drift (frictionless: max
 |E_total - E0| / E0; with dissipation: max |energy_residual| / E0), RHS evaluations and steps
-(FMU outputs), CPU time (process time of the run; the median of 1-5 repeats: runs are repeated while
-they took under 0.5 s CPU in all, so cheap runs, whose timing decides close races, are timed several
+(FMU outputs), CPU time (process time of the run; the median of 1-3 repeats: runs are repeated while
+they took under 0.25 s CPU in all, so cheap runs, whose timing decides close races, are timed several
 times and expensive ones once). Failed or unstable configurations are kept in the table with their
 status and message.
 
 Cost: the configurations and the three references (cached, see
-:mod:`double_pendulum.analysis.reference`) run on parallel worker processes, one per core, about
-2 minutes CPU in all without cached references. ``thorough=True`` (``--thorough``) adds Rodas4 at
-rtol 1e-12 (40 s CPU on the stiff case alone; it wins no band) and times every configuration at
-least 3 times.
+:mod:`double_pendulum.analysis.reference`; their error floor from SciPy's DOP853 at rtol 1e-13, about
+15 s CPU for all three) run on parallel worker processes, one per core, about 70 s CPU in all on a first
+run. ``thorough=True`` (``--thorough``, about three times the CPU time) adds the settings that cost most
+and win no band -- Rodas4 at rtol 1e-10 and 1e-12 (40 s CPU on the stiff case alone), Dopri5 at rtol
+1e-12, Euler at h = 2e-5 s, the 1 ms communication step --, cross-checks the references with SciPy's
+Radau at rtol 1e-12 (80 s CPU) and times every configuration at least 3 times.
 
 Outputs: ``work_precision.csv``, one log-log plot per case (max error against CPU time, one line
 per method), ``report.md`` naming the fastest method per accuracy band and case.
@@ -25,88 +27,36 @@ per method), ``report.md`` naming the fastest method per accuracy band and case.
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from double_pendulum import plots
 from double_pendulum.analysis.progress import step
-from double_pendulum.analysis.reference import STATE_OUTPUTS, Reference, cached_reference, reference_solution
+from double_pendulum.analysis.reference import CROSS_CHECK, THOROUGH_CROSS_CHECK, Reference, cached_reference
 from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.analysis.work_precision import (
     BASE_COMM_STEP,
     CASES,
     COMM_STEPS,
+    OUTPUTS,
+    THOROUGH_COMM_STEPS,
     THOROUGH_TIMING,
     TIMING,
-    Case,
-    Timing,
+    Config,
     accuracy_columns,
     best_per_band,
-    failure_columns,
     report,
+    run_config,
+    run_task,
     settings_for,
-    timing_columns,
 )
-from double_pendulum.fmu.runner import FmuRunError, FmuRunner
+from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_table_csv, write_text
 from double_pendulum.solvers import METHODS
 
+__all__ = ["DESCRIPTION", "OUTPUTS", "Config", "configurations", "run", "run_config"]
+
 DESCRIPTION = "error against CPU time for every solver, tolerance and communication step (through fmpy)"
-
-OUTPUTS = (*STATE_OUTPUTS, "E_total", "energy_residual", "solver_rhs_evaluations", "solver_steps")
-"""The outputs a configuration needs for its errors, drift and counts."""
-
-
-@dataclass(frozen=True)
-class Config:
-    """One run of the table: a case, a solver with its setting, a communication step, a horizon."""
-
-    case: Case
-    solver: str
-    setting: dict[str, float]
-    comm: float
-    horizon: float
-    timing: Timing
-
-    def cost(self) -> float:
-        """A rough estimate of the run's CPU time (to start the expensive runs first)."""
-        per_step = self.setting.get("fixed_step") or self.setting.get("rtol", 1e-8) ** (1 / 5) * 0.05
-        implicit = 8.0 if self.solver in ("rodas4", "gauss4", "gauss2") else 1.0
-        stiff = 20.0 if self.case.dissipative else 1.0
-        return self.horizon * (implicit * stiff / per_step + 1.0 / self.comm)
-
-
-def run_config(runner: FmuRunner, config: Config) -> tuple[dict[str, Any], np.ndarray | None]:
-    """Run one configuration (repeated as its :class:`Timing` says); its row (no errors yet) and result."""
-    case = config.case
-    start = {**case.start, "solver": config.solver, **config.setting}
-    row: dict[str, Any] = {"case": case.name, "solver": config.solver, **config.setting,
-                           "comm_step_s": config.comm, "horizon_s": config.horizon}
-    cpu: list[float] = []
-    result = None
-    try:
-        while config.timing.more(cpu):
-            t0 = time.process_time()
-            result = runner.simulate(start, stop_time=config.horizon, output_interval=config.comm, outputs=OUTPUTS)
-            cpu.append(time.process_time() - t0)
-        row["status"] = "ok"
-    except FmuRunError as error:
-        return {**row, **failure_columns(error)}, None
-    return {**row, **timing_columns(cpu)}, result
-
-
-def _task(runner: FmuRunner, task: tuple[str, Any]) -> Any:
-    """Worker: a reference (``("reference", (case, horizon))``) or a configuration (``("config", Config)``)."""
-    kind, item = task
-    if kind == "reference":
-        case, horizon = item
-        return reference_solution(case.start, horizon, BASE_COMM_STEP)
-    return run_config(runner, item)
-
 
 def configurations(quick: bool, thorough: bool) -> list[Config]:
     """Every configuration of the sweep, case by case, solver by solver."""
@@ -121,7 +71,7 @@ def configurations(quick: bool, thorough: bool) -> list[Config]:
             if not quick:  # communication-step sweep at the middle setting
                 mid = sweep[len(sweep) // 2]
                 out += [Config(case, solver, mid, comm, horizon, timing)
-                        for comm in COMM_STEPS if comm != BASE_COMM_STEP]
+                        for comm in (THOROUGH_COMM_STEPS if thorough else COMM_STEPS) if comm != BASE_COMM_STEP]
     return out
 
 
@@ -132,12 +82,13 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     refs: dict[str, Reference] = {}
     tasks: list[tuple[str, Any]] = []
     costs: list[float] = []
+    cross_check = THOROUGH_CROSS_CHECK if thorough else CROSS_CHECK
     for name, (case, horizon) in horizons.items():
-        cached = cached_reference(case.start, horizon, BASE_COMM_STEP)
+        cached = cached_reference(case.start, horizon, BASE_COMM_STEP, cross_check=cross_check)
         if cached is not None:
             refs[name] = cached
         else:
-            tasks.append(("reference", (case, horizon)))
+            tasks.append(("reference", (case, horizon, cross_check)))
             costs.append(1e9)  # the references are the longest tasks: start them first
     missing = [t[1][0].name for t in tasks]
     step(f"{len(configs)} configurations through fmpy" + (
@@ -145,7 +96,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         " (references cached)"))
     tasks += [("config", c) for c in configs]
     costs += [c.cost() for c in configs]
-    results = runner_map(_task, tasks, runner, max_workers=1 if quick else None, costs=costs,
+    results = runner_map(run_task, tasks, runner, max_workers=1 if quick else None, costs=costs,
                          label="work_precision", unit="run")
     for (kind, item), value in zip(tasks, results):
         if kind == "reference":
@@ -169,6 +120,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     summary = {"scenario": "work_precision", "quick": quick, "thorough": thorough,
                "reference_error_floor": floors, "best_per_band": best, "configurations": len(rows),
                "failed_or_unstable": sum(r["status"] != "ok" for r in rows),
-               "cpu_timing": timing.describe()}
+               "cpu_timing": timing.describe(),
+               "reference_cross_check": f"SciPy {cross_check['method']} rtol {cross_check['rtol']:g}"}
     write_json(out_dir / "summary.json", summary)
     return summary

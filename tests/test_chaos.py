@@ -153,10 +153,17 @@ def test_energetic_bound_on_flipping_is_respected_by_every_trajectory():
     assert np.all(rods == 0) and np.all(np.isnan(times))
 
 
-def test_flip_times_are_mirror_symmetric():
-    """(phi1, phi2) -> (-phi1, -phi2) mirrors the motion: the same flip time."""
-    fmap = chaos.flip_time_map(20, 20, P, t_max=3.0, max_workers=1)
-    np.testing.assert_allclose(fmap.time, fmap.time[::-1, ::-1], rtol=1e-9, equal_nan=True)
+def test_flip_times_are_mirror_symmetric_and_the_mirrored_map_is_the_integrated_one_bit_for_bit():
+    """(phi1, phi2) -> (-phi1, -phi2) mirrors the motion: the same flip time. Integrated over the whole grid
+    (``mirror=False``) the map is symmetric to rounding, so mirroring half of it gives the same map."""
+    for n1, n2 in ((20, 20), (15, 21)):  # even and odd rows (the middle row of an odd grid is integrated)
+        full = chaos.flip_time_map(n1, n2, P, t_max=3.0, max_workers=1, mirror=False)
+        np.testing.assert_allclose(full.time, full.time[::-1, ::-1], rtol=1e-12, equal_nan=True)
+        np.testing.assert_array_equal(full.rod, full.rod[::-1, ::-1])
+        assert np.any(np.isfinite(full.time)) and np.any(np.isnan(full.time))  # both outcomes on the grid
+        half = chaos.flip_time_map(n1, n2, P, t_max=3.0, max_workers=1)
+        np.testing.assert_allclose(half.time, full.time, rtol=1e-12, equal_nan=True)
+        np.testing.assert_array_equal(half.rod, full.rod)
 
 
 def test_predictability_horizon_grows_by_one_over_lambda_per_e_fold_of_precision(chaotic_estimates):

@@ -25,6 +25,7 @@ def test_every_stability_case_meets_its_criterion(quick_results):
     for r in loud:
         assert r["status"] == "failed"
         assert "non-finite" in r["message"] or "more than" in r["message"] or "instability" in r["message"]
+        assert r["cpu_time_s"] < 1.0  # and quickly: the blow-up or the step budget trips within the first doSteps
     # and the stiff solver passes the same stiff suspension
     stiff = next(r for r in rows if r["case"].startswith("stiff suspension k=1e8") and r["solver"] == "rodas4")
     assert stiff["status"] == "finished" and stiff["max_rel_energy_residual"] < 1e-6
@@ -102,6 +103,10 @@ def test_judge_applies_each_criterion():
 def test_expected_failures_are_explicit_solvers_and_every_case_has_its_own_name():
     table = stability_cases.cases()
     assert len({c.name for c in table}) == len(table)
+    # the stiff suspension cases (the costly ones: Rodas4 resolves the suspension mode) stay short
+    stiff = [c for c in table if c.start.get("suspension")]
+    assert len(stiff) == 7 and all(c.stop_time <= stability_cases.STIFF_STOP for c in stiff)
+    assert all(stability_cases.run_length(c, quick=True) == stability_cases.QUICK_STIFF_STOP for c in stiff)
     assert {c.start["solver"] for c in table if c.expect_failure} <= {"rk4", "dop853"}
 
 

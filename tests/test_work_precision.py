@@ -45,7 +45,8 @@ def test_settings_sweep_tolerances_of_adaptive_and_steps_of_fixed_step_methods()
     adaptive = wp.settings_for("dop853", quick=True)
     assert [s["rtol"] for s in adaptive] == [1e-5, 1e-8]
     assert [s["atol"] for s in adaptive] == pytest.approx([1e-7, 1e-10], rel=1e-12)  # atol = rtol / 100
-    assert [s["fixed_step"] for s in wp.settings_for("euler", quick=False)] == [1e-3, 1e-4, 2e-5]  # first order
+    assert [s["fixed_step"] for s in wp.settings_for("euler", quick=False)] == [1e-3, 1e-4]  # first order
+    assert [s["fixed_step"] for s in wp.settings_for("euler", quick=False, thorough=True)] == [1e-3, 1e-4, 2e-5]
     assert [s["fixed_step"] for s in wp.settings_for("rk4", quick=False)] == [2e-2, 1e-2, 5e-3, 2e-3, 1e-3]
 
 
@@ -83,8 +84,24 @@ def test_cheap_runs_are_timed_several_times_and_expensive_ones_once():
     assert timing.more([0.1, 0.1]) and not timing.more([0.1] * 5)  # cheap: up to 5 times
     assert not timing.more([0.2, 0.2, 0.2])  # until 0.5 s CPU in all
     assert wp.THOROUGH_TIMING.more([5.0, 5.0])  # thorough: at least 3 repeats
-    assert [s["rtol"] for s in wp.settings_for("rodas4", quick=False)][-1] == 1e-10
+    assert [s["rtol"] for s in wp.settings_for("rodas4", quick=False)][-1] == 1e-8
     assert [s["rtol"] for s in wp.settings_for("rodas4", quick=False, thorough=True)][-1] == 1e-12
+    assert [s["rtol"] for s in wp.settings_for("dopri5", quick=False)][-1] == 1e-10
+    assert [s["rtol"] for s in wp.settings_for("dop853", quick=False)][-1] == 1e-12  # the default solver: all
+    assert 1e-3 in wp.THOROUGH_COMM_STEPS and 1e-3 not in wp.COMM_STEPS
+
+
+def test_the_cross_check_reference_floor_resolves_the_errors_the_bands_report(tmp_path):
+    """SciPy's DOP853 cross-check: the chaotic case's floor lies far below the 1e-6 band it ranks, and the
+    cheap check is keyed apart from the Radau one (--thorough)."""
+    from double_pendulum.analysis import reference
+
+    case = wp.CASES[1]
+    ref = reference.reference_solution(case.start, 0.5, wp.BASE_COMM_STEP, cache_dir=tmp_path)
+    assert 0.0 < ref.error_floor < 1e-9
+    assert reference.cached_reference(case.start, 0.5, wp.BASE_COMM_STEP, cache_dir=tmp_path) is not None
+    assert reference.cached_reference(case.start, 0.5, wp.BASE_COMM_STEP, cache_dir=tmp_path,
+                                      cross_check=reference.THOROUGH_CROSS_CHECK) is None
 
 
 def test_best_per_band_takes_the_fastest_run_within_each_bound_above_the_floor():

@@ -306,6 +306,17 @@ def runner_map(
     return out
 
 
+def timed_simulate(runner: FmuRunner, item: tuple[Mapping[str, Any], Mapping[str, Any]]) -> tuple[np.ndarray, float]:
+    """Worker for :func:`runner_map`: ``runner.simulate(start_values, **options)`` for ``item = (start_values,
+    options)``, and the run's CPU time [s] (this process's)."""
+    import time
+
+    start_values, options = item
+    t0 = time.process_time()
+    result = runner.simulate(dict(start_values), **options)
+    return result, time.process_time() - t0
+
+
 def run_sweep(
     fmu_path: str | Path,
     cases: Sequence[Mapping[str, Any]],

@@ -134,8 +134,13 @@ def write_container(
     dest: str | Path, pendulum_fmu: str | Path, suspension_fmu: str | Path, values: Mapping[str, Any] | None = None,
     *, macro_step: float = 1e-3, stop_time: float = 10.0, pendulum_outputs: Sequence[str] = PENDULUM_OUTPUTS,
     suspension_outputs: Sequence[str] = SUSPENSION_OUTPUTS, parallel: bool = False,
+    compression: int = zipfile.ZIP_DEFLATED,
 ) -> Path:
-    """Write the container FMU at ``dest`` (FMI 2.0 co-simulation, fixed macro step ``macro_step`` [s])."""
+    """Write the container FMU at ``dest`` (FMI 2.0 co-simulation, fixed macro step ``macro_step`` [s]).
+
+    ``compression`` is the zip method of the archive: ``zipfile.ZIP_STORED`` writes a container meant to be
+    run once and removed about twice as fast (compressing the two bundled FMUs takes ~0.3 s).
+    """
     from fmpy.container_fmu import write_configuration
     from fmpy.model_description import write_model_description
 
@@ -162,7 +167,7 @@ def write_container(
             (root / "binaries" / fmi2_platform).mkdir(parents=True, exist_ok=True)
             shutil.copyfile(binaries / platform_tuple / library, root / "binaries" / fmi2_platform / library)
         tmp_fmu = dest.with_suffix(".fmu.tmp")
-        with zipfile.ZipFile(tmp_fmu, "w", zipfile.ZIP_DEFLATED) as archive:
+        with zipfile.ZipFile(tmp_fmu, "w", compression) as archive:
             for path in sorted(root.rglob("*")):
                 if path.is_file():
                     archive.write(path, path.relative_to(root).as_posix())
