@@ -9,9 +9,10 @@ container FMU failed to load their FMUs in a process that had already run the py
 
 The children's lines reach the terminal as they come, each marked with its scenario's name; their
 progress counters are plain lines (``DOUBLE_PENDULUM_PROGRESS=lines``: two tqdm bars would
-overwrite each other), while the parent shows one bar over the scenarios. The longest scenarios
-start first (:data:`double_pendulum.scenarios.EXPECTED_CPU_S`), so the run does not end on a long
-scenario started last.
+overwrite each other), while the parent shows one bar over the scenarios, each weighted by its
+expected CPU time (:data:`double_pendulum.scenarios.EXPECTED_CPU_S`), so that its rate and time
+left mean something. The longest scenarios start first, so the run does not end on a long scenario
+started last.
 """
 
 from __future__ import annotations
@@ -140,7 +141,9 @@ def run_in_children(
     number = {name: f"{names.index(name) + 1}/{len(names)}" for name in names}
     lock = threading.Lock()
     waiting, running, failed = list(order), [], []
-    with progress_bar(len(names), "scenarios", unit="scenario") as bar:
+    weight = {name: max(1, round(EXPECTED_CPU_S.get(name, 1.0))) for name in names}
+    label = f"{len(names)} scenarios, progress in expected CPU seconds"
+    with progress_bar(sum(weight.values()), label, unit="CPU s") as bar:
         try:
             while waiting or running:
                 while waiting and len(running) < jobs:
@@ -156,7 +159,7 @@ def run_in_children(
                         if code not in (1, 2):  # the child's own line says why for 1 and 2
                             with lock:
                                 write_line(f"{child.name}: FAILED: its process ended with code {code}", sys.stderr)
-                    bar.update(1)
+                    bar.update(weight[child.name])
         except KeyboardInterrupt:
             _stop(running)
             raise
