@@ -191,3 +191,30 @@ def test_gauss_newton_says_why_it_stopped():
     x, _, stop = li.gauss_newton(residuals, np.array([1.0, 1.0]))
     assert stop == "converged" and x == pytest.approx([3.0, -1.0], abs=1e-4)
     assert li.gauss_newton(residuals, np.array([1.0, 1.0]), max_runs=2)[2] == "run limit"
+
+
+@pytest.mark.parametrize("quick", [False, True])
+def test_identified_fit_fits_a_model_as_the_identification_of_its_mode_does(monkeypatch, quick):
+    """``measured_vs_sim`` takes its losses from :func:`li.identified_fit`: the fit items (model, start, run
+    budget) it fits must be the identification's own, so the cached fits of one scenario serve the other."""
+    items: list[li.FitItem] = []
+
+    def fake_fit_item(item: li.FitItem, problem: object) -> li.ModelFit:
+        items.append(item)
+        theta = np.array(item.starts[0] if item.starts else [p.ref for p in li.parameters_of(item.model)])
+        chi2 = 1000.0 / (1 + len(item.model)) + 7.0 * len(items)  # differing chi2: the parent choice matters
+        return li.ModelFit(item.model, 1.1 * theta, chi2, 100, np.zeros((100, len(theta))), np.zeros(100), 1.0, 1)
+
+    monkeypatch.setattr(li, "fit_item", fake_fit_item)
+    models = li.QUICK_MODELS if quick else li.FULL_MODELS
+    problem = object()  # never simulated: the fake fits only record their items
+    li.fit_models(models, problem, max_workers=1)  # the identification's rounds (identify_losses, short=True)
+    identification = {i.model: i for i in items}
+    items.clear()
+    fit = li.identified_fit("air+drag", problem, quick=quick)
+    assert fit.model == "air+drag"
+    assert {i.model for i in items} == ({"air+drag"} if quick else {"air", "drag", "air+drag"})
+    assert items[-1] == identification["air+drag"]
+    assert bool(items[-1].starts) != quick  # default: warm-started from a one-mechanism fit; quick: references
+    with pytest.raises(ValueError):
+        li.identified_fit("air+drag+bearing", problem)

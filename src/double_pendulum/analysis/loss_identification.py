@@ -538,6 +538,19 @@ def fit_models(
     return fits, workers
 
 
+def identified_fit(model: str, problem: FitProblem, *, quick: bool = False) -> ModelFit:
+    """The fit of ``model`` (one of :data:`FULL_MODELS`; quick: :data:`QUICK_MODELS`) exactly as
+    :func:`identify_losses` obtains it in that mode, in this process: the same rounds (:func:`fit_models`)
+    restricted to ``model`` and the default models nested in it, so its item (start, run budget) is the
+    identification's and :func:`fit_loss_model`'s cache serves either run with the other's fits."""
+    models = QUICK_MODELS if quick else FULL_MODELS
+    if model not in models:
+        raise ValueError(f"{model!r} is not fitted by the {'quick' if quick else 'default'} identification {models}")
+    needed = [m for m in models if m == model or contains(model, m)]
+    fits, _ = fit_models(needed, problem, max_workers=1)
+    return next(f for f in fits if f.model == model)
+
+
 def common_factor(fits: Sequence[ModelFit]) -> float:
     """Residual-correlation factor F of the best-fitting model (lowest chi2), used for all."""
     best = min(fits, key=lambda f: f.chi2)
@@ -868,7 +881,8 @@ def identify_losses(
     quick mode) and re-run it through ``runner`` (the FMU) for the headline numbers. One pool of worker
     processes serves every round and the profile. All modes fit the whole record (the first 8 s alone
     leave the losses unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim``
-    fits the same ``air+drag`` from the same start, so it reads the quick mode's fit."""
+    obtains its ``air+drag`` by :func:`identified_fit` (the same start and budget in each mode), so it reads
+    this mode's fit."""
     from .sweep import parallel_map, worker_pool  # noqa: PLC0415 - process pools only when identifying
 
     rec = seed_reconstruction()

@@ -73,7 +73,8 @@ def geometry_text(geometry: Mapping[str, float], stderr: Mapping[str, float]) ->
 
 
 def sensitivity_rows(s: Mapping[str, Any]) -> str:
-    """Markdown table of the smoothed horizons [s] per fit window of the start and geometry (full run only)."""
+    """Markdown table of the smoothed horizons [s] per fit window of the start and geometry (``--thorough`` only;
+    otherwise a sentence saying so and that the table's other windows come with ``--thorough``)."""
     span = s["prediction_s"]
     main = s["starts"]["least_squares_geometry"]
     main_row = {
@@ -82,7 +83,8 @@ def sensitivity_rows(s: Mapping[str, Any]) -> str:
     }
     table = sorted([*s.get("fit_window_sensitivity", []), main_row], key=lambda r: r["fit_frames"])
     if len(table) == 1:
-        return "(full run only)"
+        return (f"Only the {main['n_frames']}-frame window is fitted in this run; the other windows "
+                "(0.5 s, 1 s, 2 s) are fitted with ``--thorough``.")
     rows = [
         f"| {r['fit_frames']}{' (used)' if r.get('main') else ''} | {r['fit_frames'] / FPS:.2f} "
         f"| {r['chi2_red']:.0f} | {1e3 * r['rms_residual_m']:.1f} "
@@ -189,9 +191,10 @@ its positions turned and shifted by the fitted camera rotation and pivot offset 
 Model: the seed's pendulum with its acrylic rods ({m["rods"]["m_rod1"]:.3f} kg and {m["rods"]["m_rod2"]:.3f} kg
 plates of {m["rods"]["L_rod1"]:.2f} m and {m["rods"]["L_rod2"]:.2f} m), l1 = {m["lengths_m"]["l1"]:.4f} m,
 l2 = {m["lengths_m"]["l2"]:.4f} m from the track, and the losses of the ``loss_identification`` scenario's best
-model ``{m["loss_model"]}`` fitted again to {m["loss_fit_record_s"]:.1f} s of the measured energy decay
-({m["loss_fit_runs"]} in-process runs): {loss_text(s)}. The seed-start frictionless run uses point masses on
-massless rods, as the seed did.
+model ``{m["loss_model"]}`` fitted to {m["loss_fit_record_s"]:.1f} s of the measured energy decay as that
+scenario's {"quick" if s["quick"] else "default"} run fits it (same start and run budget, so either scenario reads
+the other's cached fit; {m["loss_fit_runs"]} in-process runs): {loss_text(s)}. The seed-start frictionless
+run uses point masses on massless rods, as the seed did.
 
 ## Start states and geometry
 

@@ -203,6 +203,7 @@ def fit_start_state(
     absolute_sigma: bool = False,
     geometry: Sequence[str] = (),
     geometry_guess: Mapping[str, float] | None = None,
+    tolerance: float = 1e-8,
 ) -> StartStateFit:
     """Fit ``(phi1, phi2, omega1, omega2)`` at ``t0`` [s] to measured frames (see the module docstring).
 
@@ -214,6 +215,8 @@ def fit_start_state(
     :data:`FIT_SETTINGS`. ``absolute_sigma``: take ``sigma`` as the true errors (else scale the
     covariance by chi2 / (n - p)). ``geometry``: names of free geometry parameters fitted with the
     state (module docstring), started from ``geometry_guess``, else ``model_values``, else 0.
+    ``tolerance``: relative change of chi2 and of the parameters at which the iteration stops (scipy's
+    ``ftol`` and ``xtol``; 1e-8 is scipy's default).
     """
     offsets = np.asarray(offsets, dtype=int)
     data = np.asarray(data, dtype=float)
@@ -232,7 +235,8 @@ def fit_start_state(
         sim = simulate_frames(runner, values, t0, n_frames, dt=dt, outputs=outputs)
         return ((shift_outputs(output_matrix(sim, outputs)[offsets], outputs, shifts) - data) / sigma).ravel()
 
-    res = least_squares(residuals, x0, method="lm", diff_step=DIFF_STEP, x_scale="jac")
+    res = least_squares(residuals, x0, method="lm", diff_step=DIFF_STEP, x_scale="jac", ftol=tolerance,
+                        xtol=tolerance)
     chi2 = float(res.fun @ res.fun)
     m = res.fun.size
     cov = np.linalg.inv(res.jac.T @ res.jac)

@@ -43,7 +43,6 @@ from . import chaos, loss_identification, lyapunov_study
 from .ensemble import batch_energy, initial_states, pendulum_field
 from .measurement import FRAME_INTERVAL, Reconstruction
 from .start_state import (
-    FIT_SETTINGS,
     POSITION_OUTPUTS,
     STATE_NAMES,
     StartStateFit,
@@ -68,7 +67,15 @@ turned about the pivot), the pivot's offset [m] from the circle-fit pivot and l2
 track's value: freed as well, it trades off against the pivot's height over a few swings."""
 LOSS_MODEL = "air+drag"
 """The best loss model of the ``loss_identification`` scenario (air drag with a free factor on rho_air,
-a bearing drag torque at both joints), fitted again here by its own functions."""
+a bearing drag torque at both joints), obtained here as that scenario obtains it (:func:`identified_losses`)."""
+FIT_TOLERANCE = 1e-6
+"""Relative stopping tolerance of the least-squares starts (scipy's ``ftol``, ``xtol``): on the seed's track the
+start and geometry fit then ends after about half the FMU runs of scipy's 1e-8, with chi2 1e-7 (relative) and
+the geometry < 1 um and < 1e-3 deg from that fit's, far inside their standard errors."""
+PREDICTION_SETTINGS: dict[str, Any] = {"solver": "dop853", "rtol": 1e-8, "atol": 1e-10}
+"""Integration of the predictions and the ensemble runs: a 20 s run from the seed's fitted start stays within
+2 um of the fits' tighter :data:`~double_pendulum.analysis.start_state.FIT_SETTINGS` (which only the
+finite-difference Jacobian needs) at half the cost; the horizons are about centimetres."""
 LYAPUNOV_RENORM_S = 0.1
 """Renormalisation interval [s] of the Lyapunov estimate (:func:`regime`)."""
 LYAPUNOV_STEP_S = 2e-3
@@ -200,13 +207,15 @@ class IdentifiedLosses:
         return {**self.pendulum, **self.losses, "omega_reg": loss_identification.OMEGA_REG}
 
 
-def identified_losses(rec: Reconstruction, window_s: float | None = None) -> IdentifiedLosses:
+def identified_losses(rec: Reconstruction, window_s: float | None = None, *, quick: bool = False) -> IdentifiedLosses:
     """Fit :data:`LOSS_MODEL` to the measured energy decay of ``rec`` (a reconstruction with rods),
-    in-process, with the ``loss_identification`` scenario's functions; ``window_s``: only the first
-    seconds after the release (None: the whole record)."""
+    in-process, the way the ``loss_identification`` scenario's run in the same mode (``quick``) fits it
+    (:func:`~double_pendulum.analysis.loss_identification.identified_fit`: the same start and run budget,
+    so the cached fit of either scenario serves the other); ``window_s``: only the first seconds after the
+    release (None: the whole record)."""
     md = loss_identification.measured(rec, window_s)
     problem = loss_identification.problem_from_track(rec, md)
-    fit = loss_identification.fit_loss_model(LOSS_MODEL, problem)
+    fit = loss_identification.identified_fit(LOSS_MODEL, problem, quick=quick)
     factor = loss_identification.common_factor([fit])
     pendulum = {k: problem.base[k] for k in ("l1", "l2", "m1", "m2", *SEED_RIGID_LINKS)}
     return IdentifiedLosses(
@@ -227,13 +236,15 @@ def least_squares_start(
     n_frames: int = START_FIT_FRAMES,
     geometry: Sequence[str] = (),
     warm: StartStateFit | None = None,
+    tolerance: float = FIT_TOLERANCE,
 ) -> StartStateFit:
     """Start state at frame ``i0`` (and the free ``geometry``, e.g. :data:`FREE_GEOMETRY`) fitted to the
-    positions of ``n_frames`` frames, from the reconstruction (pivot offsets from 0, lengths from ``values``)."""
+    positions of ``n_frames`` frames, from the reconstruction (pivot offsets from 0, lengths from ``values``);
+    ``tolerance``: the iteration's relative stopping tolerance on chi2 and the parameters."""
     w = track_window(rec, i0, n_frames)
     guess, geometry_guess = (w.guess, None) if warm is None else (warm.state, warm.geometry)
     return fit_start_state(runner, w.t0, w.offsets, w.positions, w.sigma_positions, guess, values,
-                           geometry=geometry, geometry_guess=geometry_guess)
+                           geometry=geometry, geometry_guess=geometry_guess, tolerance=tolerance)
 
 
 def start_fit_summary(fit: StartStateFit, guess: np.ndarray) -> dict[str, Any]:
@@ -260,7 +271,7 @@ def predict(
     start, shifts = split_geometry(geometry)
     result = simulate_frames(
         runner,
-        {**FIT_SETTINGS, **values, **start, **state_start_values(state)},
+        {**PREDICTION_SETTINGS, **values, **start, **state_start_values(state)},
         float(rec.t[i0]),
         n_frames,
         outputs=RUN_OUTPUTS,
@@ -286,10 +297,12 @@ def chaos_spread(
     n_frames: int,
     size: int,
     seed: int = ENSEMBLE_SEED,
+    max_workers: int | None = 1,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Median distance [m] of the lower bob between runs drawn from the fit's covariance (state and
     any fitted geometry) and the central run, per frame (times [s] since t0): how fast the fit's own
-    uncertainty grows."""
+    uncertainty grows. ``max_workers``: worker processes (1: here, with ``runner``; a few runs of about a
+    second each cost less than starting workers; None: one per core)."""
     rng = np.random.default_rng(seed)
     draws = rng.multivariate_normal(fit.values, fit.covariance, size=size)
     _, central_shifts = split_geometry(central.geometry)
@@ -297,8 +310,9 @@ def chaos_spread(
     items = []
     for x in draws:
         start, shifts = split_geometry(dict(zip(fit.names[4:], x[4:])))
-        items.append(({**FIT_SETTINGS, **values, **start, **state_start_values(x[:4])}, shifts, fit.t0, n_frames, ref))
-    distances = runner_map(_spread_distance, items, runner, label="start-state ensemble")
+        start_values = {**PREDICTION_SETTINGS, **values, **start, **state_start_values(x[:4])}
+        items.append((start_values, shifts, fit.t0, n_frames, ref))
+    distances = runner_map(_spread_distance, items, runner, max_workers=max_workers, label="start-state ensemble")
     return np.arange(n_frames) * FRAME_INTERVAL, np.median(np.array(distances), axis=0)
 
 
