@@ -218,7 +218,8 @@ def plot_decay_rate_map(
     axes[0, 0].set_ylabel("suspension damping c [N s/m]")
     fig.colorbar(mesh, ax=axes[0].tolist(), label="decay rate b of the pendulum energy, E ~ exp(b t) [1/s]",
                  shrink=0.95, pad=0.02)
-    fig.suptitle("decay rate of the pendulum energy over the suspension's stiffness and damping, by suspension mass")
+    by_mass = ", by suspension mass" if len(panels) > 1 else ""
+    fig.suptitle(f"decay rate of the pendulum energy over the suspension's stiffness and damping{by_mass}")
     legend_below(fig, *_unique_handles(axes[0]), ncols=2)
     return save(fig, path)
 
