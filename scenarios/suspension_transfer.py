@@ -129,7 +129,7 @@ QUICK = Plan(
     window_s=QUICK_WINDOW_S,
     valley_k_factors=(),
     window_checks_s=(),
-    max_workers=None,
+    max_workers=1,
 )
 
 
