@@ -27,9 +27,9 @@ WORK = ("W_air", "W_bearing", "W_bearing_drag", "W_suspension")
 
 @pytest.fixture(scope="module")
 def budget_runs(fmu_path):
-    """One 30 s run per mechanism (every mechanism loses over 0.6 % of the energy by then), on parallel
+    """One 20 s run per mechanism (every mechanism loses over 0.3 % of the energy by then), on parallel
     worker processes (the same runs as one after another)."""
-    results = run_sweep(fmu_path, [{**START, **sw} for sw in MECHANISMS.values()], stop_time=30.0,
+    results = run_sweep(fmu_path, [{**START, **sw} for sw in MECHANISMS.values()], stop_time=20.0,
                         output_interval=0.01)
     return dict(zip(MECHANISMS, results))
 

@@ -194,7 +194,7 @@ def test_massless_rods_are_bit_identical_through_the_fmu(runner):
 
 @pytest.mark.parametrize("start", [(0.4, -0.3, 0.0, 1.0), (2.0, 2.0, 0.0, 0.0)])
 def test_trajectory_matches_the_independent_lagrangian(start):
-    """Fixed pivot, seed rods, 2 s: the FMU component against SciPy's DOP853 on the independent equations."""
+    """Fixed pivot, seed rods, 1 s: the FMU component against SciPy's DOP853 on the independent equations."""
     config = ModelConfig(pendulum=RIGID)
     ind = IndependentPendulum(config)
     zeros = np.zeros(4)
@@ -203,11 +203,11 @@ def test_trajectory_matches_the_independent_lagrangian(start):
         q, qd = np.array([z[0], z[1], 0.0, 0.0]), np.array([z[2], z[3], 0.0, 0.0])
         return [z[2], z[3], *ind.accelerations(q, qd, zeros)]
 
-    times = np.linspace(0.0, 2.0, 21)
-    ref = solve_ivp(rhs, (0.0, 2.0), start, method="DOP853", rtol=1e-12, atol=1e-12, t_eval=times).y
+    times = np.linspace(0.0, 1.0, 11)
+    ref = solve_ivp(rhs, (0.0, 1.0), start, method="DOP853", rtol=1e-12, atol=1e-12, t_eval=times).y
     r = simulate(
         {**SEED_RIGID_LINKS, **dict(zip(("phi1_0", "phi2_0", "omega1_0", "omega2_0"), start)), "rtol": 1e-12},
-        stop_time=2.0,
+        stop_time=1.0,
         output_interval=0.1,
     )
     for k, name in enumerate(("phi1", "phi2", "omega1", "omega2")):
