@@ -218,9 +218,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.jobs is not None and args.jobs < 1:
         raise CliError(f"--jobs must be at least 1, got {args.jobs}")
     out = _writable_folder(args.out)
-    from .scenario_pool import default_jobs
+    from .analysis.sweep import default_workers  # one scenario per core this process may use
 
-    jobs = min(len(names), args.jobs or default_jobs())
+    jobs = min(len(names), args.jobs or default_workers())
     start, cpu_start = time.perf_counter(), _cpu_seconds()
     failed = _run_in_children(names, args, out, jobs) if jobs > 1 else _run_in_this_process(names, args, out)
     if len(names) > 1:

@@ -37,14 +37,6 @@ STOP_GRACE_S = 10.0
 """How long [s] interrupted children may take to clean up before they are killed."""
 
 
-def default_jobs() -> int:
-    """Scenarios at a time: one per core this process may use."""
-    try:
-        return max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not on Linux
-        return max(1, os.cpu_count() or 1)
-
-
 def longest_first(names: Sequence[str]) -> list[str]:
     """``names`` ordered by expected CPU time, longest first (ties keep their order)."""
     return sorted(names, key=lambda name: -EXPECTED_CPU_S.get(name, 0.0))
