@@ -18,8 +18,6 @@ the equations or the integrators computes them anew. Delete the folder to force 
 
 from __future__ import annotations
 
-import hashlib
-import json
 import os
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -30,7 +28,7 @@ import numpy as np
 
 from ..component.cosimulation import DoublePendulumCoSimulation
 from ..fmu.simulate import simulate
-from .result_cache import cache_root, sources_hash
+from .result_cache import cache_root, key_hash, sources_hash
 
 STATE_OUTPUTS = ("phi1", "phi2", "omega1", "omega2")
 REFERENCE_SETTINGS = {"solver": "dop853", "rtol": 1e-13, "atol": 1e-15, "max_steps": 1e8}
@@ -60,10 +58,8 @@ class Reference:
 
 
 def _key(start: Mapping[str, Any], stop_time: float, interval: float, cross_check: Mapping[str, Any]) -> str:
-    text = json.dumps({"start": dict(start), "stop": stop_time, "interval": interval,
-                       "reference": REFERENCE_SETTINGS, "cross_check": dict(cross_check), "runtime": runtime_hash()},
-                      sort_keys=True)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    return key_hash({"start": dict(start), "stop": stop_time, "interval": interval,
+                     "reference": REFERENCE_SETTINGS, "cross_check": dict(cross_check), "runtime": runtime_hash()})
 
 
 def _scipy_cross_check(start: Mapping[str, Any], times: np.ndarray, cross_check: Mapping[str, Any]) -> np.ndarray:
