@@ -162,21 +162,17 @@ def parallel_map(
     with progress_bar(sum(weights), label, enabled=progress, unit=unit) as bar:
         if scheduler is not None:
             return _dask_map(func, items, shared, scheduler, bar, weights, results)
-        workers = pool.workers if pool is not None else default_workers() if max_workers is None else max_workers
-        workers = min(workers, max(len(items), 1))
-        if workers <= 1:
-            for i, item in enumerate(items):
-                results[i] = _call(func, item, shared)
-                bar.update(weights[i])
-            return results, 1
         with contextlib.ExitStack() as stack:
-            if pool is None:
-                context = multiprocessing.get_context("spawn")
-                executor = stack.enter_context(ProcessPoolExecutor(max_workers=workers, mp_context=context))
-            else:
-                executor = pool.executor
+            if pool is None:  # a pool of this call's own
+                pool = stack.enter_context(worker_pool(max_workers, len(items)))
+            workers = 1 if pool is None else min(pool.workers, max(len(items), 1))
+            if workers <= 1:
+                for i, item in enumerate(items):
+                    results[i] = _call(func, item, shared)
+                    bar.update(weights[i])
+                return results, 1
             with _without_fmu_resources_on_path():  # workers start on these submits
-                futures = {executor.submit(_call, func, item, shared): i for i, item in enumerate(items)}
+                futures = {pool.executor.submit(_call, func, item, shared): i for i, item in enumerate(items)}
             for future in as_completed(futures):
                 i = futures[future]
                 results[i] = future.result()
