@@ -13,13 +13,15 @@ suspension, and compares them by AIC/BIC with the residuals' correlation account
   ``p_measured_stderr``, ``p_sim``, ``shares`` and the model comparison;
 - ``report.md``.
 
-Default: the one- and two-mechanism models (:data:`~double_pendulum.analysis.loss_identification.FULL_MODELS`)
-and the profile likelihood of the best one, about 100 s of CPU on one worker process per core (the
-worker pool is started once for every fitting round and the profile). ``thorough`` (``--thorough``)
-adds the three-mechanism models air+drag+bearing, air+drag+viscous and air+drag+suspension (about 90 s
-more CPU; in the last runs the first two ended at their parent's optimum and the third above it, so
-they change no figure of the default run). ``quick``: air+drag alone in this process, no comparison,
-no profile likelihood (a smoke run; the fit is the one ``measured_vs_sim`` reads from the cache).
+Default: the one- and two-mechanism models but air+drag2
+(:data:`~double_pendulum.analysis.loss_identification.FULL_MODELS`) and the profile likelihood of the
+best one, about 100 s of CPU on one worker process per core (the worker pool is started once for every
+fitting round and the profile). ``thorough`` (``--thorough``) adds air+drag2 (one drag torque per
+joint) and the three-mechanism models air+drag+bearing, air+drag+viscous and air+drag+suspension, with
+30 runs for every fit (about 2 min more CPU; in the last runs they ended at or above their parent's
+optimum, so they change no figure of the default run). ``quick``: air+drag alone in this process, no
+comparison, no profile likelihood (a smoke run; the fit is the one ``measured_vs_sim`` reads from the
+cache).
 """
 
 from __future__ import annotations

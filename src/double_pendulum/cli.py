@@ -265,7 +265,8 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("--quick", action="store_true", help="short runs, for smoke tests (about 30 s for all)")
     p_run.add_argument("--thorough", action="store_true",
                        help="heavier, publication-grade settings where a scenario has them (chaos, "
-                       "work_precision); the others run as usual")
+                       "work_precision, loss_identification, suspension_transfer, measured_vs_sim); the others "
+                       "run as usual")
     p_run.add_argument("--jobs", type=int, default=None, metavar="N",
                        help="scenarios at a time, each in its own process (default: one per core; "
                        "1 runs them one after another in this process)")
