@@ -67,31 +67,35 @@ def plot_phase_portraits(runs: Mapping[str, np.ndarray], path: str | Path) -> Pa
 
 
 def plot_residuals(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
-    """|energy_residual| / E_total(0) over time [s], log scale, one line per run.
+    """|energy_residual| / E_total(0) over time [s], log scale, one panel per run (each on its own time axis:
+    the runs last from a fraction of a second to 1000 s), on one shared residual axis.
 
     The axis spans the nonzero values only; samples that are exactly zero (no residual to display on a
     log scale) are marked on the bottom edge, so a zero does not stretch the axis over empty decades.
     """
-    fig, ax = plt.subplots(figsize=(10, 5))
-    nonzero, zero_times = [], []
-    for label, r in runs.items():
+    fig, axes = plt.subplots(len(runs), 1, figsize=(10, 1.0 + 2.0 * len(runs)), sharey=True, squeeze=False,
+                             layout="constrained")  # fmt: skip
+    nonzero, marked = [], False
+    for ax, (label, r) in zip(axes[:, 0], runs.items()):
         e0 = abs(r["E_total"][0]) or 1.0
         rel = np.abs(np.asarray(r["energy_residual"], dtype=float)) / e0
         zero = rel == 0.0
-        ax.semilogy(r["time"], np.where(zero, np.nan, rel), label=label)
+        ax.semilogy(r["time"], np.where(zero, np.nan, rel), color="C0")
         nonzero.append(rel[np.isfinite(rel) & ~zero])
-        zero_times.append(np.asarray(r["time"])[zero])
-    zeros = np.concatenate(zero_times) if zero_times else np.empty(0)
-    if zeros.size:
-        ax.plot(zeros, np.zeros(zeros.size), "|", color="k", ms=10, mew=1.5, transform=ax.get_xaxis_transform(),
-                clip_on=False, label="residual exactly 0 (off the log scale)")
+        zeros = np.asarray(r["time"])[zero]
+        if zeros.size:
+            ax.plot(zeros, np.zeros(zeros.size), "|", color="k", ms=10, mew=1.5, transform=ax.get_xaxis_transform(),
+                    clip_on=False, label=None if marked else "residual exactly 0 (off the log scale)")
+            marked = True
+        ax.set(xlabel="t [s]", title=label)
+        ax.grid(alpha=0.3, which="both")
     values = np.concatenate(nonzero) if nonzero else np.empty(0)
     if values.size:
-        ax.set_ylim(values.min() / 2.0, values.max() * 2.0)
-    ax.set(xlabel="t [s]", ylabel="relative energy residual |energy_residual| / E_total(0) [-]",
-           title=f"energy balance error of the {len(runs)} worst cases")
-    legend_outside(ax)
-    ax.grid(alpha=0.3, which="both")
+        axes[0, 0].set_ylim(values.min() / 2.0, values.max() * 2.0)
+    fig.supylabel("relative energy residual |energy_residual| / E_total(0) [-]")
+    fig.suptitle(f"energy balance error of the {len(runs)} worst passing cases")
+    if marked:
+        legend_outside(next(ax for ax in axes[:, 0] if ax.get_legend_handles_labels()[0]))
     return save(fig, path)
 
 
