@@ -43,7 +43,14 @@ from double_pendulum.scenarios.energy_decay import SEED_FIT
 
 from double_pendulum import plots
 from double_pendulum.analysis import suspension_transfer as study
-from double_pendulum.analysis.decay_map import MAP_SETTINGS, MAP_UNITS, decay_maps, map_summary, trace_valley
+from double_pendulum.analysis.decay_map import (
+    BASE_SETTINGS,
+    MAP_SETTINGS,
+    MAP_UNITS,
+    decay_maps,
+    map_summary,
+    trace_valley,
+)
 from double_pendulum.analysis.energy_flow import energy_flow_run, energy_flow_summary
 from double_pendulum.analysis.measurement import load_track, reconstruct
 from double_pendulum.analysis.progress import step
@@ -208,7 +215,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         "quick": quick,
         "thorough": thorough,
         "energy_fitted": "E_pendulum (the bobs' energy, what the camera measures)",
-        "settings": {"map": MAP_SETTINGS, "fits": FIT_SETTINGS, "losses": LOSSES},
+        "settings": {"map": MAP_SETTINGS, "map_without_suspension": BASE_SETTINGS, "fits": FIT_SETTINGS,
+                     "losses": LOSSES},
         "measured": study.measured_summary(md, SEED_B),
         "start_state": model.start.as_dict(),
         "identified": {**point_summary(md, ident, ident.chi2), "fixed": {"k": ident.k, "M_s": ident.m_s}},

@@ -9,7 +9,7 @@ from double_pendulum.scenarios import suspension_transfer as st
 from double_pendulum.scenarios.friction_budget import SEED_RELEASE
 
 from double_pendulum.analysis.decay_fit import calibrate_error_model, fit_model
-from double_pendulum.analysis.decay_map import MAP_SETTINGS, decay_rate_sweep
+from double_pendulum.analysis.decay_map import BASE_SETTINGS, MAP_SETTINGS, decay_rate_sweep
 from double_pendulum.analysis.measurement import FRAME_INTERVAL, load_track, reconstruct
 from double_pendulum.analysis.suspension_identification import (
     FIT_SETTINGS,
@@ -70,7 +70,7 @@ def test_stiff_suspension_loss_scales_as_c_over_k_squared_and_follows_linear_res
     frames = FitFrames(0.0, np.arange(n), np.arange(n) * FRAME_INTERVAL, None)
     base = dict(SEED_RELEASE)
     points = [(1e5, 30.0), (1e5, 90.0), (1e5, 270.0), (2e5, 270.0)]
-    cases = [{**MAP_SETTINGS, "suspension": False}]
+    cases = [{**BASE_SETTINGS, "suspension": False}]
     cases += [{**MAP_SETTINGS, **suspension_values(k, c, 2.0)} for k, c in points]
     rates = [r["b_E_pendulum"] for r in decay_rate_sweep(runner.fmu_path, base, frames, cases, max_workers=1)]
     assert abs(rates[0]) < 1e-5  # no loss mechanism, no decay

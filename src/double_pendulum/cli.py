@@ -105,7 +105,8 @@ def accepts_thorough(module) -> bool:
 
 
 def run_scenario(module, name: str, runner, out: Path, quick: bool, thorough: bool = False) -> None:
-    """Run one scenario into a fresh folder that replaces ``out/name`` only once it has finished.
+    """Run one scenario into a fresh folder that replaces ``out/name`` only once it has finished (figures of
+    quick runs at :data:`~double_pendulum.plots.style.DRAFT_DPI`).
 
     No stale file from an earlier run and no half-written folder survive: an interrupted run
     leaves the earlier results as they were; a failed one also keeps what it wrote, in
@@ -115,9 +116,12 @@ def run_scenario(module, name: str, runner, out: Path, quick: bool, thorough: bo
     staging = out / f".{name}.incomplete"
     shutil.rmtree(staging, ignore_errors=True)
     staging.mkdir()
+    from .plots.style import draft_figures  # here, not at the top: matplotlib would slow down `list`
+
     try:
         options = {"thorough": True} if thorough and accepts_thorough(module) else {}
-        module.run(runner, staging, quick=quick, **options)
+        with draft_figures(quick):  # quick runs draw their figures at a lower resolution
+            module.run(runner, staging, quick=quick, **options)
         _mark_quick(staging, quick)
     except KeyboardInterrupt:
         shutil.rmtree(staging, ignore_errors=True)

@@ -29,6 +29,7 @@ from typing import IO
 
 from .analysis.progress import ENV as PROGRESS_ENV
 from .analysis.progress import progress_bar, write_line
+from .analysis.sweep import WORKERS_ENV
 from .scenarios import EXPECTED_CPU_S
 
 POLL_S = 0.2
@@ -54,11 +55,14 @@ def child_command(name: str, index: str, out: Path, fmu: Path, quick: bool, thor
 
 
 def child_environment() -> dict[str, str]:
-    """The parent's environment, with progress as plain lines (unless switched off) and unbuffered output."""
+    """The parent's environment, with progress as plain lines (unless switched off), unbuffered output and
+    one worker process per child (unless ``$DOUBLE_PENDULUM_WORKERS`` is set): the children already run
+    one per core, and a pool of spawned workers costs each sweep some seconds of imports."""
     env = dict(os.environ)
     if env.get(PROGRESS_ENV, "").strip().lower() != "off":
         env[PROGRESS_ENV] = "lines"
     env["PYTHONUNBUFFERED"] = "1"
+    env.setdefault(WORKERS_ENV, "1")
     return env
 
 

@@ -77,12 +77,14 @@ def _map_section(s: Mapping[str, Any]) -> str:
         if largest is not None and largest < -needed
         else ""
     )
-    fisher = s["valley"]["fisher"]
+    fisher, settings = s["valley"]["fisher"], s["settings"]
     return f"""## The map b(k, c)
 
 {s["map_runs"]} FMU runs (``decay_rate_map.csv``, ``decay_rate_map.png``), k = k_x = k_y from
 {main["k_N_per_m"][0]:.3g} to {main["k_N_per_m"][-1]:.3g} N/m, c = c_x = c_y from {main["c_N_s_per_m"][0]:.3g} to
-{main["c_N_s_per_m"][-1]:.3g} N s/m, swept in {s["map_wall_time_s"]:.0f} s by ``analysis.sweep.run_sweep``.
+{main["c_N_s_per_m"][-1]:.3g} N s/m, swept in {s["map_wall_time_s"]:.0f} s by ``analysis.sweep.run_sweep``
+at rtol {settings["map"]["rtol"]:g} (b to about 1e-4 relative; the run without suspension at rtol
+{settings["map_without_suspension"]["rtol"]:g}).
 b of E_pendulum and of E_total differ by at most {main["max_abs_b_E_pendulum_minus_b_E_total"]:.1e} 1/s.
 
 | M_s [kg] | grid | b without suspension [1/s] | stiffest k reaching the measured b [N/m] | iso-b points (measured b) |

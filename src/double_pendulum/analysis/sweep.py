@@ -49,12 +49,20 @@ from .progress import progress_bar as _progress_bar
 CHUNKS_PER_WORKER = 4
 
 
+WORKERS_ENV = "DOUBLE_PENDULUM_WORKERS"
+"""Environment variable capping the worker processes of every sweep (``run all`` sets it to 1 in its
+children, which already run one per core)."""
+
+
 def default_workers() -> int:
-    """Number of cores this process may use."""
+    """Number of worker processes a sweep uses by default: the cores this process may use, at most
+    ``$DOUBLE_PENDULUM_WORKERS`` when that is set to a positive integer."""
     try:
-        return max(1, len(os.sched_getaffinity(0)))
+        cores = max(1, len(os.sched_getaffinity(0)))
     except AttributeError:  # not on Linux
-        return max(1, os.cpu_count() or 1)
+        cores = max(1, os.cpu_count() or 1)
+    cap = os.environ.get(WORKERS_ENV, "").strip()
+    return min(cores, int(cap)) if cap.isdigit() and int(cap) > 0 else cores
 
 
 def chunk(items: Sequence[Any], n_chunks: int) -> list[list[Any]]:
