@@ -155,3 +155,44 @@ def test_ctrl_c_exits_130_with_one_line(tmp_path, capsys, monkeypatch, fmu_path)
     assert main(["run", "free_swing", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 130
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "interrupted" in err
+
+
+def _recorded_runs(monkeypatch) -> list[str]:
+    """The scenarios ``run --jobs 1`` runs from now on, recorded instead of run (and no FMU opened)."""
+    import contextlib
+
+    runs: list[str] = []
+    monkeypatch.setattr("double_pendulum.cli._load_fmu", lambda path, rebuild: contextlib.nullcontext())
+    monkeypatch.setattr("double_pendulum.cli.run_scenario", lambda module, name, *args: runs.append(name))
+    return runs
+
+
+def test_several_scenarios_run_once_each_with_cosimulation_first_in_one_process(tmp_path, capsys, monkeypatch):
+    runs = _recorded_runs(monkeypatch)
+    assert main(["run", "free_swing", "cosimulation", "free_swing", "--jobs", "1", "--out", str(tmp_path)]) == 0
+    assert runs == ["cosimulation", "free_swing"]  # duplicates dropped; cosimulation first (scenarios.in_process_order)
+    out = capsys.readouterr().out
+    assert "[1/2] cosimulation:" in out and "[2/2] free_swing:" in out and "2 of 2 scenarios wrote" in out
+
+
+def test_a_child_numbers_its_scenarios_as_its_parent_says_and_leaves_the_sum_to_it(tmp_path, capsys, monkeypatch):
+    runs = _recorded_runs(monkeypatch)
+    command = ["run", "cosimulation", "chaos", "--jobs", "1", "--out", str(tmp_path)]
+    assert main([*command, "--index", "1/11,10/11"]) == 0
+    assert runs == ["cosimulation", "chaos"]
+    out = capsys.readouterr().out
+    assert "[1/11] cosimulation:" in out and "[10/11] chaos:" in out and "scenarios wrote" not in out
+    assert main([*command, "--index", "1/11"]) == 2
+    assert "--index needs one k/N per scenario (2)" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("names", "message"), [
+    (["all", "free_swing"], "'all' runs every scenario: give it alone"),
+    (["free_swing", "all"], "'all' runs every scenario: give it alone"),
+    (["free_swing", "nope"], "unknown scenario 'nope'"),
+])  # fmt: skip
+def test_bad_scenario_lists_are_one_clear_line(tmp_path, capsys, names, message):
+    assert main(["run", *names, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err
+    assert list(tmp_path.iterdir()) == []  # nothing ran

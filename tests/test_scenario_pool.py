@@ -1,23 +1,79 @@
-"""``run all`` in child processes: order, relayed lines, failures, Ctrl-C."""
+"""``run all`` in child processes: order, groups, relayed lines, progress, failures, Ctrl-C."""
 
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import pytest
-from double_pendulum.scenarios import EXPECTED_CPU_S, SCENARIOS
+from double_pendulum.scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, SCENARIOS
 
-from double_pendulum import scenario_pool
+from double_pendulum import scenario_lines, scenario_pool
 from double_pendulum.analysis.progress import ENV
 from double_pendulum.cli import main
 
 
 def test_every_scenario_has_an_expected_cost_and_the_longest_start_first():
     assert set(EXPECTED_CPU_S) == set(SCENARIOS)
+    assert set(EXPECTED_QUICK_CPU_S) == set(SCENARIOS)
     order = scenario_pool.longest_first(SCENARIOS)
     costs = [EXPECTED_CPU_S[name] for name in order]
     assert costs == sorted(costs, reverse=True)
     assert sorted(order) == sorted(SCENARIOS)
+
+
+def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_longest_first():
+    groups = scenario_pool.scenario_groups(SCENARIOS, quick=False, jobs=2)
+    assert groups == [[name] for name in scenario_pool.longest_first(SCENARIOS)]
+
+
+def test_a_quick_run_shares_the_scenarios_out_longest_first_to_the_least_loaded(monkeypatch):
+    costs = {"a": 5.0, "b": 4.0, "c": 3.0, "d": 3.0, "e": 2.0, "cosimulation": 1.0, "f": 0.5}
+    monkeypatch.setattr(scenario_pool, "EXPECTED_QUICK_CPU_S", costs)
+    # a 5 | b 4 | c -> b 7 | d -> a 8 | e -> b 9 | cosimulation -> a 9 | f -> a 9.5 (the first of the least)
+    assert scenario_pool.scenario_groups(list(costs), quick=True, jobs=2) == [
+        ["cosimulation", "a", "d", "f"],  # 9.5, cosimulation first in its group, the others longest first
+        ["b", "c", "e"],  # 9
+    ]
+
+
+@pytest.mark.parametrize("jobs", [1, 2, 3, 4, 11, 20])
+def test_quick_groups_hold_every_scenario_once_balanced_and_cosimulation_first(jobs):
+    groups = scenario_pool.scenario_groups(SCENARIOS, quick=True, jobs=jobs)
+    assert len(groups) == min(jobs, len(SCENARIOS))
+    assert sorted(name for group in groups for name in group) == sorted(SCENARIOS)
+    assert all(group for group in groups)
+    host = next(group for group in groups if "cosimulation" in group)
+    assert host[0] == "cosimulation"
+    totals = [sum(EXPECTED_QUICK_CPU_S[name] for name in group) for group in groups]
+    assert totals == sorted(totals, reverse=True)  # the largest group starts first
+    if len(groups) > 1:  # no group could give its last scenario to the smallest and be better off
+        assert totals[0] - totals[-1] <= max(EXPECTED_QUICK_CPU_S.values())
+    if jobs == 2:
+        assert totals[0] - totals[1] < 1.0  # about equal halves of the measured costs
+
+
+def test_a_child_command_names_its_scenarios_and_their_numbers_and_runs_them_in_its_process(tmp_path):
+    command = scenario_pool.child_command(["cosimulation", "chaos"], ["1/11", "10/11"], tmp_path, tmp_path / "x.fmu",
+                                          quick=True, thorough=False)  # fmt: skip
+    run = command[command.index("run"):]
+    assert run[:3] == ["run", "cosimulation", "chaos"]
+    assert run[run.index("--index") + 1] == "1/11,10/11"
+    assert run[run.index("--jobs") + 1] == "1"
+    assert "--quick" in run and "--thorough" not in run
+
+
+def test_the_lines_a_scenario_prints_are_read_back():
+    names = ("chaos", "stability")
+    assert scenario_lines.header_name(scenario_lines.header_line("3/11", "chaos", "sensitivity"), names) == "chaos"
+    assert scenario_lines.header_name("  - chaos: a step", names) is None
+    assert scenario_lines.header_name("[1/2] other: its header ...", names) is None
+    wrote = scenario_lines.wrote_line("stability", Path("out/stability"), 1.0, 2.0)
+    assert scenario_lines.outcome(wrote, names) == ("stability", scenario_lines.WROTE)
+    failed = scenario_lines.failed_line("chaos", "boom")
+    assert scenario_lines.outcome(failed, names) == ("chaos", scenario_lines.FAILED)
+    assert scenario_lines.outcome("chaos: wrote nothing yet", ("stability",)) is None
+    assert scenario_lines.outcome("chaos: writes", names) is None
 
 
 def test_child_lines_are_marked_with_their_scenario():
@@ -34,10 +90,77 @@ def test_children_count_progress_in_plain_lines_unless_it_is_off(monkeypatch, pa
     assert scenario_pool.child_environment()[ENV] == child
 
 
+def test_lines_of_a_group_child_are_marked_with_the_scenario_running_in_it():
+    child = scenario_pool.Child(("a", "b"), process=None, current="a")
+    assert child.take("loading\n") == ("  a: loading", None)
+    assert child.take("[2/5] b: the second ...\n") == ("[2/5] b: the second ...", None)
+    assert child.take("a step\n") == ("  b: a step", None)
+    # a's failure line, relayed from stderr after b's header: as it is, and a reported
+    assert child.take("a: FAILED: boom\n") == ("a: FAILED: boom", "a")
+    assert child.take("b: wrote out/b in 1 s\n") == ("b: wrote out/b in 1 s", "b")
+    assert child.take("b: wrote it again\n") == ("b: wrote it again", None)  # reported once
+    assert child.failures(0) == ["a"] and child.failures(1) == ["a"] and child.unreported() == []
+
+
 def _fake_children(monkeypatch, scripts: dict[str, str]) -> None:
-    """Children that run a small Python script per scenario name instead of the scenario."""
+    """Children that run a small Python script, chosen by their first scenario's name, instead of the scenarios."""
     monkeypatch.setattr(scenario_pool, "child_command",
-                        lambda name, *args: [sys.executable, "-c", scripts[name]])  # fmt: skip
+                        lambda names, *args: [sys.executable, "-c", scripts[names[0]]])  # fmt: skip
+
+
+class _Bar:
+    """A stand-in progress bar that records its total and each update."""
+
+    def __init__(self, total: int) -> None:
+        self.total, self.updates = total, []
+
+    def update(self, n: int) -> None:
+        self.updates.append(n)
+
+    def __enter__(self) -> _Bar:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        pass
+
+
+def _recorded_bars(monkeypatch) -> list[_Bar]:
+    """The progress bars run_in_children makes from now on, as :class:`_Bar`."""
+    made: list[_Bar] = []
+
+    def make(total, *args, **kwargs) -> _Bar:
+        made.append(_Bar(total))
+        return made[-1]
+
+    monkeypatch.setattr(scenario_pool, "progress_bar", make)
+    return made
+
+
+def test_a_group_child_relays_its_scenarios_lines_marked_with_each(monkeypatch, tmp_path, capsys):
+    script = ("print('[1/2] a: first ...'); print('working'); print('a: wrote x'); "
+              "print('[2/2] b: second ...'); print('working'); print('b: wrote y')")  # fmt: skip
+    _fake_children(monkeypatch, {"a": script})
+    failed = scenario_pool.run_in_children(["a", "b"], tmp_path, tmp_path / "x.fmu", quick=True, thorough=False,
+                                           jobs=1)  # fmt: skip
+    assert failed == []
+    out = capsys.readouterr().out.splitlines()
+    assert out == ["[1/2] a: first ...", "  a: working", "a: wrote x", "[2/2] b: second ...", "  b: working",
+                   "b: wrote y"]  # fmt: skip
+
+
+def test_a_group_child_that_dies_mid_group_fails_the_rest_and_the_bar_still_ends_full(monkeypatch, tmp_path,
+                                                                                       capsys):  # fmt: skip
+    monkeypatch.setattr(scenario_pool, "EXPECTED_QUICK_CPU_S", {"a": 5.0, "b": 3.0, "c": 2.0})
+    bars = _recorded_bars(monkeypatch)
+    _fake_children(monkeypatch, {"a": "import sys; print('[1/3] a: ...'); print('a: wrote x'); "
+                                      "print('[2/3] b: ...'); sys.exit(3)"})  # fmt: skip
+    failed = scenario_pool.run_in_children(["c", "b", "a"], tmp_path, tmp_path / "x.fmu", quick=True, thorough=False,
+                                           jobs=1)  # fmt: skip
+    assert failed == ["c", "b"]  # in the order of the names given
+    err = capsys.readouterr().err
+    assert "b: FAILED: its process ended with code 3" in err and "c: FAILED: its process ended with code 3" in err
+    assert "a: FAILED" not in err
+    assert bars[0].total == 10 and bars[0].updates == [5, 5]  # a when it wrote, b and c when the child ended
 
 
 def test_failed_children_are_named_and_the_others_finish(monkeypatch, tmp_path, capsys):
@@ -46,7 +169,7 @@ def test_failed_children_are_named_and_the_others_finish(monkeypatch, tmp_path, 
         "b": "import sys; print('b: FAILED: bad input', file=sys.stderr); sys.exit(1)",
         "c": "print('c: wrote it')",
     })  # fmt: skip
-    failed = scenario_pool.run_in_children(["a", "b", "c"], tmp_path, tmp_path / "x.fmu", quick=True,
+    failed = scenario_pool.run_in_children(["a", "b", "c"], tmp_path, tmp_path / "x.fmu", quick=False,
                                            thorough=False, jobs=2)  # fmt: skip
     assert failed == ["a", "b"]
     out, err = capsys.readouterr()
@@ -76,14 +199,15 @@ def test_ctrl_c_stops_every_child(monkeypatch, tmp_path):
     assert all(child.process.poll() is not None for child in started)  # none left running
 
 
-def test_run_all_in_children_writes_every_folder(tmp_path, capsys, fmu_path, monkeypatch):
-    monkeypatch.setattr("double_pendulum.cli._check_scenario", lambda name: ("energy_decay", "free_swing"))
-    assert main(["run", "all", "--quick", "--jobs", "2", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 0
+def test_several_scenarios_in_children_write_every_folder(tmp_path, capsys, fmu_path):
+    names = ["energy_decay", "free_swing", "friction_budget"]
+    assert main(["run", *names, "--quick", "--jobs", "2", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["energy_decay", "free_swing"]
-    assert "2 at a time in their own processes" in out
-    assert "[1/2] energy_decay:" in out and "[2/2] free_swing:" in out
-    assert "2 of 2 scenarios wrote" in out
+    assert sorted(p.name for p in tmp_path.iterdir()) == names
+    assert "3 scenarios in 2 processes" in out
+    # free_swing alone; energy_decay and friction_budget one after another in the other child
+    assert "[1/3] energy_decay:" in out and "[2/3] free_swing:" in out and "[3/3] friction_budget:" in out
+    assert out.count("scenarios wrote") == 1 and "3 of 3 scenarios wrote" in out  # the children's sums not shown
 
 
 def test_jobs_below_one_is_refused_in_one_line(tmp_path, capsys):

@@ -19,7 +19,8 @@ from pathlib import Path
 
 from . import __version__
 from .fmu.build import DEFAULT_FMU_PATH, build_all, build_fmu
-from .scenarios import SCENARIOS
+from .scenario_lines import failed_line, header_line, wrote_line
+from .scenarios import SCENARIOS, in_process_order
 
 PROG = "double-pendulum"
 
@@ -43,12 +44,27 @@ def scenario_listing() -> str:
     return "\n".join(f"  {name:22s} {scenario_description(name)}" for name in SCENARIOS)
 
 
-def _check_scenario(name: str) -> tuple[str, ...]:
-    if name == "all":
+def _check_scenarios(names: list[str]) -> tuple[str, ...]:
+    """The scenarios the command line names (``all``: every one), each once, in the order given."""
+    if "all" in names:
+        if len(names) > 1:
+            raise CliError("'all' runs every scenario: give it alone, not with other scenario names")
         return SCENARIOS
-    if name not in SCENARIOS:
-        raise CliError(f"unknown scenario {name!r}; choose one of: {', '.join(SCENARIOS)} (or 'all')")
-    return (name,)
+    for name in names:
+        if name not in SCENARIOS:
+            raise CliError(f"unknown scenario {name!r}; choose one of: {', '.join(SCENARIOS)} (or 'all')")
+    return tuple(dict.fromkeys(names))
+
+
+def _indices(index: str | None, count: int) -> list[str]:
+    """The "k/N" of each of ``count`` scenarios in their header lines: ``--index`` (one per scenario,
+    comma-separated, as a parent process passes them) or 1/count, 2/count, ..."""
+    if index is None:
+        return [f"{k}/{count}" for k in range(1, count + 1)]
+    indices = index.split(",")
+    if len(indices) != count:
+        raise CliError(f"--index needs one k/N per scenario ({count}), got {index!r}")
+    return indices
 
 
 def _writable_folder(path: str) -> Path:
@@ -182,12 +198,14 @@ def _cpu_seconds() -> float:
 
 
 def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: Path) -> list[str]:
-    """Run the scenarios one after another in this process; return the names of those that failed."""
+    """Run the scenarios one after another in this process (``cosimulation`` first, see
+    :func:`double_pendulum.scenarios.in_process_order`); return the names of those that failed."""
     failed = []
+    order = in_process_order(names)
+    indices = _indices(args.index, len(order))
     with _load_fmu(args.fmu, args.rebuild) as runner:
-        for number, name in enumerate(names, start=1):
-            index = args.index or f"{number}/{len(names)}"
-            print(f"[{index}] {name}: {scenario_description(name)} ...", flush=True)
+        for index, name in zip(indices, order):
+            print(header_line(index, name, scenario_description(name)), flush=True)
             module = importlib.import_module(f"double_pendulum.scenarios.{name}")
             start, cpu_start = time.perf_counter(), _cpu_seconds()
             if args.thorough and not accepts_thorough(module):
@@ -198,11 +216,10 @@ def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: 
                 raise
             except Exception as error:  # report, keep what was written, go on with the next
                 failed.append(name)
-                print(f"{name}: FAILED: {error} (partial results in {out / (name + '.failed')})", file=sys.stderr)
+                print(failed_line(name, f"{error} (partial results in {out / (name + '.failed')})"), file=sys.stderr)
                 continue
-            print(f"{name}: wrote {out / name} in {time.perf_counter() - start:.1f} s "
-                  f"(CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
-    return failed
+            print(wrote_line(name, out / name, time.perf_counter() - start, _cpu_seconds() - cpu_start), flush=True)
+    return [name for name in names if name in failed]
 
 
 def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path, jobs: int) -> list[str]:
@@ -210,13 +227,17 @@ def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path
     from .scenario_pool import run_in_children
 
     _load_fmu(args.fmu, args.rebuild).close()  # build once here, and fail early on an unusable FMU
-    print(f"running {len(names)} scenarios, {jobs} at a time in their own processes, the longest first",
-          flush=True)
+    if args.quick:
+        print(f"running {len(names)} scenarios in {jobs} processes, each running its share one after another",
+              flush=True)
+    else:
+        print(f"running {len(names)} scenarios, {jobs} at a time in their own processes, the longest first",
+              flush=True)
     return run_in_children(names, out, Path(args.fmu), quick=args.quick, thorough=args.thorough, jobs=jobs)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    names = _check_scenario(args.scenario)
+    names = _check_scenarios(args.scenarios)
     if args.quick and args.thorough:
         raise CliError("--quick and --thorough exclude each other")
     if args.jobs is not None and args.jobs < 1:
@@ -227,10 +248,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     jobs = min(len(names), args.jobs or default_workers())
     start, cpu_start = time.perf_counter(), _cpu_seconds()
     failed = _run_in_children(names, args, out, jobs) if jobs > 1 else _run_in_this_process(names, args, out)
-    if len(names) > 1:
+    if len(names) > 1 and args.index is None:  # a child of run_in_children leaves the sum to its parent
         print(f"{len(names) - len(failed)} of {len(names)} scenarios wrote {out} in "
               f"{time.perf_counter() - start:.1f} s (CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
-    if failed:
+    if failed and args.index is None:
         print(f"{len(failed)} of {len(names)} scenarios failed: {', '.join(failed)}", file=sys.stderr)
     return 1 if failed else 0
 
@@ -254,14 +275,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     p_run = sub.add_parser(
         "run",
-        help="run a scenario (or 'all') through the FMU with fmpy",
-        description="Run a scenario through the FMU with fmpy; write CSV files, plots, summary.json "
-        "and a report into OUT/SCENARIO/.",
+        help="run scenarios (or 'all') through the FMU with fmpy",
+        description="Run one or more scenarios through the FMU with fmpy; write CSV files, plots,\n"
+        "summary.json and a report into OUT/SCENARIO/ for each. Several names run like 'all',\n"
+        "restricted to them.",
         epilog="scenarios:\n" + scenario_listing()
-        + "\n  all                    every scenario above, one per core at a time (see --jobs)",
+        + "\n  all                    every scenario above, in child processes, one per core at a time "
+        "(see --jobs)",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p_run.add_argument("scenario", metavar="SCENARIO", help="scenario name (see below), or 'all'")
+    p_run.add_argument("scenarios", nargs="+", metavar="SCENARIO",
+                       help="scenario names (see below), or 'all' alone")
     p_run.add_argument("--out", default="results", help="output folder (default: results)")
     p_run.add_argument("--fmu", default=str(DEFAULT_FMU_PATH),
                        help=f"FMU to use, built if missing or older than the sources (default: {DEFAULT_FMU_PATH})")
@@ -272,9 +296,11 @@ def build_parser() -> argparse.ArgumentParser:
                        "work_precision, loss_identification, suspension_transfer, measured_vs_sim); the others "
                        "run as usual")
     p_run.add_argument("--jobs", type=int, default=None, metavar="N",
-                       help="scenarios at a time, each in its own process (default: one per core; "
-                       "1 runs them one after another in this process)")
-    p_run.add_argument("--index", default=None, help=argparse.SUPPRESS)  # "k/N" in a child's header line
+                       help="child processes at a time (default: one per core): each runs one scenario, "
+                       "or with --quick its share of them one after another; 1 runs them all one after "
+                       "another in this process")
+    # a child's "k/N" in its header lines, one per scenario, comma-separated
+    p_run.add_argument("--index", default=None, help=argparse.SUPPRESS)
     p_run.set_defaults(func=cmd_run)
 
     p_list = sub.add_parser("list", help="list the scenarios", description="List the scenarios.")

@@ -1,18 +1,26 @@
-"""Run several scenarios at once, each in a child process of its own: ``double-pendulum run all``.
+"""Run several scenarios at once in child processes: ``double-pendulum run all``.
 
 A scenario alternates between sequential parts (a fit whose each step needs the last) and parallel
-sweeps; run one after another, the sequential parts leave a core idle. Running ``jobs`` scenarios
-at a time (one per core by default) keeps the cores busy. Each child is ``python -m
-double_pendulum.cli run NAME ...``, so it writes its results exactly as a single run does (fresh
-folder, replaced on success), and a scenario cannot disturb another's process (libcosim and fmpy's
-container FMU failed to load their FMUs in a process that had already run the pythonfmu FMU).
+sweeps; run one after another, the sequential parts leave a core idle. Running ``jobs`` children at
+a time (one per core by default) keeps the cores busy. Each child is ``python -m
+double_pendulum.cli run NAME... --jobs 1 ...``, so it writes its results exactly as a single run
+does (fresh folder, replaced on success).
 
-The children's lines reach the terminal as they come, each marked with its scenario's name; their
-progress counters are plain lines (``DOUBLE_PENDULUM_PROGRESS=lines``: two tqdm bars would
-overwrite each other), while the parent shows one bar over the scenarios, each weighted by its
-expected CPU time (:data:`double_pendulum.scenarios.EXPECTED_CPU_S`), so that its rate and time
-left mean something. The longest scenarios start first, so the run does not end on a long scenario
-started last.
+A default or thorough run gives every scenario a child of its own, the longest first (by
+:data:`double_pendulum.scenarios.EXPECTED_CPU_S`), so the run does not end on a long scenario started
+last, and a scenario cannot disturb another's process. A quick run is dominated by the imports
+(NumPy, SciPy, Matplotlib, fmpy: some 2.5 s of CPU per process), so it starts only ``jobs`` children,
+each running its share of the scenarios one after another (:func:`scenario_groups`: balanced by
+:data:`double_pendulum.scenarios.EXPECTED_QUICK_CPU_S`, ``cosimulation`` first in its group, as
+libcosim and fmpy's container FMU failed to load their FMUs in a process that had already run the
+pythonfmu FMU).
+
+The children's lines reach the terminal as they come, each marked with the name of the scenario
+running in its child (a child's header line ``[k/N] NAME: ...`` says which); their progress
+counters are plain lines (``DOUBLE_PENDULUM_PROGRESS=lines``: two tqdm bars would overwrite each
+other), while the parent shows one bar over the scenarios, each weighted by its expected CPU time,
+so that its rate and time left mean something. A scenario's share of the bar is added when its
+``wrote`` or ``FAILED`` line arrives, what is left of a child's share when the child ends.
 """
 
 from __future__ import annotations
@@ -30,7 +38,8 @@ from typing import IO
 from .analysis.progress import ENV as PROGRESS_ENV
 from .analysis.progress import progress_bar, write_line
 from .analysis.sweep import WORKERS_ENV
-from .scenarios import EXPECTED_CPU_S
+from .scenario_lines import FAILED, WROTE, failed_line, header_name, outcome
+from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, in_process_order
 
 POLL_S = 0.2
 """How often [s] the parent looks for finished children."""
@@ -38,15 +47,44 @@ STOP_GRACE_S = 10.0
 """How long [s] interrupted children may take to clean up before they are killed."""
 
 
-def longest_first(names: Sequence[str]) -> list[str]:
+def expected_cpu_s(name: str, quick: bool) -> float:
+    """The expected CPU time [s] of scenario ``name`` in a quick or a default run (1 s if unknown)."""
+    return (EXPECTED_QUICK_CPU_S if quick else EXPECTED_CPU_S).get(name, 1.0)
+
+
+def longest_first(names: Sequence[str], quick: bool = False) -> list[str]:
     """``names`` ordered by expected CPU time, longest first (ties keep their order)."""
-    return sorted(names, key=lambda name: -EXPECTED_CPU_S.get(name, 0.0))
+    return sorted(names, key=lambda name: -expected_cpu_s(name, quick))
 
 
-def child_command(name: str, index: str, out: Path, fmu: Path, quick: bool, thorough: bool) -> list[str]:
-    """The command line of the child that runs scenario ``name`` (``index``: "k/N" for its header)."""
-    command = [sys.executable, "-m", "double_pendulum.cli", "run", name, "--out", str(out), "--fmu", str(fmu),
-               "--index", index]  # fmt: skip
+def balanced_groups(names: Sequence[str], count: int) -> list[list[str]]:
+    """``names`` shared out among ``count`` groups of about equal expected quick-run CPU time: each
+    scenario, longest first, joins the group with the least so far. Within a group ``cosimulation``
+    comes first, the others longest first; the groups come largest first; none is empty."""
+    groups: list[list[str]] = [[] for _ in range(max(1, min(count, len(names))))]
+    totals = [0.0] * len(groups)
+    for name in longest_first(names, quick=True):
+        least = totals.index(min(totals))
+        groups[least].append(name)
+        totals[least] += expected_cpu_s(name, quick=True)
+    order = sorted(range(len(groups)), key=lambda k: -totals[k])
+    return [in_process_order(groups[k]) for k in order if groups[k]]
+
+
+def scenario_groups(names: Sequence[str], *, quick: bool, jobs: int) -> list[list[str]]:
+    """The scenarios each child runs, in the order the children start: in a quick run ``jobs``
+    balanced groups (:func:`balanced_groups`), otherwise one scenario per child, longest first."""
+    if quick:
+        return balanced_groups(names, jobs)
+    return [[name] for name in longest_first(names)]
+
+
+def child_command(names: Sequence[str], indices: Sequence[str], out: Path, fmu: Path, quick: bool,
+                  thorough: bool) -> list[str]:  # fmt: skip
+    """The command line of the child that runs the scenarios ``names`` one after another in its own
+    process (``indices``: their "k/N" in the parent's run, for their header lines)."""
+    command = [sys.executable, "-m", "double_pendulum.cli", "run", *names, "--out", str(out), "--fmu", str(fmu),
+               "--index", ",".join(indices), "--jobs", "1"]  # fmt: skip
     if quick:
         command.append("--quick")
     if thorough:
@@ -77,27 +115,58 @@ def marked(name: str, line: str) -> str:
 
 @dataclass
 class Child:
-    """A running scenario: its process and the threads that relay its output."""
+    """A running child: its scenarios, its process, the threads that relay its output, the scenario
+    running in it now and the outcome (WROTE or FAILED) each scenario has reported so far."""
 
-    name: str
+    names: tuple[str, ...]
     process: subprocess.Popen
+    current: str
+    outcomes: dict[str, str] = field(default_factory=dict)
     relays: list[threading.Thread] = field(default_factory=list)
 
+    def take(self, line: str) -> tuple[str, str | None]:
+        """Read a line of the child: switch :attr:`current` on a header line, note a first outcome;
+        return the line as the parent prints it and the scenario that has just reported (or None)."""
+        self.current = header_name(line, self.names) or self.current
+        reported = outcome(line, self.names)
+        text = marked(reported[0] if reported else self.current, line)
+        if reported is None or reported[0] in self.outcomes:
+            return text, None
+        self.outcomes[reported[0]] = reported[1]
+        return text, reported[0]
 
-def _relay(name: str, stream: IO[str], target: Callable[[], IO[str]], lock: threading.Lock) -> None:
+    def failures(self, code: int) -> list[str]:
+        """The scenarios that failed, once the child ended with ``code``: those that said FAILED and,
+        if the code is not 0, those that had not said WROTE."""
+        return [name for name in self.names
+                if self.outcomes.get(name) == FAILED or (code != 0 and self.outcomes.get(name) != WROTE)]  # fmt: skip
+
+    def unreported(self) -> list[str]:
+        """The scenarios that have reported no outcome."""
+        return [name for name in self.names if name not in self.outcomes]
+
+
+def _relay(child: Child, stream: IO[str], target: Callable[[], IO[str]], lock: threading.Lock,
+           reported: Callable[[str], None]) -> None:  # fmt: skip
+    """Print the lines of one of ``child``'s streams as they come; call ``reported(name)`` (under
+    ``lock``) when a scenario reports its outcome."""
     for line in stream:
         with lock:
-            write_line(marked(name, line), target())
+            text, name = child.take(line)
+            write_line(text, target())
+            if name is not None:
+                reported(name)
     stream.close()
 
 
-def start_child(name: str, command: list[str], lock: threading.Lock) -> Child:
-    """Start a scenario's process and the threads that relay its stdout and stderr."""
+def start_child(names: Sequence[str], command: list[str], lock: threading.Lock,
+                reported: Callable[[str], None]) -> Child:  # fmt: skip
+    """Start a child running the scenarios ``names`` and the threads that relay its stdout and stderr."""
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, bufsize=1,
                                env=child_environment())  # fmt: skip
-    child = Child(name, process)
+    child = Child(tuple(names), process, current=names[0])
     for stream, target in ((process.stdout, lambda: sys.stdout), (process.stderr, lambda: sys.stderr)):
-        thread = threading.Thread(target=_relay, args=(name, stream, target, lock), daemon=True)
+        thread = threading.Thread(target=_relay, args=(child, stream, target, lock, reported), daemon=True)
         thread.start()
         child.relays.append(thread)
     return child
@@ -109,6 +178,7 @@ def _pause(seconds: float) -> None:
 
 
 def _finish(child: Child) -> int:
+    """Wait for the child and for its relayed lines; return its exit code."""
     code = child.process.wait()
     for thread in child.relays:
         thread.join()
@@ -127,35 +197,45 @@ def _stop(children: Sequence[Child]) -> None:
         _finish(child)
 
 
+def _failures_of_ended(child: Child, lock: threading.Lock) -> tuple[list[str], list[str]]:
+    """Once ``child`` has ended: the scenarios that failed, and those still unreported (each failed one
+    among them gets a line that says how its process ended)."""
+    code = _finish(child)
+    failures, unreported = child.failures(code), child.unreported()
+    with lock:
+        for name in (n for n in unreported if n in failures):
+            write_line(failed_line(name, f"its process ended with code {code}"), sys.stderr)
+    return failures, unreported
+
+
 def run_in_children(
     names: Sequence[str], out: Path, fmu: Path, *, quick: bool, thorough: bool, jobs: int
 ) -> list[str]:
-    """Run every scenario of ``names`` in a child process, ``jobs`` at a time, longest first; return
-    the names of those that failed (a child's exit code other than 0). Ctrl-C stops every child and
-    raises KeyboardInterrupt once they have cleaned up."""
-    order = longest_first(names)
-    number = {name: f"{names.index(name) + 1}/{len(names)}" for name in names}
+    """Run the scenarios ``names`` in child processes, ``jobs`` at a time (:func:`scenario_groups`:
+    one scenario per child, or in a quick run ``jobs`` children with a group each); return the names
+    of those that failed, in the order of ``names``. Ctrl-C stops every child and raises
+    KeyboardInterrupt once they have cleaned up."""
+    number = {name: f"{k}/{len(names)}" for k, name in enumerate(names, start=1)}
+    weight = {name: max(1, round(expected_cpu_s(name, quick))) for name in names}
     lock = threading.Lock()
-    waiting, running, failed = list(order), [], []
-    weight = {name: max(1, round(EXPECTED_CPU_S.get(name, 1.0))) for name in names}
+    waiting, running, failed = scenario_groups(names, quick=quick, jobs=jobs), [], []
     label = f"{len(names)} scenarios, progress in expected CPU seconds"
     with progress_bar(sum(weight.values()), label, unit="CPU s") as bar:
+        def reported(name: str) -> None:
+            bar.update(weight[name])
+
         try:
             while waiting or running:
                 while waiting and len(running) < jobs:
-                    name = waiting.pop(0)
-                    running.append(start_child(name, child_command(name, number[name], out, fmu, quick, thorough),
-                                               lock))  # fmt: skip
+                    group = waiting.pop(0)
+                    command = child_command(group, [number[n] for n in group], out, fmu, quick, thorough)
+                    running.append(start_child(group, command, lock, reported))
                 _pause(POLL_S)
                 for child in [c for c in running if c.process.poll() is not None]:
                     running.remove(child)
-                    code = _finish(child)
-                    if code != 0:
-                        failed.append(child.name)
-                        if code not in (1, 2):  # the child's own line says why for 1 and 2
-                            with lock:
-                                write_line(f"{child.name}: FAILED: its process ended with code {code}", sys.stderr)
-                    bar.update(weight[child.name])
+                    failures, unreported = _failures_of_ended(child, lock)
+                    failed.extend(failures)
+                    bar.update(sum(weight[n] for n in unreported))
         except KeyboardInterrupt:
             _stop(running)
             raise
