@@ -27,33 +27,34 @@ SCENARIOS: tuple[str, ...] = (
 )
 
 EXPECTED_CPU_S: dict[str, float] = {
-    "cosimulation": 50.0,
+    "cosimulation": 45.0,
     "free_swing": 5.0,
-    "friction_budget": 14.0,
-    "energy_decay": 3.0,
-    "loss_identification": 116.0,
-    "suspension_transfer": 189.0,
+    "friction_budget": 11.0,
+    "energy_decay": 2.5,
+    "loss_identification": 98.0,
+    "suspension_transfer": 130.0,
     "measured_vs_sim": 18.0,
-    "work_precision": 88.0,
-    "stability": 31.0,
-    "chaos": 283.0,
-    "base_excitation": 59.0,
+    "work_precision": 78.0,
+    "stability": 29.0,
+    "chaos": 211.0,
+    "base_excitation": 49.0,
 }
-"""CPU time [s] of each scenario's default run, as last measured (first run, 2 cores, 2026-12-01): ``run
-all`` starts the longest first and weights its progress bar by them; nothing else depends on them."""
+"""CPU time [s] of each scenario's default run, as last measured (first run, 2 cores, one worker process
+each, 2026-12-02): ``run all`` starts the longest first and weights its progress bar by them; nothing else
+depends on them."""
 
 EXPECTED_QUICK_CPU_S: dict[str, float] = {
-    "cosimulation": 6.6,
-    "free_swing": 2.5,
-    "friction_budget": 1.8,
-    "energy_decay": 2.4,
-    "loss_identification": 9.4,
-    "suspension_transfer": 17.5,
-    "measured_vs_sim": 5.1,
-    "work_precision": 0.6,
-    "stability": 3.2,
-    "chaos": 12.2,
-    "base_excitation": 4.8,
+    "cosimulation": 7.6,
+    "free_swing": 2.9,
+    "friction_budget": 1.9,
+    "energy_decay": 1.7,
+    "loss_identification": 13.3,
+    "suspension_transfer": 16.4,
+    "measured_vs_sim": 5.4,
+    "work_precision": 0.8,
+    "stability": 4.3,
+    "chaos": 14.0,
+    "base_excitation": 5.6,
 }
 """CPU time [s] of each scenario's quick run (``--quick``), as last measured (2 cores): ``run all
 --quick`` shares the scenarios out among its processes by them and weights its progress bar by them;
