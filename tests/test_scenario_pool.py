@@ -22,9 +22,18 @@ def test_every_scenario_has_an_expected_cost_and_the_longest_start_first():
     assert sorted(order) == sorted(SCENARIOS)
 
 
-def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_longest_first():
+def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_longest_first_the_small_ones_one_last():
     groups = scenario_pool.scenario_groups(SCENARIOS, quick=False, jobs=2)
-    assert groups == [[name] for name in scenario_pool.longest_first(SCENARIOS)]
+    order = scenario_pool.longest_first(SCENARIOS)
+    small = [name for name in order if EXPECTED_CPU_S[name] < scenario_pool.SMALL_SCENARIO_CPU_S]
+    assert 1 < len(small) < len(SCENARIOS)
+    assert groups == [[name] for name in order if name not in small] + [small]
+
+
+def test_default_run_groups_keep_cosimulation_first_when_it_is_small(monkeypatch):
+    costs = {"a": 100.0, "b": 10.0, "cosimulation": 5.0, "c": 20.0}
+    monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", costs)
+    assert scenario_pool.scenario_groups(list(costs), quick=False, jobs=2) == [["a"], ["cosimulation", "c", "b"]]
 
 
 def test_a_quick_run_shares_the_scenarios_out_longest_first_to_the_least_loaded(monkeypatch):
@@ -164,6 +173,7 @@ def test_a_group_child_that_dies_mid_group_fails_the_rest_and_the_bar_still_ends
 
 
 def test_failed_children_are_named_and_the_others_finish(monkeypatch, tmp_path, capsys):
+    monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", {"a": 300.0, "b": 200.0, "c": 100.0})  # a child each
     _fake_children(monkeypatch, {
         "a": "print('working'); import sys; sys.exit(3)",
         "b": "import sys; print('b: FAILED: bad input', file=sys.stderr); sys.exit(1)",

@@ -374,7 +374,8 @@ def identify_suspension(
     response. ``quick`` fits only the first :data:`QUICK_WINDOW_S` seconds.
 
     The result is kept for the rest of the process, keyed by the FMU file's content, the track, ``quick``,
-    ``k`` and ``m_s``: ``suspension_transfer`` and ``measured_vs_sim`` in one ``run all`` fit it once.
+    ``k`` and ``m_s``, so repeated calls in one process (the tests' fixtures and ``suspension_transfer``)
+    fit it once.
     """
     rec = reconstruct(load_track()) if rec is None else rec
     key = (_file_digest(runner.fmu_path), _track_digest(rec), quick, k, m_s)
