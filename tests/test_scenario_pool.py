@@ -22,18 +22,21 @@ def test_every_scenario_has_an_expected_cost_and_the_longest_start_first():
     assert sorted(order) == sorted(SCENARIOS)
 
 
-def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_longest_first_the_small_ones_one_last():
+def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_small_ones_one_the_largest_first():
     groups = scenario_pool.scenario_groups(SCENARIOS, quick=False, jobs=2)
     order = scenario_pool.longest_first(SCENARIOS)
     small = [name for name in order if EXPECTED_CPU_S[name] < scenario_pool.SMALL_SCENARIO_CPU_S]
     assert 1 < len(small) < len(SCENARIOS)
-    assert groups == [[name] for name in order if name not in small] + [small]
+    assert sorted(groups) == sorted([[name] for name in order if name not in small] + [small])
+    totals = [sum(EXPECTED_CPU_S[name] for name in group) for group in groups]
+    assert totals == sorted(totals, reverse=True)
 
 
-def test_default_run_groups_keep_cosimulation_first_when_it_is_small(monkeypatch):
-    costs = {"a": 100.0, "b": 10.0, "cosimulation": 5.0, "c": 20.0}
+def test_default_run_groups_keep_cosimulation_first_and_sort_by_their_sum(monkeypatch):
+    costs = {"a": 100.0, "b": 10.0, "cosimulation": 5.0, "c": 20.0, "d": 30.0}
     monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", costs)
-    assert scenario_pool.scenario_groups(list(costs), quick=False, jobs=2) == [["a"], ["cosimulation", "c", "b"]]
+    assert scenario_pool.scenario_groups(list(costs), quick=False, jobs=2) == [
+        ["a"], ["cosimulation", "c", "b"], ["d"]]  # the small ones' 35 s before d's 30 s
 
 
 def test_a_quick_run_shares_the_scenarios_out_longest_first_to_the_least_loaded(monkeypatch):

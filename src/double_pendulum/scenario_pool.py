@@ -9,7 +9,7 @@ does (fresh folder, replaced on success).
 A default or thorough run gives every scenario a child of its own, the longest first (by
 :data:`double_pendulum.scenarios.EXPECTED_CPU_S`), so the run does not end on a long scenario started
 last, and a scenario cannot disturb another's process; only the small ones (under
-:data:`SMALL_SCENARIO_CPU_S`) share the last child. A quick run is dominated by the imports
+:data:`SMALL_SCENARIO_CPU_S`) share a child, placed by their sum. A quick run is dominated by the imports
 (NumPy, SciPy, Matplotlib, fmpy: some 2.5 s of CPU per process), so it starts only ``jobs`` children,
 each running its share of the scenarios one after another (:func:`scenario_groups`: balanced by
 :data:`double_pendulum.scenarios.EXPECTED_QUICK_CPU_S`, ``cosimulation`` first in its group, as
@@ -73,20 +73,20 @@ def balanced_groups(names: Sequence[str], count: int) -> list[list[str]]:
 
 
 SMALL_SCENARIO_CPU_S = 30.0
-"""Default-run scenarios expected to take less CPU time [s] than this share one child, which runs them
-last: a child of their own would cost each some 3 s of CPU importing NumPy, SciPy, Matplotlib and fmpy."""
+"""Default-run scenarios expected to take less CPU time [s] than this share one child: a child of their
+own would cost each some 3 s of CPU importing NumPy, SciPy, Matplotlib and fmpy."""
 
 
 def scenario_groups(names: Sequence[str], *, quick: bool, jobs: int) -> list[list[str]]:
     """The scenarios each child runs, in the order the children start: in a quick run ``jobs``
-    balanced groups (:func:`balanced_groups`), otherwise one scenario per child, longest first, except
-    that those under :data:`SMALL_SCENARIO_CPU_S` share the last child (longest first among them)."""
+    balanced groups (:func:`balanced_groups`), otherwise one scenario per child, except that those
+    under :data:`SMALL_SCENARIO_CPU_S` share one; the children with the most expected CPU time first."""
     if quick:
         return balanced_groups(names, jobs)
     order = longest_first(names)
     small = [name for name in order if expected_cpu_s(name, quick=False) < SMALL_SCENARIO_CPU_S]
-    groups = [[name] for name in order if name not in small]
-    return groups + ([in_process_order(small)] if small else [])
+    groups = [[name] for name in order if name not in small] + ([in_process_order(small)] if small else [])
+    return sorted(groups, key=lambda group: -sum(expected_cpu_s(name, quick=False) for name in group))
 
 
 def child_command(names: Sequence[str], indices: Sequence[str], out: Path, fmu: Path, quick: bool,
