@@ -248,9 +248,9 @@ def poincare(out: Path, plan: Plan, params: PendulumParameters) -> dict:
     """Sections phi1 = 0, omega1 > 0 at a regular energy and at the default start's energy."""
     releases = {"regular, energy of a rest start at phi1 = phi2 = 0.5 rad": (0.5, 0.5),
                 "chaotic, energy of the default start": PHI0}
-    sections = {label: phase_space.poincare_at_energy(pendulum_field(params), phase_space.rest_energy(*phi, params),
-                                                      plan.poincare_starts, params, t_end=plan.poincare_t_end, h=H)
-                for label, phi in releases.items()}
+    energies = [phase_space.rest_energy(*phi, params) for phi in releases.values()]
+    sections = dict(zip(releases, phase_space.poincare_at_energies(
+        pendulum_field(params), energies, plan.poincare_starts, params, t_end=plan.poincare_t_end, h=H)))
     plots.plot_poincare_sections(phase_space.section_points(sections), out / "poincare_sections.png")
     return {label: phase_space.section_summary(s, params) for label, s in sections.items()}
 

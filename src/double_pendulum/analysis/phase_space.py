@@ -12,7 +12,7 @@ spread over :math:`\varphi_2` within the reach :math:`V(0, \varphi_2) < E` (:fun
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -96,10 +96,25 @@ def poincare_at_energy(
     The starts have phi2 evenly spread over +-:func:`phi2_reach`, omega2 = 0 and omega1 > 0 from the
     energy (:func:`.chaos.section_starts`); RK4 step ``h`` [s] up to ``t_end`` [s] (:func:`.chaos.poincare_section`).
     """
-    phi2 = np.linspace(-1.0, 1.0, n_starts) * phi2_reach(energy, params)
-    starts = chaos.section_starts(energy, phi2, 0.0, params)
-    points, owner = chaos.poincare_section(field, starts, t_end, h=h)
-    return Section(energy, starts, points, owner)
+    return poincare_at_energies(field, (energy,), n_starts, params, t_end=t_end, h=h)[0]
+
+
+def poincare_at_energies(
+    field: BatchField, energies: Sequence[float], n_starts: int, params: PendulumParameters, *, t_end: float,
+    h: float,
+) -> list[Section]:
+    """:func:`poincare_at_energy` for each of ``energies`` [J], all starts integrated as one batch (the
+    per-step overhead of a small batch dominates; each start's points are those of its own run)."""
+    starts = [chaos.section_starts(e, np.linspace(-1.0, 1.0, n_starts) * phi2_reach(e, params), 0.0, params)
+              for e in energies]  # fmt: skip
+    points, owner = chaos.poincare_section(field, np.concatenate(starts, axis=1), t_end, h=h)
+    sections, offset = [], 0
+    for energy, own in zip(energies, starts):
+        width = own.shape[1]
+        mine = (owner >= offset) & (owner < offset + width)
+        sections.append(Section(energy, own, points[mine], owner[mine] - offset))
+        offset += width
+    return sections
 
 
 def section_summary(section: Section, params: PendulumParameters) -> dict:
