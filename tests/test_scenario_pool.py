@@ -10,6 +10,7 @@ from double_pendulum.scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, SCEN
 
 from double_pendulum import scenario_lines, scenario_pool
 from double_pendulum.analysis.progress import ENV
+from double_pendulum.analysis.sweep import WORKERS_ENV
 from double_pendulum.cli import main
 
 
@@ -100,6 +101,13 @@ def test_child_lines_are_marked_with_their_scenario():
 def test_children_count_progress_in_plain_lines_unless_it_is_off(monkeypatch, parent, child):
     monkeypatch.setenv(ENV, parent)
     assert scenario_pool.child_environment()[ENV] == child
+
+
+def test_children_run_their_sweeps_on_one_worker_unless_the_user_chose_a_number(monkeypatch):
+    monkeypatch.delenv(WORKERS_ENV, raising=False)
+    assert scenario_pool.child_environment()[WORKERS_ENV] == "1"
+    monkeypatch.setenv(WORKERS_ENV, "2")
+    assert scenario_pool.child_environment()[WORKERS_ENV] == "2"
 
 
 def test_lines_of_a_group_child_are_marked_with_the_scenario_running_in_it():

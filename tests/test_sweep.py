@@ -8,7 +8,16 @@ import numpy as np
 import pytest
 
 from double_pendulum.analysis import chaos
-from double_pendulum.analysis.sweep import chunk, grid_cases, parallel_map, random_cases, run_sweep, worker_pool
+from double_pendulum.analysis.sweep import (
+    WORKERS_ENV,
+    chunk,
+    default_workers,
+    grid_cases,
+    parallel_map,
+    random_cases,
+    run_sweep,
+    worker_pool,
+)
 from double_pendulum.fmu.runner import FmuRunError
 
 OPTIONS = {"stop_time": 0.5, "output_interval": 0.05}
@@ -122,3 +131,14 @@ def test_a_worker_pool_serves_several_maps_with_the_same_processes():
 
 def _pid(_: int) -> int:
     return os.getpid()
+
+
+@pytest.mark.parametrize(("value", "expected"), [("1", 1), ("", None), ("0", None), ("-2", None), ("many", None)])
+def test_default_workers_are_capped_by_the_environment_variable_when_it_is_a_positive_integer(monkeypatch, value,
+                                                                                             expected):  # fmt: skip
+    monkeypatch.delenv(WORKERS_ENV, raising=False)
+    cores = default_workers()
+    monkeypatch.setenv(WORKERS_ENV, value)
+    assert default_workers() == (cores if expected is None else min(cores, expected))
+    monkeypatch.setenv(WORKERS_ENV, str(cores + 5))
+    assert default_workers() == cores  # a cap, never more processes than cores
