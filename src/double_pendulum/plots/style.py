@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
+from contextvars import ContextVar
 from pathlib import Path
 
 import matplotlib
@@ -19,24 +20,28 @@ FIGURE_DPI = 120
 DRAFT_DPI = 60
 """Resolution [dots per inch] of draft figures (quick runs): rendering at 120 dpi is about half of a
 figure's cost."""
-plt.rcParams["savefig.dpi"] = FIGURE_DPI
+_SAVE_DPI: ContextVar[int] = ContextVar("save_dpi", default=FIGURE_DPI)
+"""The resolution :func:`save` uses now (this package's own setting: matplotlib's rcParams stay the user's)."""
 
 
 @contextmanager
 def draft_figures(draft: bool = True) -> Iterator[None]:
     """Within the block, :func:`save` writes figures at :data:`DRAFT_DPI` (if ``draft``), as quick runs do."""
-    with plt.rc_context({"savefig.dpi": DRAFT_DPI if draft else FIGURE_DPI}):
+    token = _SAVE_DPI.set(DRAFT_DPI if draft else FIGURE_DPI)
+    try:
         yield
+    finally:
+        _SAVE_DPI.reset(token)
 
 
 def save(fig: plt.Figure, path: str | Path) -> Path:
-    """Write ``fig`` as a PNG (``savefig.dpi``: :data:`FIGURE_DPI`, :data:`DRAFT_DPI` in
-    :func:`draft_figures`) cropped to its content, legends outside the axes included; close it."""
+    """Write ``fig`` as a PNG (:data:`FIGURE_DPI`, :data:`DRAFT_DPI` in :func:`draft_figures`) cropped to
+    its content, legends outside the axes included; close it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     if fig.get_layout_engine() is None:
         fig.tight_layout()
-    fig.savefig(path, bbox_inches="tight")
+    fig.savefig(path, dpi=_SAVE_DPI.get(), bbox_inches="tight")
     plt.close(fig)
     return path
 
