@@ -12,7 +12,7 @@ Poincare sections. The analysis: ``double_pendulum.analysis`` predictability, ly
 
 Cost: the parts are independent and run on parallel worker processes (one per core), the flip map
 after them split over the same cores. The default run follows the frictionless exponents of 32
-starts for 100 s and the damped one for 160 s (the exponent has fallen to about 0 by 130 s);
+starts for 100 s and the damped one for 140 s (the exponent has fallen to about 0 by 130 s);
 ``thorough=True`` (``--thorough``) takes 64 starts, RK4 at h / 2 too, and follows the damped exponent
 for 360 s, as the seed's energy falls to a fifth. The
 summary's ``precision`` states what each headline figure is good for.
@@ -102,7 +102,7 @@ fallen to about 0 by 130 s; the thorough run shows the later windows scattering 
 150 x 150 cells (2.4 degrees, 4 pixels a cell in the figure), the energy scan (every 0.2 rad, the
 thorough run every 0.1 rad), the spectrum (its middle exponents vanish to about 1/T = 0.02 1/s) and the
 Poincare sections over 50 s, the largest exponent from 32 starts
-(standard error about 0.03 1/s, below the finite-time bias of about 0.05 1/s; 64 in the thorough run) by
+(standard error about 0.02 1/s, below the finite-time bias of about 0.05 1/s; 64 in the thorough run) by
 DOP853 at rtol 1e-8 (half the CPU of 1e-10, the thorough run's: on the same 32 starts the two means
 differ by 0.004 1/s) and RK4 (h) only: RK4 at h / 2 costs as much as all the others and agreed with both to 0.7 %
 (within the standard error) in the thorough run."""
