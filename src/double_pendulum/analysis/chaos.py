@@ -77,9 +77,29 @@ def central_difference_jvp(field: BatchField, t: Any, y: np.ndarray, v: np.ndarr
 
     Second-order accurate; use it for vector fields that are not analytic (``abs``, ``sign``).
     """
+    return field_and_central_jvp(field, t, y, v, rel_step=rel_step)[1]
+
+
+def field_and_central_jvp(
+    field: BatchField, t: Any, y: np.ndarray, v: np.ndarray, *, at: tuple[Any, np.ndarray] | None = None,
+    rel_step: float = 1e-6,
+) -> tuple[np.ndarray | None, np.ndarray]:
+    """``(f(t0, y0), J(y) v)`` with :func:`central_difference_jvp`'s ``J v``, from one call of ``field``.
+
+    ``at = (t0, y0)``: columns at which ``f`` itself is wanted too (``None``: only ``J v``). All columns
+    ``[y0; y + s v; y - s v]`` go to ``field`` in one call (a column-wise field pays its per-call overhead
+    once, not three times); every column is evaluated on its own, so the values are those of separate calls.
+    """
     norm_v = np.sqrt(np.sum(v * v, axis=0))
     s = rel_step * (1.0 + np.sqrt(np.sum(y * y, axis=0))) / np.where(norm_v > 0, norm_v, 1.0)
-    return (field(t, y + s * v) - field(t, y - s * v)) / (2.0 * s)
+    t0, y0 = at if at is not None else (0.0, y[:, :0])
+    columns = np.concatenate((y0, y + s * v, y - s * v), axis=1)
+    if np.ndim(t):  # per-column times follow their columns
+        t = np.broadcast_to(t, (y.shape[1],))
+        t = np.concatenate((np.broadcast_to(t0, (y0.shape[1],)), t, t))
+    f = field(t, columns)
+    n0, m = y0.shape[1], y.shape[1]
+    return (f[:, :n0] if at is not None else None), (f[:, n0:n0 + m] - f[:, n0 + m:]) / (2.0 * s)
 
 
 JVP_METHODS: dict[str, Callable[..., np.ndarray]] = {
@@ -103,8 +123,11 @@ def tangent_field(field: BatchField, n_vectors: int, jvp: str = "complex", dim: 
         v = z[d:].reshape(k, d, n).transpose(1, 0, 2).reshape(d, k * n)
         yk = np.broadcast_to(y[:, None, :], (d, k, n)).reshape(d, k * n)
         tk = np.tile(t, k) if np.ndim(t) else t  # per-trajectory times follow their columns
-        jv = product(field, tk, yk, v).reshape(d, k, n).transpose(1, 0, 2).reshape(k * d, n)
-        return np.concatenate((field(t, y), jv), axis=0)
+        if jvp == "central":  # f(y) in the same call of the field as the differences
+            value, jv = field_and_central_jvp(field, tk, yk, v, at=(t, y))
+        else:
+            value, jv = field(t, y), product(field, tk, yk, v)
+        return np.concatenate((value, jv.reshape(d, k, n).transpose(1, 0, 2).reshape(k * d, n)), axis=0)
 
     return augmented
 

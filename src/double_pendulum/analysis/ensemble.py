@@ -110,11 +110,9 @@ def columnwise_field(scalar_field: Callable[[float, list[float]], list[float]]) 
     """
 
     def field(t: Any, y: np.ndarray) -> np.ndarray:
-        out = np.empty_like(y)
-        times = np.broadcast_to(np.asarray(t, dtype=float), (y.shape[1],))
-        for j in range(y.shape[1]):
-            out[:, j] = scalar_field(float(times[j]), y[:, j].tolist())
-        return out
+        columns = np.asarray(y, dtype=float).T.tolist()
+        times = np.asarray(t, dtype=float).tolist() if np.ndim(t) else [float(t)] * len(columns)
+        return np.array([scalar_field(tj, yj) for tj, yj in zip(times, columns)], dtype=float).T
 
     return field
 
