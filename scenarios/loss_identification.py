@@ -8,20 +8,20 @@ suspension, and compares them by AIC/BIC with the residuals' correlation account
 
 - ``energy.csv``: per fitted frame the measured energy, its error, the best model's simulated energy
   (FMU run) and its dissipated work per mechanism;
-- ``energy_fit.png``, ``loss_shares.png``, ``profiles.png`` (not in quick mode);
+- ``energy_fit.png``, ``loss_shares.png``, ``profiles.png`` (``--thorough`` only);
 - ``summary.json``: ``best_model``, ``b_measured_per_s``, ``b_sim_per_s``, ``p_measured``,
   ``p_measured_stderr``, ``p_sim``, ``shares`` and the model comparison;
 - ``report.md``.
 
 Default: the one- and two-mechanism models but air+drag2
-(:data:`~double_pendulum.analysis.loss_identification.FULL_MODELS`) and the profile likelihood of the
-best one, about 100 s of CPU on one worker process per core (the worker pool is started once for every
-fitting round and the profile). ``thorough`` (``--thorough``) adds air+drag2 (one drag torque per
-joint) and the three-mechanism models air+drag+bearing, air+drag+viscous and air+drag+suspension, with
-30 runs for every fit (about 2 min more CPU; in the last runs they ended at or above their parent's
-optimum, so they change no figure of the default run). ``quick``: air+drag alone in this process, no
-comparison, no profile likelihood (a smoke run; the fit is the one ``measured_vs_sim`` reads from the
-cache).
+(:data:`~double_pendulum.analysis.loss_identification.FULL_MODELS`), about 80 s of CPU on one worker
+process per core (the worker pool is started once for every fitting round). ``thorough``
+(``--thorough``) adds air+drag2 (one drag torque per joint), the three-mechanism models
+air+drag+bearing, air+drag+viscous and air+drag+suspension, with 30 runs for every fit, and the best
+model's profile likelihood (about 2.5 min more CPU; in the last runs the added models ended at or above
+their parent's optimum, so they change no figure of the default run, and the profile intervals matched
+the curvature errors). ``quick``: air+drag alone in this process, no comparison, no profile likelihood
+(a smoke run; the fit is the one ``measured_vs_sim`` reads from the cache).
 """
 
 from __future__ import annotations

@@ -96,9 +96,11 @@ def report_text(s: Mapping[str, Any]) -> str:
     shares = ", ".join(f"{k} {v:.0%} +- {err.get(k, 0.0):.0%}" for k, v in s["shares"].items())
     mode = (" (quick mode, a smoke run: air+drag alone, no comparison, no profiles; its errors are the curvature"
             " errors of one fit)" if s["quick"] else
-            " (thorough: with air+drag2 and the three-mechanism models)" if s.get("thorough") else
-            " (default run: one and two mechanisms; `--thorough` adds air+drag2 and the three-mechanism models"
-            " air+drag+bearing, air+drag+viscous and air+drag+suspension, about 2 min more CPU)")
+            " (thorough: with air+drag2, the three-mechanism models and the profile likelihood)"
+            if s.get("thorough") else
+            " (default run: one and two mechanisms; `--thorough` adds air+drag2, the three-mechanism models"
+            " air+drag+bearing, air+drag+viscous and air+drag+suspension and the best model's profile likelihood,"
+            " about 2.5 min more CPU)")
     return f"""# Loss identification: which mechanisms drain the seed's pendulum?
 
 The measured energy of the seed's pendulum (camera track, Table 1; rigid links with 70 g acrylic
