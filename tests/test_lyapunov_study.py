@@ -52,29 +52,6 @@ def test_integrations_agree_on_the_chaotic_cloud_and_the_summary_reports_their_d
     assert set(units.values()) == {"1/s"}
 
 
-def test_cross_checks_on_the_first_starts_compare_with_the_reference_on_the_same_starts(comparison):
-    """check_starts = 2: RK4 and the two-trajectory estimate follow the first 2 of 4 starts, with the same
-    values as on all 4 (each trajectory is integrated on its own), and are compared with DOP853 on those 2."""
-    starts = chaos.release_ensemble(2.0, 0.0, 0.005, 4, P, seed=41, include_nominal=True)
-    part = lyapunov_study.compare_integrations(FIELD, starts, 4.0, METHODS, renorm=0.5, reference="dop853",
-                                               check_starts=2)
-    assert part.members == 4 and part.starts_of("dop853") == 4 and part.starts_of("rk4_h") == 2
-    full = comparison.cloud_exponents()
-    np.testing.assert_array_equal(part.cloud_exponents()["dop853"], full["dop853"])
-    np.testing.assert_array_equal(part.cloud_exponents()["rk4_h"], full["rk4_h"][:2])
-    np.testing.assert_array_equal(part.two_trajectory, comparison.two_trajectory[:, :2])
-    summary = lyapunov_study.largest_exponent_summary(part, "dop853", "starts within 5 mm")
-    assert summary["lyapunov_per_s"] == pytest.approx(full["dop853"].mean(), rel=1e-15)
-    halving = summary["step_halving"]["rk4 h=0.001 s"]
-    assert halving["starts"] == 2 and summary["two_trajectory_starts"] == 2
-    same_starts = full["dop853"][:2].mean()
-    assert halving["relative_to_dop853_cloud_mean"] == pytest.approx(full["rk4_h"][:2].mean() / same_starts - 1)
-    assert summary["two_trajectory_relative_to_dop853_cloud_mean"] == pytest.approx(
-        comparison.two_trajectory[-1, :2].mean() / same_starts - 1)
-    labels = list(lyapunov_study.convergence_curves(part, "starts"))
-    assert any("mean of 2 starts" in label for label in labels) and any("mean of 4 starts" in label for label in labels)
-
-
 def test_spectrum_pairs_and_its_sum_stays_within_the_phase_volume_bound():
     spec = lyapunov_study.lyapunov_spectrum(FIELD, initial_states(2.0, 0.0), 4.0, P, renorm=0.5, h=1e-3)
     np.testing.assert_allclose(spec.sum_bound, math.log((P.m1 + P.m2) / P.m1) / spec.times, rtol=1e-15)
