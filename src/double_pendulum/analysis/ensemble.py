@@ -117,6 +117,26 @@ def columnwise_field(scalar_field: Callable[[float, list[float]], list[float]]) 
     return field
 
 
+def rod_field(config: Any) -> Callable[[float, list[float]], list[float]]:
+    """The scene ``config``'s own float vector field on the four rod states ``(phi1, phi2, omega1, omega2)``.
+
+    :func:`double_pendulum.model.vector_field.build_vector_field` with the dissipated-work states it
+    appends fed in as zeros and their rates dropped (no equation depends on them). The suspension adds
+    dynamic states of its own and is not supported here.
+    """
+    from ..model.vector_field import build_vector_field, state_layout
+
+    if config.suspension.suspension:
+        raise ValueError("rod_field: scenes with the suspension have more than the four rod states")
+    scalar = build_vector_field(config)
+    padding = [0.0] * (state_layout(config).size - 4)
+
+    def rods_only(t: float, y: list[float]) -> list[float]:
+        return scalar(t, y + padding)[:4]
+
+    return rods_only
+
+
 def model_field(config: Any) -> BatchField:
     """The scene ``config`` (:class:`~double_pendulum.model.vector_field.ModelConfig`) as a batch field.
 
@@ -126,19 +146,13 @@ def model_field(config: Any) -> BatchField:
     their rates dropped, since no equation depends on them. The suspension adds dynamic states of its
     own and is not supported here.
     """
-    from ..model.vector_field import build_vector_field, is_core, state_layout
+    from ..model.vector_field import is_core
 
     if config.suspension.suspension:
         raise ValueError("model_field: scenes with the suspension have more than the four rod states")
     if is_core(config):
         return pendulum_field(config.pendulum)
-    scalar = build_vector_field(config)
-    padding = [0.0] * (state_layout(config).size - 4)
-
-    def rods_only(t: float, y: list[float]) -> list[float]:
-        return scalar(t, y + padding)[:4]
-
-    return columnwise_field(rods_only)
+    return columnwise_field(rod_field(config))
 
 
 def initial_states(phi1: Any, phi2: Any, omega1: Any = 0.0, omega2: Any = 0.0) -> np.ndarray:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -277,26 +277,20 @@ class FrictionWindows:
 
 
 def exponent_with_friction(
-    field: BatchField, y0: np.ndarray, t_end: float, params: PendulumParameters, *, renorm: float, window: float,
-    rtol: float = 1e-8,
+    field: Callable[[float, list[float]], list[float]], y0: Sequence[float], t_end: float, params: PendulumParameters,
+    *, renorm: float, window: float, rtol: float = 1e-8,
 ) -> FrictionWindows:
-    """Largest exponent of ``y0`` ``(4, 1)`` in windows of ``window`` [s] under a dissipative ``field``.
+    """Largest exponent of the start ``y0`` (4 floats) in windows of ``window`` [s] under a dissipative float
+    vector field ``field`` (:func:`~double_pendulum.analysis.ensemble.rod_field`).
 
     The field is not analytic (friction evaluated with ``math``), so the tangent uses central
-    differences; DOP853 at ``rtol``, atol = rtol / 100 (rtol 1e-6 takes a third of the CPU time of 1e-8;
-    either way the chaotic trajectory itself is lost after some 10 s, and each window's exponent is one
-    sample of the chaotic sea). The energy is that of the frictionless pendulum ``E = T + V`` along the
-    trajectory, over ``E_flip``.
+    differences (:func:`.chaos.lyapunov_single`: the runtime's DOP853 at ``rtol``, atol = rtol / 100;
+    rtol 1e-6 takes a third of the CPU time of 1e-8; either way the chaotic trajectory itself is lost
+    after some 10 s, and each window's exponent is one sample of the chaotic sea). The energy is that
+    of the frictionless pendulum ``E = T + V`` along the trajectory, over ``E_flip``.
     """
     start = time.perf_counter()
-    res = chaos.lyapunov_benettin(
-        field,
-        y0,
-        t_end,
-        renorm_interval=renorm,
-        integration=chaos.Integration("dop853", rtol=rtol, atol=rtol * 1e-2),
-        jvp="central",
-    )
+    res = chaos.lyapunov_single(field, y0, t_end, renorm_interval=renorm, rtol=rtol)
     wall = time.perf_counter() - start
     centres, local = chaos.local_exponents(res, window)
     ratio = batch_energy(res.states[:, :, 0].T, params) / chaos.flip_energy_threshold(params)
