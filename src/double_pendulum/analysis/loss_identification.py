@@ -69,6 +69,11 @@ OMEGA_REG = 0.01
 SIM_SETTINGS: dict[str, Any] = {"solver": "dop853", "rtol": 1e-6, "atol": 1e-8, "omega_reg": OMEGA_REG}
 """Integration tolerances: energy errors ~1e-6 J (chi2 changes by < 0.01 against 1e-8), far below
 the effect of a 2 % parameter step (~1e-3 J)."""
+QUICK_SIM_SETTINGS: dict[str, Any] = {**SIM_SETTINGS, "rtol": 1e-5, "atol": 1e-7}
+"""Integration tolerances of the quick fit (a smoke run): energy errors ~1e-4 J, still a tenth of a 2 %
+parameter step's effect, for 0.6 of the CPU per run. Converging at them would stall (Gauss-Newton ran out
+of descent after 25 runs), but the quick fit takes one step (:data:`QUICK_RUN_BUDGET`): chi2 609.3 against
+609.0 at the default settings' converged optimum."""
 DIFF_STEP = 0.02
 """Finite-difference step in x = theta / theta_ref: 2 % of a parameter's reference value."""
 SUSPENSION_K = 2e4
@@ -285,13 +290,16 @@ class FitProblem:
         return self.scaled_residuals(e_sim)[0]
 
 
-def problem_from_track(rec: Reconstruction, md: MeasuredDecay, runner: Any = None) -> FitProblem:
-    """The fit problem of a reconstruction with rods: measured decay ``md``, start state fitted after the release."""
+def problem_from_track(
+    rec: Reconstruction, md: MeasuredDecay, runner: Any = None, *, quick: bool = False
+) -> FitProblem:
+    """The fit problem of a reconstruction with rods: measured decay ``md``, start state fitted after the release;
+    runs at :data:`SIM_SETTINGS` (``quick``: :data:`QUICK_SIM_SETTINGS`)."""
     runner = ComponentRunner() if runner is None else runner
     rods = {k: getattr(rec.params, k) for k in SEED_RIGID_LINKS}
     pendulum = {"l1": rec.params.l1, "l2": rec.params.l2, "m1": rec.params.m1, "m2": rec.params.m2, **rods}
     start = fit_release_state(runner, rec, {**pendulum, "air_drag": True, "rod_drag": True})
-    base = {**SIM_SETTINGS, **pendulum, **start.start_values()}
+    base = {**(QUICK_SIM_SETTINGS if quick else SIM_SETTINGS), **pendulum, **start.start_values()}
     f = md.frames
     return FitProblem(f.t0, np.asarray(f.offsets), np.asarray(f.t), np.asarray(md.energy), np.asarray(f.sigma), base)
 
@@ -893,18 +901,18 @@ def identify_losses(
     runner: Any, *, quick: bool = False, thorough: bool = False, max_workers: int | None = None
 ) -> LossIdentification:
     """Fit every model (:data:`FULL_MODELS`; thorough: :data:`THOROUGH_MODELS`; quick: :data:`QUICK_MODELS`,
-    in this process, with :data:`QUICK_RUN_BUDGET` runs: one Gauss-Newton step) in parallel with the in-process
-    component, compare them, profile the best one (not in quick mode) and re-run it through ``runner`` (the FMU)
-    for the headline numbers. One pool of worker
-    processes serves every round and the profile. All modes fit the whole record (the first 8 s alone
-    leave the losses unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim``
-    obtains its ``air+drag`` by :func:`identified_fit` (the same start and budget in each mode), so it reads
-    this mode's fit."""
+    in this process, at :data:`QUICK_SIM_SETTINGS` with :data:`QUICK_RUN_BUDGET` runs: one Gauss-Newton
+    step) in parallel with the in-process component, compare them, profile the best one (not in quick mode)
+    and re-run it through ``runner`` (the FMU) for the headline numbers. One pool of worker processes serves
+    every round and the profile. All modes fit the whole record (the first 8 s alone leave the losses
+    unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim`` obtains its
+    ``air+drag`` by :func:`identified_fit` from the same problem (:func:`problem_from_track` in the same
+    mode: the same start, budget and settings), so it reads this mode's fit."""
     from .sweep import parallel_map, worker_pool  # noqa: PLC0415 - process pools only when identifying
 
     rec = seed_reconstruction()
     md = measured(rec)
-    problem = problem_from_track(rec, md)
+    problem = problem_from_track(rec, md, quick=quick)
     models = QUICK_MODELS if quick else THOROUGH_MODELS if thorough else FULL_MODELS
     profile: dict[str, Any] = {}
     max_workers = 1 if quick else max_workers  # one model: no worker processes to start
