@@ -60,6 +60,12 @@ EXPECTED_QUICK_CPU_S: dict[str, float] = {
 --quick`` shares the scenarios out among its processes by them and weights its progress bar by them;
 nothing else depends on them. Measure again when a quick run gets cheaper or dearer."""
 
+READS_FITS_OF: dict[str, str] = {"measured_vs_sim": "loss_identification"}
+"""Scenarios that read a fit another scenario caches on disk, by the name of that one: ``measured_vs_sim`` reads
+``loss_identification``'s air+drag fit of the same mode (on a cold cache, without it, it fits it itself: about 7 s
+more CPU in a quick run). ``run all --quick`` runs each in the process of the one it reads from, after it
+(:func:`double_pendulum.scenario_pool.balanced_groups`); :data:`SCENARIOS` lists each after it too."""
+
 FIRST_IN_A_PROCESS = "cosimulation"
 """The scenario that must run before the others when one process runs several (see above)."""
 
