@@ -19,9 +19,9 @@ best one, about 100 s of CPU on one worker process per core (the worker pool is 
 fitting round and the profile). ``thorough`` (``--thorough``) adds air+drag2 (one drag torque per
 joint) and the three-mechanism models air+drag+bearing, air+drag+viscous and air+drag+suspension, with
 30 runs for every fit (about 2 min more CPU; in the last runs they ended at or above their parent's
-optimum, so they change no figure of the default run). ``quick``: air+drag alone in this process, no
-comparison, no profile likelihood (a smoke run; the fit is the one ``measured_vs_sim`` reads from the
-cache).
+optimum, so they change no figure of the default run). ``quick``: air+drag alone in this process, one
+Gauss-Newton step (6 runs) at rtol 1e-5, no comparison, no profile likelihood (a smoke run; the fit is the
+one ``measured_vs_sim`` reads from the cache).
 """
 
 from __future__ import annotations

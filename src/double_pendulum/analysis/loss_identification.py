@@ -72,8 +72,9 @@ the effect of a 2 % parameter step (~1e-3 J)."""
 QUICK_SIM_SETTINGS: dict[str, Any] = {**SIM_SETTINGS, "rtol": 1e-5, "atol": 1e-7}
 """Integration tolerances of the quick fit (a smoke run): energy errors ~1e-4 J, still a tenth of a 2 %
 parameter step's effect, for 0.6 of the CPU per run. Converging at them would stall (Gauss-Newton ran out
-of descent after 25 runs), but the quick fit takes one step (:data:`QUICK_RUN_BUDGET`): chi2 609.3 against
-609.0 at the default settings' converged optimum."""
+of descent after 25 runs), but the quick fit takes one step (:data:`QUICK_RUN_BUDGET`), whose direction the
+integration noise turns: chi2 609.3 to 610.1 in trials (air factor 1.5 to 1.7, tau_b 1.2 to 1.3 mN.m)
+against 608.9 at the default settings' converged optimum, about one standard error away."""
 DIFF_STEP = 0.02
 """Finite-difference step in x = theta / theta_ref: 2 % of a parameter's reference value."""
 SUSPENSION_K = 2e4
@@ -191,8 +192,8 @@ QUICK_MODELS: tuple[str, ...] = ("air+drag",)
 QUICK_RUN_BUDGET = 6
 """Runs of each quick fit (:func:`fit_models` with ``max_runs``; the default and thorough fits: up to 30): the
 residuals at the references, their Jacobian, one Gauss-Newton step and the Jacobian there, so the fit stops
-at ``"run limit"`` after one step. On the seed's record air+drag then ends at chi2 609.2 against 609.0 at its
-converged optimum (9 runs; well within a standard error), for two thirds of the CPU (about 5 s less)."""
+at ``"run limit"`` after one step. On the seed's record air+drag then ends at chi2 609.2 against 608.9 at its
+converged optimum (9 runs, both at :data:`SIM_SETTINGS`), for two thirds of the CPU."""
 
 def mechanisms_of(model: str) -> list[Mechanism]:
     """The mechanisms of a model name such as ``"air+drag"``."""
