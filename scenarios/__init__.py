@@ -44,19 +44,20 @@ each, 2026-12-02): ``run all`` starts the longest first and weights its progress
 depends on them."""
 
 EXPECTED_QUICK_CPU_S: dict[str, float] = {
-    "cosimulation": 7.6,
-    "free_swing": 2.9,
-    "friction_budget": 1.9,
+    "cosimulation": 6.2,
+    "free_swing": 2.2,
+    "friction_budget": 1.7,
     "energy_decay": 1.7,
-    "loss_identification": 13.3,
-    "suspension_transfer": 16.4,
-    "measured_vs_sim": 5.4,
+    "loss_identification": 7.6,
+    "suspension_transfer": 13.5,
+    "measured_vs_sim": 5.9,
     "work_precision": 0.8,
     "stability": 4.3,
-    "chaos": 14.0,
-    "base_excitation": 5.6,
+    "chaos": 10.5,
+    "base_excitation": 5.5,
 }
-"""CPU time [s] of each scenario's quick run (``--quick``), as last measured (2 cores): ``run all
+"""CPU time [s] of each scenario's quick run (``--quick``), as last measured (2 cores, ``run all --quick``
+on a fresh cache, 2026-12-02; ``measured_vs_sim`` reading ``loss_identification``'s fit): ``run all
 --quick`` shares the scenarios out among its processes by them and weights its progress bar by them;
 nothing else depends on them. Measure again when a quick run gets cheaper or dearer."""
 
