@@ -295,11 +295,12 @@ def problem_from_track(
     rec: Reconstruction, md: MeasuredDecay, runner: Any = None, *, quick: bool = False
 ) -> FitProblem:
     """The fit problem of a reconstruction with rods: measured decay ``md``, start state fitted after the release;
-    runs at :data:`SIM_SETTINGS` (``quick``: :data:`QUICK_SIM_SETTINGS`)."""
+    runs at :data:`SIM_SETTINGS` (``quick``: :data:`QUICK_SIM_SETTINGS`, the start state fitted as
+    :func:`~double_pendulum.analysis.suspension_identification.fit_release_state` does in a quick run)."""
     runner = ComponentRunner() if runner is None else runner
     rods = {k: getattr(rec.params, k) for k in SEED_RIGID_LINKS}
     pendulum = {"l1": rec.params.l1, "l2": rec.params.l2, "m1": rec.params.m1, "m2": rec.params.m2, **rods}
-    start = fit_release_state(runner, rec, {**pendulum, "air_drag": True, "rod_drag": True})
+    start = fit_release_state(runner, rec, {**pendulum, "air_drag": True, "rod_drag": True}, quick=quick)
     base = {**(QUICK_SIM_SETTINGS if quick else SIM_SETTINGS), **pendulum, **start.start_values()}
     f = md.frames
     return FitProblem(f.t0, np.asarray(f.offsets), np.asarray(f.t), np.asarray(md.energy), np.asarray(f.sigma), base)
