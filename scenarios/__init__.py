@@ -44,20 +44,20 @@ each, 2026-12-02): ``run all`` starts the longest first and weights its progress
 depends on them."""
 
 EXPECTED_QUICK_CPU_S: dict[str, float] = {
-    "cosimulation": 6.2,
+    "cosimulation": 5.2,
     "free_swing": 2.2,
     "friction_budget": 1.7,
-    "energy_decay": 1.7,
-    "loss_identification": 7.6,
-    "suspension_transfer": 13.5,
-    "measured_vs_sim": 5.9,
-    "work_precision": 0.8,
-    "stability": 4.3,
-    "chaos": 10.5,
-    "base_excitation": 5.5,
+    "energy_decay": 1.6,
+    "loss_identification": 7.0,
+    "suspension_transfer": 13.2,
+    "measured_vs_sim": 5.8,
+    "work_precision": 0.9,
+    "stability": 4.0,
+    "chaos": 10.7,
+    "base_excitation": 5.3,
 }
 """CPU time [s] of each scenario's quick run (``--quick``), as last measured (2 cores, ``run all --quick``
-on a fresh cache, 2026-12-02; ``measured_vs_sim`` reading ``loss_identification``'s fit): ``run all
+on a fresh cache, mean of 6 runs, 2026-12-02; ``measured_vs_sim`` reading ``loss_identification``'s fit): ``run all
 --quick`` shares the scenarios out among its processes by them and weights its progress bar by them;
 nothing else depends on them. Measure again when a quick run gets cheaper or dearer."""
 
