@@ -44,21 +44,28 @@ each, 2026-12-02): ``run all`` starts the longest first and weights its progress
 depends on them."""
 
 EXPECTED_QUICK_CPU_S: dict[str, float] = {
-    "cosimulation": 7.6,
-    "free_swing": 2.9,
-    "friction_budget": 1.9,
-    "energy_decay": 1.7,
-    "loss_identification": 13.3,
-    "suspension_transfer": 16.4,
-    "measured_vs_sim": 5.4,
-    "work_precision": 0.8,
-    "stability": 4.3,
-    "chaos": 14.0,
-    "base_excitation": 5.6,
+    "cosimulation": 5.2,
+    "free_swing": 2.2,
+    "friction_budget": 1.7,
+    "energy_decay": 1.6,
+    "loss_identification": 7.0,
+    "suspension_transfer": 13.2,
+    "measured_vs_sim": 5.8,
+    "work_precision": 0.9,
+    "stability": 4.0,
+    "chaos": 10.7,
+    "base_excitation": 5.3,
 }
-"""CPU time [s] of each scenario's quick run (``--quick``), as last measured (2 cores): ``run all
+"""CPU time [s] of each scenario's quick run (``--quick``), as last measured (2 cores, ``run all --quick``
+on a fresh cache, mean of 6 runs, 2026-12-02; ``measured_vs_sim`` reading ``loss_identification``'s fit): ``run all
 --quick`` shares the scenarios out among its processes by them and weights its progress bar by them;
 nothing else depends on them. Measure again when a quick run gets cheaper or dearer."""
+
+READS_FITS_OF: dict[str, str] = {"measured_vs_sim": "loss_identification"}
+"""Scenarios that read a fit another scenario caches on disk, by the name of that one: ``measured_vs_sim`` reads
+``loss_identification``'s air+drag fit of the same mode (on a cold cache, without it, it fits it itself: about 7 s
+more CPU in a quick run). ``run all --quick`` runs each in the process of the one it reads from, after it
+(:func:`double_pendulum.scenario_pool.balanced_groups`); :data:`SCENARIOS` lists each after it too."""
 
 FIRST_IN_A_PROCESS = "cosimulation"
 """The scenario that must run before the others when one process runs several (see above)."""

@@ -48,7 +48,7 @@ FULL = Plan(
     None,
 )
 QUICK = Plan(
-    study.KapitzaSetup(stop_time=2.5, steps_per_period=20, iterations=4),
+    study.KapitzaSetup(stop_time=2.5, steps_per_period=20, iterations=3),
     study.AchesonSetup(omegas=(100.0, 200.0), amplitudes=(0.005, 0.02, 0.04), stop_time=1.0,
                        example_amplitudes=(0.022,), example_stop_time=1.0),
     study.ResonanceSetup(settle_time=6.0, window=4.0, step=0.025, n_broad=3, offsets=(-0.025, 0.0, 0.025)),

@@ -20,8 +20,9 @@ process per core (the worker pool is started once for every fitting round). ``th
 air+drag+bearing, air+drag+viscous and air+drag+suspension, with 30 runs for every fit, and the best
 model's profile likelihood (about 2.5 min more CPU; in the last runs the added models ended at or above
 their parent's optimum, so they change no figure of the default run, and the profile intervals matched
-the curvature errors). ``quick``: air+drag alone in this process, no comparison, no profile likelihood
-(a smoke run; the fit is the one ``measured_vs_sim`` reads from the cache).
+the curvature errors). ``quick``: air+drag alone in this process, one Gauss-Newton step (6 runs) at
+rtol 1e-5, no comparison, no profile likelihood (a smoke run; the fit is the one ``measured_vs_sim``
+reads from the cache).
 """
 
 from __future__ import annotations

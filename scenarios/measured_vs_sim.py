@@ -39,8 +39,9 @@ fitted start (frictionless, rods, :data:`LYAPUNOV_S` s; quick: :data:`QUICK_LYAP
 Cost: about 21 s of CPU by default once ``loss_identification`` has cached its fits (about 34 s on a first
 run that fits the losses itself). ``thorough`` (``--thorough``) adds the fit-window check (the start and
 geometry fitted again to the first :data:`WINDOW_SENSITIVITY` frames, about 35 s of CPU) and averages the
-Lyapunov exponent over :data:`THOROUGH_LYAPUNOV_S` s (5 s more). ``quick``: a 4 s prediction, the geometry
-fitted to :data:`QUICK_GEOMETRY_FIT_FRAMES` frames, a 10 s Lyapunov exponent.
+Lyapunov exponent over :data:`THOROUGH_LYAPUNOV_S` s (5 s more). ``quick``: a 3 s prediction, the geometry
+fitted to :data:`QUICK_GEOMETRY_FIT_FRAMES` frames, :data:`QUICK_ENSEMBLE_SIZE` ensemble runs, a 10 s
+Lyapunov exponent.
 
 Outputs in ``results/measured_vs_sim/``: one CSV per run (FMU outputs from t0), ``errors.csv``
 (track and position errors per frame), ``coordinates.png`` (x1, y1, x2, y2 measured and simulated,
@@ -105,7 +106,7 @@ QUICK_GEOMETRY_FIT_FRAMES = 15
 """Frames the quick run fits the start and geometry to (0.5 s: a smoke run of the fit, a third of its cost)."""
 PREDICTION_S = 20.0
 """Length [s] of each prediction, to the end of the track (quick: :data:`QUICK_PREDICTION_S`)."""
-QUICK_PREDICTION_S = 4.0
+QUICK_PREDICTION_S = 3.0
 COORDINATES_S = 10.0
 """Seconds after t0 shown in ``coordinates.png`` (the whole prediction would crowd the swings)."""
 WINDOW_SENSITIVITY = (15, 30, 60)
@@ -123,7 +124,7 @@ QUICK_LYAPUNOV_S = 10.0
 THOROUGH_LYAPUNOV_S = 100.0
 ENSEMBLE_SIZE = 6
 """FMU runs drawn from the covariance of the start and geometry (quick: :data:`QUICK_ENSEMBLE_SIZE`)."""
-QUICK_ENSEMBLE_SIZE = 4
+QUICK_ENSEMBLE_SIZE = 3
 
 
 def _plots(

@@ -242,5 +242,5 @@ def test_chaos_scenario_writes_results_plots_and_summary(quick_results):
     nominal = read_results_csv(tmp_path / "nominal.csv")
     assert nominal["phi1"][0] == scenario.DEFAULT_START["phi1_0"]
     fmap = read_results_csv(tmp_path / "flip_map.csv")
-    assert len(fmap) == 24 * 24
+    assert len(fmap) == scenario.QUICK.flip_n**2
     assert set(np.unique(fmap["flipped_rod"])) <= {0.0, 1.0, 2.0}

@@ -211,7 +211,8 @@ def test_identified_fit_fits_a_model_as_the_identification_of_its_mode_does(monk
     monkeypatch.setattr(li, "fit_item", fake_fit_item)
     models = li.QUICK_MODELS if quick else li.FULL_MODELS
     problem = object()  # never simulated: the fake fits only record their items
-    li.fit_models(models, problem, max_workers=1)  # the identification's rounds (identify_losses, short=True)
+    # the identification's rounds (identify_losses: short=True, the mode's run budget)
+    li.fit_models(models, problem, max_workers=1, max_runs=li.run_budget(quick))
     identification = {i.model: i for i in items}
     items.clear()
     fit = li.identified_fit("air+drag", problem, quick=quick)
@@ -219,5 +220,6 @@ def test_identified_fit_fits_a_model_as_the_identification_of_its_mode_does(monk
     assert {i.model for i in items} == ({"air+drag"} if quick else {"air", "drag", "air+drag"})
     assert items[-1] == identification["air+drag"]
     assert bool(items[-1].starts) != quick  # default: warm-started from a one-mechanism fit; quick: references
+    assert items[-1].max_nfev == (li.QUICK_RUN_BUDGET if quick else 30)  # quick: one Gauss-Newton step
     with pytest.raises(ValueError):
         li.identified_fit("air+drag+bearing", problem)

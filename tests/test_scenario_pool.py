@@ -50,6 +50,22 @@ def test_a_quick_run_shares_the_scenarios_out_longest_first_to_the_least_loaded(
     ]
 
 
+def test_a_quick_run_keeps_a_scenario_that_reads_a_cached_fit_after_the_one_that_writes_it(monkeypatch):
+    for jobs in (1, 2, 3, 4):  # the real pair: measured_vs_sim reads loss_identification's fit
+        host = next(group for group in scenario_pool.scenario_groups(SCENARIOS, quick=True, jobs=jobs)
+                    if "loss_identification" in group)
+        assert host.index("measured_vs_sim") > host.index("loss_identification")
+    costs = {"a": 5.0, "writer": 4.0, "b": 3.5, "reader": 3.0, "cosimulation": 1.0}
+    monkeypatch.setattr(scenario_pool, "EXPECTED_QUICK_CPU_S", costs)
+    monkeypatch.setattr(scenario_pool, "READS_FITS_OF", {"reader": "writer"})
+    # alone the reader would join a (a 5 | writer 4 | b -> 7.5 | reader -> a 8); as a unit: writer + reader 7 | a 5
+    # | b -> a 8.5 | cosimulation -> 8
+    assert scenario_pool.scenario_groups(list(costs), quick=True, jobs=2) == [
+        ["a", "b"], ["cosimulation", "writer", "reader"]]
+    assert scenario_pool.scenario_groups(["a", "reader", "cosimulation"], quick=True, jobs=2) == [
+        ["a"], ["cosimulation", "reader"]]  # without its writer the reader is placed alone
+
+
 @pytest.mark.parametrize("jobs", [1, 2, 3, 4, 11, 20])
 def test_quick_groups_hold_every_scenario_once_balanced_and_cosimulation_first(jobs):
     groups = scenario_pool.scenario_groups(SCENARIOS, quick=True, jobs=jobs)

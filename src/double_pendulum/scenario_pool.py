@@ -14,7 +14,8 @@ last, and a scenario cannot disturb another's process; only the small ones (unde
 each running its share of the scenarios one after another (:func:`scenario_groups`: balanced by
 :data:`double_pendulum.scenarios.EXPECTED_QUICK_CPU_S`, ``cosimulation`` first in its group, as
 libcosim and fmpy's container FMU failed to load their FMUs in a process that had already run the
-pythonfmu FMU).
+pythonfmu FMU; ``measured_vs_sim`` after ``loss_identification`` in the same group, so it reads that one's
+cached fit instead of fitting it again, :data:`double_pendulum.scenarios.READS_FITS_OF`).
 
 The children's lines reach the terminal as they come, each marked with the name of the scenario
 running in its child (a child's header line ``[k/N] NAME: ...`` says which); their progress
@@ -40,7 +41,7 @@ from .analysis.progress import ENV as PROGRESS_ENV
 from .analysis.progress import progress_bar, write_line
 from .analysis.sweep import WORKERS_ENV
 from .scenario_lines import FAILED, WROTE, failed_line, header_name, outcome
-from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, in_process_order
+from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF, in_process_order
 
 POLL_S = 0.2
 """How often [s] the parent looks for finished children."""
@@ -58,16 +59,32 @@ def longest_first(names: Sequence[str], quick: bool = False) -> list[str]:
     return sorted(names, key=lambda name: -expected_cpu_s(name, quick))
 
 
+def _units(names: Sequence[str]) -> list[list[str]]:
+    """``names`` (longest first) as the units :func:`balanced_groups` places: one scenario each, except that a
+    scenario reading another's cached fit (:data:`~double_pendulum.scenarios.READS_FITS_OF`) follows that one
+    in its unit, if both are in ``names``."""
+    order = longest_first(names, quick=True)
+    units = {name: [name] for name in order if READS_FITS_OF.get(name) not in order}
+    for name in order:
+        if name not in units:
+            units[READS_FITS_OF[name]].append(name)
+    return list(units.values())
+
+
 def balanced_groups(names: Sequence[str], count: int) -> list[list[str]]:
-    """``names`` shared out among ``count`` groups of about equal expected quick-run CPU time: each
-    scenario, longest first, joins the group with the least so far. Within a group ``cosimulation``
-    comes first, the others longest first; the groups come largest first; none is empty."""
-    groups: list[list[str]] = [[] for _ in range(max(1, min(count, len(names))))]
+    """``names`` shared out among ``count`` groups of about equal expected quick-run CPU time: each unit
+    (a scenario; with fewer groups than scenarios, a scenario and those reading its cached fit,
+    :func:`_units`), the longest first, joins the group with the least so far. Within a group
+    ``cosimulation`` comes first, the others in the order they joined (a reader after the scenario it
+    reads from); the groups come largest first; none is empty."""
+    units = _units(names) if count < len(names) else [[name] for name in longest_first(names, quick=True)]
+    units.sort(key=lambda unit: -sum(expected_cpu_s(name, quick=True) for name in unit))  # stable: ties keep order
+    groups: list[list[str]] = [[] for _ in range(max(1, min(count, len(units))))]
     totals = [0.0] * len(groups)
-    for name in longest_first(names, quick=True):
+    for unit in units:
         least = totals.index(min(totals))
-        groups[least].append(name)
-        totals[least] += expected_cpu_s(name, quick=True)
+        groups[least] += unit
+        totals[least] += sum(expected_cpu_s(name, quick=True) for name in unit)
     order = sorted(range(len(groups)), key=lambda k: -totals[k])
     return [in_process_order(groups[k]) for k in order if groups[k]]
 

@@ -52,7 +52,7 @@ import itertools
 import json
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -69,6 +69,12 @@ OMEGA_REG = 0.01
 SIM_SETTINGS: dict[str, Any] = {"solver": "dop853", "rtol": 1e-6, "atol": 1e-8, "omega_reg": OMEGA_REG}
 """Integration tolerances: energy errors ~1e-6 J (chi2 changes by < 0.01 against 1e-8), far below
 the effect of a 2 % parameter step (~1e-3 J)."""
+QUICK_SIM_SETTINGS: dict[str, Any] = {**SIM_SETTINGS, "rtol": 1e-5, "atol": 1e-7}
+"""Integration tolerances of the quick fit (a smoke run): energy errors ~1e-4 J, still a tenth of a 2 %
+parameter step's effect, for 0.6 of the CPU per run. Converging at them would stall (Gauss-Newton ran out
+of descent after 25 runs), but the quick fit takes one step (:data:`QUICK_RUN_BUDGET`), whose direction the
+integration noise turns: chi2 609.3 to 610.1 in trials (air factor 1.5 to 1.7, tau_b 1.2 to 1.3 mN.m)
+against 608.9 at the default settings' converged optimum, about one standard error away."""
 DIFF_STEP = 0.02
 """Finite-difference step in x = theta / theta_ref: 2 % of a parameter's reference value."""
 SUSPENSION_K = 2e4
@@ -183,6 +189,11 @@ loss; in the last default run two of them ended at their parent's optimum and th
 it, at about 90 s of CPU together)."""
 QUICK_MODELS: tuple[str, ...] = ("air+drag",)
 """Models of the quick identification (a smoke run: the best model alone, no comparison)."""
+QUICK_RUN_BUDGET = 6
+"""Runs of each quick fit (:func:`fit_models` with ``max_runs``; the default and thorough fits: up to 30): the
+residuals at the references, their Jacobian, one Gauss-Newton step and the Jacobian there, so the fit stops
+at ``"run limit"`` after one step. On the seed's record air+drag then ends at chi2 609.2 against 608.9 at its
+converged optimum (9 runs, both at :data:`SIM_SETTINGS`), for two thirds of the CPU."""
 
 def mechanisms_of(model: str) -> list[Mechanism]:
     """The mechanisms of a model name such as ``"air+drag"``."""
@@ -280,13 +291,17 @@ class FitProblem:
         return self.scaled_residuals(e_sim)[0]
 
 
-def problem_from_track(rec: Reconstruction, md: MeasuredDecay, runner: Any = None) -> FitProblem:
-    """The fit problem of a reconstruction with rods: measured decay ``md``, start state fitted after the release."""
+def problem_from_track(
+    rec: Reconstruction, md: MeasuredDecay, runner: Any = None, *, quick: bool = False
+) -> FitProblem:
+    """The fit problem of a reconstruction with rods: measured decay ``md``, start state fitted after the release;
+    runs at :data:`SIM_SETTINGS` (``quick``: :data:`QUICK_SIM_SETTINGS`, the start state fitted as
+    :func:`~double_pendulum.analysis.suspension_identification.fit_release_state` does in a quick run)."""
     runner = ComponentRunner() if runner is None else runner
     rods = {k: getattr(rec.params, k) for k in SEED_RIGID_LINKS}
     pendulum = {"l1": rec.params.l1, "l2": rec.params.l2, "m1": rec.params.m1, "m2": rec.params.m2, **rods}
-    start = fit_release_state(runner, rec, {**pendulum, "air_drag": True, "rod_drag": True})
-    base = {**SIM_SETTINGS, **pendulum, **start.start_values()}
+    start = fit_release_state(runner, rec, {**pendulum, "air_drag": True, "rod_drag": True}, quick=quick)
+    base = {**(QUICK_SIM_SETTINGS if quick else SIM_SETTINGS), **pendulum, **start.start_values()}
     f = md.frames
     return FitProblem(f.t0, np.asarray(f.offsets), np.asarray(f.t), np.asarray(md.energy), np.asarray(f.sigma), base)
 
@@ -519,20 +534,29 @@ def fit_item_of(model: str, fits: Sequence[ModelFit], *, short: bool = True) -> 
     return FitItem(model, warm_starts(model, parent), SHORT_RUN_BUDGET if short else 30)
 
 
+def run_budget(quick: bool) -> int | None:
+    """The run budget :func:`fit_models` imposes on every fit of a mode: :data:`QUICK_RUN_BUDGET` in a quick run,
+    none otherwise (each fit item's own, :func:`fit_item_of`)."""
+    return QUICK_RUN_BUDGET if quick else None
+
+
 def fit_models(
     models: Sequence[str], problem: FitProblem, max_workers: int | None = None, pool: Any = None,
-    *, short: bool = True,
+    *, short: bool = True, max_runs: int | None = None,
 ) -> tuple[list[ModelFit], int]:
     """Fit every model, in rounds by :func:`model_rank`: one-mechanism models from the references, each
     larger one warm-started from the best-fitting model of an earlier round nested in it
     (:func:`fit_item_of`); the models of a round are fitted in parallel (on ``pool``'s workers if given,
-    a :func:`~double_pendulum.analysis.sweep.worker_pool`); ``short``: see :func:`fit_item_of`."""
+    a :func:`~double_pendulum.analysis.sweep.worker_pool`); ``short``: see :func:`fit_item_of`;
+    ``max_runs``: every fit's run budget instead of its item's (the quick run's, :func:`run_budget`)."""
     from .sweep import parallel_map  # noqa: PLC0415 - process pools only when identifying
 
     fits: list[ModelFit] = []
     workers = 1
     for rank in sorted({model_rank(m) for m in models}):
         items = [fit_item_of(m, fits, short=short) for m in models if model_rank(m) == rank]
+        if max_runs is not None:
+            items = [replace(item, max_nfev=max_runs) for item in items]
         more, used = parallel_map(fit_item, items, shared=problem, max_workers=max_workers, label="loss models",
                                   pool=pool)  # fmt: skip
         fits += more
@@ -549,7 +573,7 @@ def identified_fit(model: str, problem: FitProblem, *, quick: bool = False) -> M
     if model not in models:
         raise ValueError(f"{model!r} is not fitted by the {'quick' if quick else 'default'} identification {models}")
     needed = [m for m in models if m == model or contains(model, m)]
-    fits, _ = fit_models(needed, problem, max_workers=1)
+    fits, _ = fit_models(needed, problem, max_workers=1, max_runs=run_budget(quick))
     return next(f for f in fits if f.model == model)
 
 
@@ -879,23 +903,24 @@ def identify_losses(
     runner: Any, *, quick: bool = False, thorough: bool = False, max_workers: int | None = None
 ) -> LossIdentification:
     """Fit every model (:data:`FULL_MODELS`; thorough: :data:`THOROUGH_MODELS`; quick: :data:`QUICK_MODELS`,
-    in this process) in parallel with the in-process component, compare them, profile the best one (thorough
-    mode only: in the runs so far its intervals matched the curvature errors', for 8 more fits, about 18 s of
-    CPU) and re-run it through ``runner`` (the FMU) for the headline numbers. One pool of worker processes
-    serves every round and the profile. All modes fit the whole record (the first 8 s alone
-    leave the losses unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim``
-    obtains its ``air+drag`` by :func:`identified_fit` (the same start and budget in each mode), so it reads
-    this mode's fit."""
+    in this process, at :data:`QUICK_SIM_SETTINGS` with :data:`QUICK_RUN_BUDGET` runs: one Gauss-Newton
+    step) in parallel with the in-process component, compare them, profile the best one (thorough mode only:
+    in the runs so far its intervals matched the curvature errors, for 8 more fits, about 18 s of CPU) and
+    re-run it through ``runner`` (the FMU) for the headline numbers. One pool of worker processes serves
+    every round and the profile. All modes fit the whole record (the first 8 s alone leave the losses
+    unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim`` obtains its
+    ``air+drag`` by :func:`identified_fit` from the same problem (:func:`problem_from_track` in the same
+    mode: the same start, budget and settings), so it reads this mode's fit."""
     from .sweep import parallel_map, worker_pool  # noqa: PLC0415 - process pools only when identifying
 
     rec = seed_reconstruction()
     md = measured(rec)
-    problem = problem_from_track(rec, md)
+    problem = problem_from_track(rec, md, quick=quick)
     models = QUICK_MODELS if quick else THOROUGH_MODELS if thorough else FULL_MODELS
     profile: dict[str, Any] = {}
     max_workers = 1 if quick else max_workers  # one model: no worker processes to start
     with worker_pool(max_workers) as pool:
-        fits, workers = fit_models(models, problem, max_workers, pool, short=not thorough)
+        fits, workers = fit_models(models, problem, max_workers, pool, short=not thorough, max_runs=run_budget(quick))
         factor = common_factor(fits)
         rows = comparison_rows(fits, factor)
         best = next(f for f in fits if f.model == rows[0]["model"])

@@ -94,8 +94,8 @@ def report_text(s: Mapping[str, Any]) -> str:
     air = s["air_drag_at_defaults"]
     err = s.get("shares_stderr", {})
     shares = ", ".join(f"{k} {v:.0%} +- {err.get(k, 0.0):.0%}" for k, v in s["shares"].items())
-    mode = (" (quick mode, a smoke run: air+drag alone, no comparison, no profiles; its errors are the curvature"
-            " errors of one fit)" if s["quick"] else
+    mode = (" (quick mode, a smoke run: air+drag alone, one Gauss-Newton step at rtol 1e-5, no comparison, no"
+            " profiles; its errors are the curvature errors of that step)" if s["quick"] else
             " (thorough: with air+drag2, the three-mechanism models and the profile likelihood)"
             if s.get("thorough") else
             " (default run: one and two mechanisms; `--thorough` adds air+drag2, the three-mechanism models"

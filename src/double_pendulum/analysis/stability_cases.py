@@ -29,7 +29,7 @@ STIFF_SUSPENSION = {"suspension": True, "M_s": 0.01, "k_x": 1e8, "k_y": 1e8, "c_
 STUCK = {"phi1_0": 5e-4, "phi2_0": 0.0, "bearing_friction": True, "c_R1": 0.05, "c_R2": 0.05, "omega_reg": 1e-6}
 STICK = {"phi1_0": 0.05, "phi2_0": 0.03, "bearing_friction": True, "c_R1": 0.05, "c_R2": 0.05, "omega_reg": 1e-6}
 STIFF_STOP = 0.5  # s, stiff-suspension cases: the first half swing, ~1000 suspension periods at k = 1e8 N/m
-QUICK_STIFF_STOP = 0.05  # s, the same in a quick run (a smoke test: ~100 suspension periods)
+QUICK_STIFF_STOP = 0.02  # s, the same in a quick run (a smoke test: ~40 suspension periods at k = 1e8 N/m)
 
 
 @dataclass(frozen=True)

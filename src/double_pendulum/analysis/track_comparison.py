@@ -210,11 +210,11 @@ class IdentifiedLosses:
 def identified_losses(rec: Reconstruction, window_s: float | None = None, *, quick: bool = False) -> IdentifiedLosses:
     """Fit :data:`LOSS_MODEL` to the measured energy decay of ``rec`` (a reconstruction with rods),
     in-process, the way the ``loss_identification`` scenario's run in the same mode (``quick``) fits it
-    (:func:`~double_pendulum.analysis.loss_identification.identified_fit`: the same start and run budget,
-    so the cached fit of either scenario serves the other); ``window_s``: only the first seconds after the
-    release (None: the whole record)."""
+    (:func:`~double_pendulum.analysis.loss_identification.identified_fit`: the same start, run budget and
+    integration settings, so the cached fit of either scenario serves the other); ``window_s``: only the
+    first seconds after the release (None: the whole record)."""
     md = loss_identification.measured(rec, window_s)
-    problem = loss_identification.problem_from_track(rec, md)
+    problem = loss_identification.problem_from_track(rec, md, quick=quick)
     fit = loss_identification.identified_fit(LOSS_MODEL, problem, quick=quick)
     factor = loss_identification.common_factor([fit])
     pendulum = {k: problem.base[k] for k in ("l1", "l2", "m1", "m2", *SEED_RIGID_LINKS)}

@@ -22,26 +22,46 @@ DRAFT_DPI = 60
 figure's cost."""
 _SAVE_DPI: ContextVar[int] = ContextVar("save_dpi", default=FIGURE_DPI)
 """The resolution :func:`save` uses now (this package's own setting: matplotlib's rcParams stay the user's)."""
+_DRAFT: ContextVar[bool] = ContextVar("draft_figures", default=False)
+"""Whether :func:`save` writes draft figures now (:func:`draft_figures`)."""
+DRAFT_PAD_INCHES = 0.1
+"""Margin [in] around a draft figure's content (matplotlib's default ``savefig.pad_inches``)."""
+DRAFT_SPACING: dict[str, float] = {"hspace": 0.5, "wspace": 0.35}
+"""Space between the subplots of a draft figure (fractions of the mean axes height and width), instead of
+``tight_layout``'s measured spacing: room for a title above and tick labels and an axis label below."""
 
 
 @contextmanager
 def draft_figures(draft: bool = True) -> Iterator[None]:
-    """Within the block, :func:`save` writes figures at :data:`DRAFT_DPI` (if ``draft``), as quick runs do."""
+    """Within the block, :func:`save` writes draft figures (if ``draft``), as quick runs do: at :data:`DRAFT_DPI`,
+    and laid out once (see :func:`save`)."""
     token = _SAVE_DPI.set(DRAFT_DPI if draft else FIGURE_DPI)
+    token_draft = _DRAFT.set(draft)
     try:
         yield
     finally:
+        _DRAFT.reset(token_draft)
         _SAVE_DPI.reset(token)
 
 
 def save(fig: plt.Figure, path: str | Path) -> Path:
     """Write ``fig`` as a PNG (:data:`FIGURE_DPI`, :data:`DRAFT_DPI` in :func:`draft_figures`) cropped to
-    its content, legends outside the axes included; close it."""
+    its content, legends outside the axes included; close it.
+
+    A figure is laid out by ``tight_layout`` (unless it has a layout engine of its own) and cropped by
+    ``bbox_inches="tight"``, which draws it once more without rendering to find its extent. A draft figure
+    without a layout engine skips both: its extent is measured once (``get_tightbbox``, no drawing) and it is
+    drawn once, about half the CPU time of a figure (the subplots spaced by :data:`DRAFT_SPACING`)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    if fig.get_layout_engine() is None:
-        fig.tight_layout()
-    fig.savefig(path, dpi=_SAVE_DPI.get(), bbox_inches="tight")
+    if _DRAFT.get() and fig.get_layout_engine() is None:
+        fig.subplots_adjust(**DRAFT_SPACING)
+        bbox = fig.get_tightbbox(fig.canvas.get_renderer()).padded(DRAFT_PAD_INCHES)
+        fig.savefig(path, dpi=_SAVE_DPI.get(), bbox_inches=bbox)
+    else:
+        if fig.get_layout_engine() is None:
+            fig.tight_layout()
+        fig.savefig(path, dpi=_SAVE_DPI.get(), bbox_inches="tight")
     plt.close(fig)
     return path
 
