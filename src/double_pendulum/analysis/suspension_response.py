@@ -32,7 +32,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.signal import welch
 
 from ..fmu.runner import FmuRunner
 
@@ -96,6 +95,8 @@ class ForceSpectrum:
 
 def psd(signal: np.ndarray, omega: np.ndarray, sample_rate: float = FORCE_SAMPLE_RATE) -> np.ndarray:
     """Welch one-sided PSD [unit^2 s/rad] of ``signal`` (mean removed), interpolated onto ``omega`` [rad/s]."""
+    from scipy.signal import welch  # noqa: PLC0415 - scipy.signal takes a second to import; only the spectrum needs it
+
     f, s = welch(signal - np.mean(signal), fs=sample_rate, nperseg=min(WELCH_SEGMENT, len(signal)))
     return np.interp(omega, 2.0 * math.pi * f, s / (2.0 * math.pi), right=0.0)
 

@@ -10,7 +10,6 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import patheffects
 from matplotlib.colors import Normalize
-from scipy.interpolate import PchipInterpolator, interp1d
 
 from .style import legend_below, legend_outside, running_mean, save
 
@@ -124,6 +123,8 @@ def smooth_log_field(
 
 def _interp_axis(values: np.ndarray, x: np.ndarray, x_new: np.ndarray, axis: int) -> np.ndarray:
     """``values`` interpolated along ``axis`` from ``x`` to ``x_new``: PCHIP with 3 or more points, else linear."""
+    from scipy.interpolate import PchipInterpolator, interp1d  # noqa: PLC0415 - only the decay-rate map needs it
+
     if x.size >= 3:
         return PchipInterpolator(x, values, axis=axis)(x_new)
     return interp1d(x, values, axis=axis)(x_new)
