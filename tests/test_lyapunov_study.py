@@ -49,6 +49,8 @@ def test_integrations_agree_on_the_chaotic_cloud_and_the_summary_reports_their_d
     assert summary["two_trajectory_rk4_cloud_mean"] == pytest.approx(cloud["rk4_h"].mean(), rel=1e-3)
     table, units = lyapunov_study.convergence_table(comparison)
     np.testing.assert_array_equal(table["lambda_dop853_cloud_mean"], comparison.cloud_running()["dop853"])
+    np.testing.assert_array_equal(table["lambda_two_trajectory_rk4_cloud_mean"], comparison.two_trajectory.mean(axis=1))
+    assert table["lambda_two_trajectory_rk4_cloud_mean"][-1] == pytest.approx(summary["two_trajectory_rk4_cloud_mean"])
     assert set(units.values()) == {"1/s"}
 
 

@@ -103,14 +103,17 @@ def compare_integrations(
 
 
 def convergence_table(cmp: IntegrationComparison) -> tuple[np.ndarray, dict[str, str]]:
-    """Running estimates [1/s] of the nominal start and of the cloud mean, per integration: table and units."""
+    """Running estimates [1/s] of the nominal start and of the cloud mean, per integration, and the cloud mean
+    of the two-trajectory estimate: table and units."""
     columns = {f"lambda_{n}_nominal": v for n, v in cmp.nominal_running().items()}
     columns.update({f"lambda_{n}_cloud_mean": v for n, v in cmp.cloud_running().items()})
+    columns["lambda_two_trajectory_rk4_cloud_mean"] = cmp.two_trajectory.mean(axis=1)
     return table_from_columns(time=cmp.times, **columns), {k: "1/s" for k in columns}
 
 
 def convergence_curves(cmp: IntegrationComparison, cloud_label: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Labelled ``(times [s], running estimate [1/s])`` for the nominal start and the cloud mean."""
+    """Labelled ``(times [s], running estimate [1/s])`` for the nominal start and the cloud mean per integration,
+    and the cloud mean of the two-trajectory estimate."""
     curves = {f"{cmp.integrations[n].label()}, default start": (cmp.times, v) for n, v in cmp.nominal_running().items()}
     curves.update(
         {
@@ -118,6 +121,8 @@ def convergence_curves(cmp: IntegrationComparison, cloud_label: str) -> dict[str
             for n, v in cmp.cloud_running().items()
         }
     )
+    two_label = f"two trajectories ({chaos.Integration().label()}), mean of {cmp.members} {cloud_label}"
+    curves[two_label] = (cmp.times, cmp.two_trajectory.mean(axis=1))
     return curves
 
 
