@@ -89,12 +89,13 @@ class Plan:
     extra_stride: int
     window_s: float | None
     valley_k_factors: tuple[float, ...]
+    resonant_end: bool
     window_checks_s: tuple[float, ...]
     max_workers: int | None
 
 
 NULL_MEANS = {
-    "resonant_end": "not traced: the quick run skips the valley, or the measured b is not crossed at the map's "
+    "resonant_end": "not traced: the quick run skips it, or the measured b is not crossed at the map's "
                     "smallest c",
     "k_range_within_N_per_m": "no map cell within the tolerance",
     "c_range_within_N_s_per_m": "no map cell within the tolerance",
@@ -117,7 +118,8 @@ FULL = Plan(
     m_s_extra=(),
     extra_stride=2,
     window_s=None,
-    valley_k_factors=(1.5,),
+    valley_k_factors=(),
+    resonant_end=True,
     window_checks_s=(),
     max_workers=None,
 )
@@ -125,7 +127,8 @@ THOROUGH = replace(FULL, c_grid=tuple(float(c) for c in np.geomspace(1.0, 3000.0
                    valley_k_factors=(1.25, 1.5), window_checks_s=(7.0, 14.0))
 """``--thorough``: the main map on 9 x 9 cells (the default: 9 k x 7 c) and coarser ones (every second k and
 c) at M_s = 0.5 and 8 kg (50 more runs, the stiffest cells of the light suspension among them: about
-2.5 times the map's CPU time), c refitted at 1.25 k too (the default: at 1.5 k) and c identified
+2.5 times the map's CPU time), c refitted along the valley at 1.25 k and 1.5 k (the default follows the
+valley by its Fisher matrix alone: a refit is a sequential fit of about 12 s of CPU) and c identified
 again on the first 7 and 14 s of the record (three more sequential fits)."""
 QUICK = Plan(
     k_grid=_k_grid((0, 3)),
@@ -135,6 +138,7 @@ QUICK = Plan(
     extra_stride=1,
     window_s=QUICK_WINDOW_S,
     valley_k_factors=(),
+    resonant_end=False,
     window_checks_s=(),
     max_workers=1,
 )
@@ -183,7 +187,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     map_wall = time.perf_counter() - t_map
 
     # independent now: refits along the valley, window checks, Fisher matrix, runs on the measured frames
-    resonant = study.resonant_point(maps[0], md.b) if plan.valley_k_factors else None
+    resonant = study.resonant_point(maps[0], md.b) if plan.resonant_end else None
     ctx = {"md": md, "base": base, "ident": ident, "map": maps[0], "rec": rec}
     tasks: list[tuple[str, Any, dict[str, Any]]] = [("trace", f, ctx) for f in plan.valley_k_factors]
     tasks += [("window", w, ctx) for w in plan.window_checks_s]

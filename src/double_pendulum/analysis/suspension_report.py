@@ -237,7 +237,7 @@ Following the valley (c refitted at fixed k):
 def _valley_text(trace: Sequence[Mapping[str, Any]]) -> str:
     """Which way chi2 runs along the valley, and what that means."""
     if len(trace) < 2:
-        return "(The valley is followed in the full run only.)"
+        return "(c is refitted along the valley with `--thorough` only.)"
     last = trace[-1]
     direction = "falls" if last["delta_chi2"] < 0 else "rises"
     return (
