@@ -23,12 +23,17 @@ def test_every_scenario_has_an_expected_cost_and_the_longest_start_first():
     assert sorted(order) == sorted(SCENARIOS)
 
 
-def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_small_ones_one_the_largest_first():
+def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_small_ones_a_few_the_largest_first():
     groups = scenario_pool.scenario_groups(SCENARIOS, quick=False, jobs=2)
     order = scenario_pool.longest_first(SCENARIOS)
     small = [name for name in order if EXPECTED_CPU_S[name] < scenario_pool.SMALL_SCENARIO_CPU_S]
     assert 1 < len(small) < len(SCENARIOS)
-    assert sorted(groups) == sorted([[name] for name in order if name not in small] + [small])
+    singles = [group for group in groups if not set(group) & set(small)]
+    assert sorted(singles) == sorted([[name] for name in order if name not in small])
+    shared = [group for group in groups if set(group) & set(small)]
+    assert sorted(name for group in shared for name in group) == sorted(small)
+    assert all(sum(EXPECTED_CPU_S[name] for name in group) <= scenario_pool.SMALL_GROUP_CPU_S for group in shared)
+    assert len(shared) < len(small)  # they do share
     totals = [sum(EXPECTED_CPU_S[name] for name in group) for group in groups]
     assert totals == sorted(totals, reverse=True)
 
@@ -38,6 +43,13 @@ def test_default_run_groups_keep_cosimulation_first_and_sort_by_their_sum(monkey
     monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", costs)
     assert scenario_pool.scenario_groups(list(costs), quick=False, jobs=2) == [
         ["a"], ["cosimulation", "c", "b"], ["d"]]  # the small ones' 35 s before d's 30 s
+
+
+def test_small_scenarios_are_packed_first_fit_under_the_cap(monkeypatch):
+    costs = {"a": 29.0, "b": 18.0, "c": 11.0, "d": 5.0, "e": 2.5, "f": 50.0}
+    monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", costs)
+    assert scenario_pool.pack_small(["f", "a", "b", "c", "d", "e"], cap=40.0) == [
+        ["f"], ["a", "c"], ["b", "d", "e"]]  # f over the cap alone; a + b would be 47 s
 
 
 def test_a_quick_run_shares_the_scenarios_out_longest_first_to_the_least_loaded(monkeypatch):

@@ -90,19 +90,40 @@ def balanced_groups(names: Sequence[str], count: int) -> list[list[str]]:
 
 
 SMALL_SCENARIO_CPU_S = 30.0
-"""Default-run scenarios expected to take less CPU time [s] than this share one child: a child of their
+"""Default-run scenarios expected to take less CPU time [s] than this share children: a child of their
 own would cost each some 3 s of CPU importing NumPy, SciPy, Matplotlib and fmpy."""
+SMALL_GROUP_CPU_S = 40.0
+"""At most this much expected CPU time [s] in one child of small scenarios (several small children, not
+one large one: the last children to start are short, so the cores finish at about the same time)."""
+
+
+def pack_small(names: Sequence[str], cap: float = SMALL_GROUP_CPU_S) -> list[list[str]]:
+    """``names`` (longest first) packed first-fit into groups of at most ``cap`` expected default-run CPU
+    seconds (a scenario over ``cap`` alone), each in :func:`in_process_order`."""
+    groups: list[list[str]] = []
+    totals: list[float] = []
+    for name in names:
+        cost = expected_cpu_s(name, quick=False)
+        fit = next((k for k, total in enumerate(totals) if total + cost <= cap), None)
+        if fit is None:
+            groups.append([name])
+            totals.append(cost)
+        else:
+            groups[fit].append(name)
+            totals[fit] += cost
+    return [in_process_order(group) for group in groups]
 
 
 def scenario_groups(names: Sequence[str], *, quick: bool, jobs: int) -> list[list[str]]:
     """The scenarios each child runs, in the order the children start: in a quick run ``jobs``
     balanced groups (:func:`balanced_groups`), otherwise one scenario per child, except that those
-    under :data:`SMALL_SCENARIO_CPU_S` share one; the children with the most expected CPU time first."""
+    under :data:`SMALL_SCENARIO_CPU_S` share children of at most :data:`SMALL_GROUP_CPU_S`
+    (:func:`pack_small`); the children with the most expected CPU time first."""
     if quick:
         return balanced_groups(names, jobs)
     order = longest_first(names)
     small = [name for name in order if expected_cpu_s(name, quick=False) < SMALL_SCENARIO_CPU_S]
-    groups = [[name] for name in order if name not in small] + ([in_process_order(small)] if small else [])
+    groups = [[name] for name in order if name not in small] + pack_small(small)
     return sorted(groups, key=lambda group: -sum(expected_cpu_s(name, quick=False) for name in group))
 
 
