@@ -224,20 +224,27 @@ M_s moves the residuals {f["sensitivity_ratio_M_s_to_c"]:.1f} times as much as l
 nearly as the opposite of k does (the residual changes of ln M_s and ln k have a cosine of
 {f["cos_angle_ln_k_ln_M_s"]:+.2f}): M_s enters mainly through the natural frequencies sqrt(k/M).
 
-Following the valley (c refitted at fixed k):
+{_valley_heading(trace)}
 
 | k [N/m] | c [N s/m] | chi2 | delta chi2 | delta chi2 / factor | b [1/s] | p |
 |---|---|---|---|---|---|---|
 {rows}
 
-{res_text} {_valley_text(trace)}
+{" ".join(text for text in (res_text, _valley_text(trace)) if text)}
 """
+
+
+def _valley_heading(trace: Sequence[Mapping[str, Any]]) -> str:
+    """The line above the valley table: c refitted along the valley, or the identified point alone."""
+    if len(trace) < 2:
+        return "The identified point (c is refitted along the valley with `--thorough`):"
+    return "Following the valley (c refitted at fixed k):"
 
 
 def _valley_text(trace: Sequence[Mapping[str, Any]]) -> str:
     """Which way chi2 runs along the valley, and what that means."""
     if len(trace) < 2:
-        return "(c is refitted along the valley with `--thorough` only.)"
+        return ""
     last = trace[-1]
     direction = "falls" if last["delta_chi2"] < 0 else "rises"
     return (
