@@ -77,3 +77,28 @@ def test_legend_outside_sits_right_of_the_axes():
     fig.canvas.draw()
     assert legend.get_window_extent().x0 > ax.get_window_extent().x1
     plt.close(fig)
+
+
+def test_draft_figures_are_smaller_and_drop_the_minor_ticks_of_log_axes(tmp_path):
+    """Quick runs save drafts: half the resolution, laid out once, without minor ticks (most of a log
+    axis's cost); other figures keep theirs."""
+    import matplotlib.image
+    from matplotlib.ticker import NullLocator
+
+    def figure() -> plt.Figure:
+        fig, ax = plt.subplots(figsize=(4.0, 3.0))
+        ax.loglog([1.0, 10.0, 100.0], [1e-3, 1.0, 1e3])
+        ax.set(xlabel="x [1]", ylabel="y [1]", title="a log-log line")
+        return fig
+
+    full, draft = figure(), figure()
+    style.save(full, tmp_path / "full.png")
+    with style.draft_figures():
+        style.save(draft, tmp_path / "draft.png")
+    assert not isinstance(full.axes[0].xaxis.get_minor_locator(), NullLocator)
+    assert isinstance(draft.axes[0].xaxis.get_minor_locator(), NullLocator)
+    assert isinstance(draft.axes[0].yaxis.get_minor_locator(), NullLocator)
+    h_full, w_full = matplotlib.image.imread(tmp_path / "full.png").shape[:2]
+    h_draft, w_draft = matplotlib.image.imread(tmp_path / "draft.png").shape[:2]
+    assert w_draft == pytest.approx(w_full * style.DRAFT_DPI / style.FIGURE_DPI, rel=0.15)
+    assert h_draft == pytest.approx(h_full * style.DRAFT_DPI / style.FIGURE_DPI, rel=0.15)
