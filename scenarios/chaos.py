@@ -119,7 +119,7 @@ QUICK = Plan(
     workers=1, fmu_stop=2.5, sigmas=(1e-4, 1e-3, 5e-3), members=24, spread_t_end=3.0, lyap_t_end=2.0, lyap_members=7,
     scan_thetas=(0.5, 1.5, 2.5, 3.0), scan_t_end=2.0, spectrum_t_end=1.5, flip_n=16, flip_t_max=2.0,
     poincare_starts=3, poincare_t_end=2.0, friction_t_end=2.0, friction_window=1.0, friction_rtol=1e-6,
-    lyap_rtol=1e-8,
+    lyap_rtol=1e-8, step_halving=False, rk4_benettin=False,  # the default run's integrations
 )
 """The quick run (a smoke run, in this process): every part and figure at small sizes. The FMU runs to 2.5 s
 (past the FMU-batch check at 2 s; the drawn releases part by 1 cm at about 1 s), 24 releases per
