@@ -7,16 +7,16 @@ pivot, high enough for the chaotic traces of its figs. 4-6), the lower rod hangi
 
 Outputs in ``results/chaos/`` (CSVs, plots, ``summary.json`` with ``lyapunov_per_s``): FMU runs of the
 nominal and three drawn releases; ensembles and predictability horizons; Lyapunov exponents (convergence,
-step halving, two-trajectory check, spectrum, against the energy, with friction); the flip-time map and
-Poincare sections. The analysis: ``double_pendulum.analysis`` predictability, lyapunov_study, phase_space.
+two-trajectory check, step halving with ``--thorough``, spectrum, against the energy, with friction); the
+flip-time map and Poincare sections. The analysis: ``double_pendulum.analysis`` predictability,
+lyapunov_study, phase_space.
 
 Cost: the parts are independent and run on parallel worker processes (one per core), the flip map
 after them split over the same cores. The default run follows the frictionless exponents of 32
 starts for 100 s and the damped one for 180 s (the exponent has fallen to about 0.1 by 150 s, as the
-energy drops below the flip energy);
-``thorough=True`` (``--thorough``) takes 64 starts, RK4 at h / 2 too, and follows the damped exponent
-for 360 s, as the seed's energy falls to a fifth. The
-summary's ``precision`` states what each headline figure is good for.
+energy drops below the flip energy); ``thorough=True`` (``--thorough``) takes 64 starts, adds RK4's
+own estimate at h and h / 2, and follows the damped exponent for 360 s, as the seed's energy falls to a
+fifth. The summary's ``precision`` states what each headline figure is good for.
 """
 
 from __future__ import annotations
