@@ -9,7 +9,8 @@ does (fresh folder, replaced on success).
 A default or thorough run gives every scenario a child of its own, the longest first (by
 :data:`double_pendulum.scenarios.EXPECTED_CPU_S`), so the run does not end on a long scenario started
 last, and a scenario cannot disturb another's process; only the small ones (under
-:data:`SMALL_SCENARIO_CPU_S`) share a child, placed by their sum. A quick run is dominated by the imports
+:data:`SMALL_SCENARIO_CPU_S`) share children of at most :data:`SMALL_GROUP_CPU_S` (:func:`pack_small`),
+placed by their sums. A quick run is dominated by the imports
 (NumPy, SciPy, Matplotlib, fmpy: some 2.5 s of CPU per process), so it starts only ``jobs`` children,
 each running its share of the scenarios one after another (:func:`scenario_groups`: balanced by
 :data:`double_pendulum.scenarios.EXPECTED_QUICK_CPU_S`, ``cosimulation`` first in its group, as

@@ -20,10 +20,9 @@ FIGURE_DPI = 120
 DRAFT_DPI = 60
 """Resolution [dots per inch] of draft figures (quick runs): rendering at 120 dpi is about half of a
 figure's cost."""
-_SAVE_DPI: ContextVar[int] = ContextVar("save_dpi", default=FIGURE_DPI)
-"""The resolution :func:`save` uses now (this package's own setting: matplotlib's rcParams stay the user's)."""
 _DRAFT: ContextVar[bool] = ContextVar("draft_figures", default=False)
-"""Whether :func:`save` writes draft figures now (:func:`draft_figures`)."""
+"""Whether :func:`save` writes draft figures now (:func:`draft_figures`; this package's own setting:
+matplotlib's rcParams stay the user's)."""
 DRAFT_PAD_INCHES = 0.1
 """Margin [in] around a draft figure's content (matplotlib's default ``savefig.pad_inches``)."""
 DRAFT_SPACING: dict[str, float] = {"hspace": 0.5, "wspace": 0.35}
@@ -35,13 +34,11 @@ DRAFT_SPACING: dict[str, float] = {"hspace": 0.5, "wspace": 0.35}
 def draft_figures(draft: bool = True) -> Iterator[None]:
     """Within the block, :func:`save` writes draft figures (if ``draft``), as quick runs do: at :data:`DRAFT_DPI`,
     and laid out once (see :func:`save`)."""
-    token = _SAVE_DPI.set(DRAFT_DPI if draft else FIGURE_DPI)
-    token_draft = _DRAFT.set(draft)
+    token = _DRAFT.set(draft)
     try:
         yield
     finally:
-        _DRAFT.reset(token_draft)
-        _SAVE_DPI.reset(token)
+        _DRAFT.reset(token)
 
 
 def save(fig: plt.Figure, path: str | Path) -> Path:
@@ -54,17 +51,18 @@ def save(fig: plt.Figure, path: str | Path) -> Path:
     drawn once, about half the CPU time of a figure (the subplots spaced by :data:`DRAFT_SPACING`)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    if _DRAFT.get():
+    draft, own_layout = _DRAFT.get(), fig.get_layout_engine() is not None
+    if draft:
         for ax in fig.axes:  # a log axis draws a tick, a label and a grid line per minor tick: most of its cost
             ax.minorticks_off()
-    if _DRAFT.get() and fig.get_layout_engine() is None:
+    if draft and not own_layout:
         fig.subplots_adjust(**DRAFT_SPACING)
         bbox = fig.get_tightbbox(fig.canvas.get_renderer()).padded(DRAFT_PAD_INCHES)
-        fig.savefig(path, dpi=_SAVE_DPI.get(), bbox_inches=bbox)
+        fig.savefig(path, dpi=DRAFT_DPI, bbox_inches=bbox)
     else:
-        if fig.get_layout_engine() is None:
+        if not own_layout:
             fig.tight_layout()
-        fig.savefig(path, dpi=_SAVE_DPI.get(), bbox_inches="tight")
+        fig.savefig(path, dpi=DRAFT_DPI if draft else FIGURE_DPI, bbox_inches="tight")
     plt.close(fig)
     return path
 
