@@ -54,6 +54,7 @@ RENORM = 0.5  # s, Benettin renormalisation interval
 H = 1e-3  # s, RK4 step of the ensembles, maps and sections
 METHODS = {"dop853": chaos.Integration("dop853", rtol=1e-10, atol=1e-12),  # the high-accuracy estimate
            "rk4_h": chaos.Integration("rk4", h=H), "rk4_h_half": chaos.Integration("rk4", h=H / 2)}  # step halving
+RK4_STEPS = {"rk4_h": "h", "rk4_h_half": "h / 2"}  # the RK4 integrations' steps, as the precision text names them
 
 
 @dataclass(frozen=True)
@@ -76,8 +77,8 @@ class Plan:
     poincare_t_end: float
     friction_t_end: float
     friction_window: float
-    step_halving: bool = True  # also RK4 at h / 2 (the most expensive integration: 200 000 steps per 100 s)
-    rk4_benettin: bool = True  # RK4 at h beside DOP853 (without it RK4 at h is checked by the two-trajectory estimate)
+    rk4: tuple[str, ...] = ("rk4_h", "rk4_h_half")  # RK4's own estimates beside DOP853 (keys of METHODS; at h / 2
+    # the most expensive integration, 200 000 steps per 100 s; without them the two-trajectory estimate checks RK4 at h)
     lyap_rtol: float = 1e-10  # DOP853 tolerance of the largest exponent (atol: 1e-2 of it)
     friction_rtol: float = 1e-8  # DOP853 tolerance of the damped exponent (rtol 1e-6 costs a third but is not
     # safe: in a trial its trajectory stayed chaotic to 200 s where rtol 1e-8 settled on a regular orbit by 110 s;
@@ -85,10 +86,8 @@ class Plan:
 
     def methods(self) -> dict[str, chaos.Integration]:
         """The integrations of the largest exponent in this plan (DOP853 at :attr:`lyap_rtol`)."""
-        methods = {k: v for k, v in METHODS.items()
-                   if (self.step_halving or k != "rk4_h_half") and (self.rk4_benettin or k == "dop853")}
-        methods["dop853"] = dataclasses.replace(methods["dop853"], rtol=self.lyap_rtol, atol=self.lyap_rtol * 1e-2)
-        return methods
+        dop853 = dataclasses.replace(METHODS["dop853"], rtol=self.lyap_rtol, atol=self.lyap_rtol * 1e-2)
+        return {"dop853": dop853, **{name: METHODS[name] for name in self.rk4}}
 
 
 THOROUGH = Plan(
@@ -100,7 +99,7 @@ THOROUGH = Plan(
 FULL = dataclasses.replace(THOROUGH, fmu_stop=20.0, friction_t_end=180.0, flip_n=120, scan_t_end=50.0,
                            poincare_t_end=50.0,
                            spectrum_t_end=50.0,
-                           step_halving=False, rk4_benettin=False, lyap_members=31, lyap_rtol=1e-8,
+                           rk4=(), lyap_members=31, lyap_rtol=1e-8,
                            scan_thetas=tuple(np.round(np.arange(0.5, 3.0001, 0.2), 2)))
 """The default, about a quarter of :data:`THOROUGH`'s CPU time: the FMU runs
 over 20 s (the releases part after about 1 s; 30 s in the thorough run), the damped exponent up to
@@ -119,12 +118,12 @@ QUICK = Plan(
     workers=1, fmu_stop=2.5, sigmas=(1e-4, 1e-3, 5e-3), members=24, spread_t_end=3.0, lyap_t_end=2.0, lyap_members=7,
     scan_thetas=(0.5, 1.5, 2.5, 3.0), scan_t_end=2.0, spectrum_t_end=1.5, flip_n=16, flip_t_max=2.0,
     poincare_starts=3, poincare_t_end=2.0, friction_t_end=2.0, friction_window=1.0, friction_rtol=1e-6,
-    lyap_rtol=1e-8, step_halving=False, rk4_benettin=False,  # the default run's integrations
+    lyap_rtol=1e-8, rk4=(),  # the default run's integrations
 )
 """The quick run (a smoke run, in this process): every part and figure at small sizes. The FMU runs to 2.5 s
 (past the FMU-batch check at 2 s; the drawn releases part by 1 cm at about 1 s), 24 releases per
-uncertainty, the largest exponent of 8 starts over 2 s by every integration (RK4 at h / 2 too; DOP853 at
-rtol 1e-8, as in the default run), four
+uncertainty, the largest exponent of 8 starts over 2 s by the default run's integrations (DOP853 at rtol
+1e-8, checked by the two-trajectory estimate), four
 release angles of the energy scan, the spectrum over 1.5 s, Poincare sections of 3 starts over 2 s, the
 flip map on 16 x 16 cells."""
 
@@ -297,8 +296,7 @@ def precision(plan: Plan, summary: dict) -> dict[str, str]:
         "lyapunov_per_s": f"{lyap['lyapunov_per_s']:.3f} +- {lyap['lyapunov_sem_per_s']:.3f} 1/s: mean and standard "
         f"error of {plan.lyap_members + 1} finite-time estimates over {plan.lyap_t_end:g} s (the running mean still "
         "falls by about 0.05 1/s from 50 to 100 s: finite-time bias of the same order as the standard error); "
-        + ("RK4 at h and h / 2 and DOP853 compared" if plan.step_halving else
-           "DOP853 and RK4 (h = 1 ms) compared; RK4 at h / 2 with --thorough" if plan.rk4_benettin else
+        + (f"RK4 at {' and '.join(RK4_STEPS[name] for name in plan.rk4)} and DOP853 compared" if plan.rk4 else
            "DOP853, checked by the two-trajectory estimate (RK4, h = 1 ms); RK4's Benettin estimate at h and h / 2 "
            "with --thorough"),
         "spectrum": f"final estimates after {plan.spectrum_t_end:g} s; the two middle exponents and lambda1 + lambda4 "
