@@ -16,19 +16,31 @@ modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the buil
 * states each output's direct dependencies on the inputs under ``ModelStructure/Outputs``
   (the interface's ``output_dependencies``; ``dependencies=""`` for none),
   which pythonfmu leaves open (open means: depends on every input);
-* writes ``resources/requirements.txt`` with what the FMU needs at run time.
+* on Linux, makes the FMU's binary the loader of :mod:`double_pendulum.fmu.loader` (compiled from
+  source; pythonfmu's library goes beside it), so the FMU runs in hosts that are not Python, and
+  records the building CPython in ``resources/python.cfg``;
+* writes ``resources/bundle.json`` (a hash of the bundled code), which makes the FMU import its
+  bundled code under private names (``fmu_src/double_pendulum_slave.py``).
+
+The FMU needs nothing installed where it runs: only a CPython >= 3.11 and its standard library.
+Every FMU written is checked to hold a binary for this platform.
 """
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import importlib.util
+import json
 import shutil
+import sys
 import tempfile
 import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
+from . import loader
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
@@ -57,9 +69,7 @@ UNIT_EXPONENTS: dict[str, dict[str, int]] = {
     "W": {"kg": 1, "m": 2, "s": -3},
 }
 
-# What the FMU imports at run time beyond the standard library (pythonfmu's Python part is
-# bundled by pythonfmu itself, but its binary needs the interpreter with pythonfmu installed).
-RUNTIME_REQUIREMENTS = ["pythonfmu>=0.6.5"]
+BUNDLE_FILE = "resources/bundle.json"  # the bundle's id: the private name its code is imported under
 
 
 def _adapters_dir() -> Path:
@@ -168,24 +178,66 @@ def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
         return cached, cfile.read_bytes()
 
 
+@functools.cache
+def _loader_binary() -> bytes | None:
+    """The compiled loader, or None (said once on stderr) where it cannot be built."""
+    try:
+        return loader.compiled_loader()
+    except loader.LoaderUnavailable as why:
+        print(f"note: {why}", file=sys.stderr, flush=True)
+        return None
+
+
+def bundle_id(files: dict[str, bytes], model_identifier: str) -> str:
+    """A hash of the code an FMU bundles, except its own adapter: FMUs built from the same sources
+    (DoublePendulum and Suspension) share it, and so share their privately imported modules."""
+    digest = hashlib.sha256()
+    adapter = f"resources/{model_identifier}.py"
+    for name in sorted(files):
+        if name.startswith("resources/") and name.endswith(".py") and name != adapter:
+            digest.update(name.encode() + b"\0" + files[name] + b"\0")
+    return digest.hexdigest()[:16]
+
+
 def _rewrite_fmu(fmu: Path, model_identifier: str) -> None:
-    """Rewrite the zip with the completed modelDescription, bytecode and requirements.txt.
+    """Rewrite the zip with the completed modelDescription, bytecode, the loader and the bundle's id.
 
     Precompiled bytecode spares every fresh extraction (fmpy extracts the FMU anew for each
     ``simulate_fmu`` call) the compilation of the bundled sources at start-up.
     """
+    with zipfile.ZipFile(fmu) as src:
+        items = [(item, src.read(item.filename)) for item in src.infolist()]
+    binary = f"binaries/{loader.PLATFORM}/{model_identifier}.so"
+    loader_binary = _loader_binary() if any(item.filename == binary for item, _ in items) else None
+    backend = f"binaries/{loader.PLATFORM}/{loader.BACKEND_NAME}"
+    identity = bundle_id({item.filename: data for item, data in items}, model_identifier)
     tmp = fmu.with_suffix(".fmu.tmp")
-    with zipfile.ZipFile(fmu) as src, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
-        for item in src.infolist():
-            data = src.read(item.filename)
+    with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
+        for item, data in items:
             if item.filename == "modelDescription.xml":
                 data = complete_model_description(data, model_identifier)
+            if item.filename == binary and loader_binary is not None:
+                dst.writestr(backend, data, compress_type=zipfile.ZIP_DEFLATED)  # pythonfmu's, behind the loader
+                data = loader_binary
             dst.writestr(item, data, compress_type=zipfile.ZIP_DEFLATED)
             if item.filename.startswith("resources/") and item.filename.endswith(".py"):
                 cached, code = compiled_bytecode(data, item.filename)
                 dst.writestr(cached, code, compress_type=zipfile.ZIP_DEFLATED)
-        dst.writestr("resources/requirements.txt", "\n".join(RUNTIME_REQUIREMENTS) + "\n")
+        dst.writestr(BUNDLE_FILE, json.dumps({"id": identity}))
+        if loader_binary is not None:
+            dst.writestr(f"resources/{loader.CONFIG_NAME}", loader.python_record())
     tmp.replace(fmu)
+
+
+def check_platform_binary(fmu: Path, model_identifier: str) -> None:
+    """Raise if ``fmu`` holds no binary for this platform (it could not run here)."""
+    from fmpy import platform, sharedLibraryExtension
+
+    binary = f"binaries/{platform}/{model_identifier}{sharedLibraryExtension}"
+    with zipfile.ZipFile(fmu) as z:
+        if binary not in z.namelist():
+            raise RuntimeError(f"{fmu} holds no binary for this platform ({binary} missing): is pythonfmu's "
+                               f"binary for {platform} installed (pythonfmu.builder.FmuBuilder.has_binary())?")
 
 
 def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL_IDENTIFIER) -> Path:
@@ -212,6 +264,7 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
             canSerializeFMUstate=True,
         )
         _rewrite_fmu(Path(built), model_identifier)
+        check_platform_binary(Path(built), model_identifier)
         shutil.move(str(built), fmu_path)
     return fmu_path
 
@@ -250,5 +303,5 @@ def fmu_is_current(fmu_path: str | Path, model_identifier: str = MODEL_IDENTIFIE
     if not fmu_path.is_file():
         return False
     built = fmu_path.stat().st_mtime
-    sources = [adapter_script(model_identifier), shared_adapter(), *runtime_sources()]
+    sources = [adapter_script(model_identifier), shared_adapter(), *runtime_sources(), *loader.loader_sources()]
     return all(src.stat().st_mtime <= built for src in sources)

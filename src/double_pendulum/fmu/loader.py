@@ -1,0 +1,115 @@
+"""The FMU's binary on Linux: a small C loader, compiled from source when the FMU is built.
+
+pythonfmu's Linux library calls the CPython C API without linking libpython, so on its own it runs
+only inside a Python process. The loader (``fmu_src/loader/``: ``python_runtime.c`` finds, loads
+and starts a CPython, ``fmi2_loader.c`` forwards the FMI 2 functions) becomes the FMU's
+``binaries/linux64/<model identifier>.so``; pythonfmu's library lies beside it as
+``libpythonfmu-export.so``. In a Python host the loader uses the host's interpreter and changes
+nothing; in any other host it finds a CPython >= 3.11 with a shared libpython: the one named by
+``DOUBLE_PENDULUM_FMU_PYTHON``, else the one the FMU was built with (``resources/python.cfg``,
+:func:`python_record`), else ``python3`` on PATH (docs/fmu.md, "Use the FMU in other FMI tools").
+
+The loader is compiled with the system C compiler (``$CC``, else ``cc``, ``gcc`` or ``clang``)
+against the FMI 2 headers fmpy ships (``fmpy/c-code``); nothing compiled is committed. Without a
+compiler the FMU keeps pythonfmu's plain library (Python hosts only) and the build says so once.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.util
+import os
+import shlex
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+from pathlib import Path
+
+LOADER_FOLDER = "loader"  # in fmu_src/ (installed as double_pendulum.adapters)
+LOADER_SOURCES = ("python_runtime.c", "fmi2_loader.c")
+LOADER_HEADERS = ("python_runtime.h",)
+BACKEND_NAME = "libpythonfmu-export.so"  # pythonfmu's library in the FMU, beside the loader
+PLATFORM = "linux64"  # the one platform whose pythonfmu library needs the loader
+CONFIG_NAME = "python.cfg"  # in resources/: the CPython the FMU was built with
+OVERRIDE_VARIABLE = "DOUBLE_PENDULUM_FMU_PYTHON"
+CFLAGS = ("-shared", "-fPIC", "-O2", "-fvisibility=hidden")
+LIBS = ("-ldl", "-lpthread")
+
+
+class LoaderUnavailable(RuntimeError):
+    """The loader cannot be built here (no C compiler, or not Linux); the message says why in one line."""
+
+
+def loader_sources() -> list[Path]:
+    """The loader's C sources and headers (in the installed ``double_pendulum.adapters``)."""
+    spec = importlib.util.find_spec("double_pendulum.adapters")
+    if spec is None or not spec.submodule_search_locations:
+        raise FileNotFoundError("cannot find double_pendulum.adapters: is double-pendulum-fmu installed?")
+    folder = Path(next(iter(spec.submodule_search_locations))) / LOADER_FOLDER
+    return [folder / name for name in (*LOADER_SOURCES, *LOADER_HEADERS)]
+
+
+def fmi_headers() -> Path:
+    """The folder of the official FMI 2 and FMI 3 C headers that fmpy ships."""
+    import fmpy
+
+    return Path(fmpy.__file__).resolve().parent / "c-code"
+
+
+def c_compiler() -> list[str] | None:
+    """The C compiler command: ``$CC`` if set, else the first of cc, gcc, clang on PATH; None if none."""
+    if os.environ.get("CC"):
+        command = shlex.split(os.environ["CC"])
+        return command if shutil.which(command[0]) else None
+    found = next((shutil.which(name) for name in ("cc", "gcc", "clang") if shutil.which(name)), None)
+    return [found] if found else None
+
+
+@functools.cache
+def _compiled(sources: tuple[Path, ...], mtimes: tuple[float, ...]) -> bytes:
+    compiler = c_compiler()
+    if compiler is None:
+        raise LoaderUnavailable(
+            "no C compiler found ($CC, cc, gcc or clang): the FMUs keep pythonfmu's plain binary, "
+            "which runs only in Python hosts (docs/fmu.md)"
+        )
+    c_files = [str(path) for path in sources if path.suffix == ".c"]
+    with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
+        output = Path(tmp) / "loader.so"
+        command = [*compiler, *CFLAGS, f"-I{fmi_headers()}", "-o", str(output), *c_files, *LIBS]
+        done = subprocess.run(command, capture_output=True, text=True)
+        if done.returncode != 0:
+            raise RuntimeError(f"compiling the FMU's loader failed: {shlex.join(command)}\n{done.stderr}")
+        return output.read_bytes()
+
+
+def compiled_loader() -> bytes:
+    """The loader's shared library for this machine (compiled once per process and source version).
+
+    Raises :class:`LoaderUnavailable` where it cannot be built (no C compiler; not Linux), and
+    ``RuntimeError`` with the compiler's output if compiling fails.
+    """
+    if not sys.platform.startswith("linux"):
+        raise LoaderUnavailable(f"the loader is for Linux; on {sys.platform} the FMU keeps pythonfmu's binary")
+    sources = tuple(loader_sources())
+    return _compiled(sources, tuple(path.stat().st_mtime for path in sources))
+
+
+def python_record() -> str:
+    """``resources/python.cfg``: the CPython running this build, for the loader in a host without Python.
+
+    ``executable`` and ``home`` are the base interpreter's (not a virtual environment's: the FMU
+    needs only the standard library), ``library`` its shared libpython (empty if it has none).
+    """
+    library = ""
+    if sysconfig.get_config_var("Py_ENABLE_SHARED"):
+        library = os.path.join(sysconfig.get_config_var("LIBDIR") or "", sysconfig.get_config_var("INSTSONAME") or "")
+    executable = getattr(sys, "_base_executable", "") or sys.executable
+    return (
+        "# The CPython this FMU was built with. Its binary loads it in a host that has no Python of its\n"
+        f"# own, unless {OVERRIDE_VARIABLE} names another one (docs/fmu.md).\n"
+        f"version={sys.version_info[0]}.{sys.version_info[1]}\n"
+        f"executable={executable}\nlibrary={library}\nhome={sys.base_prefix}\n"
+    )
