@@ -6,25 +6,74 @@ come from its :class:`~double_pendulum.component.variables.FmuInterface`. Each F
 (``DoublePendulum.py``, ``Suspension.py``) only names its interface and component.
 
 All physics, numerics and validation live in the ``double_pendulum`` package, whose runtime part
-(model, solvers, component) the build bundles into the FMU's resources next to this file. The
-bundled copy is loaded under a private module name so the FMU always runs its own code, whatever
-``double_pendulum`` the host process may have imported.
+(model, solvers, component) the build bundles into the FMU's resources next to this file, with
+pythonfmu's Python part. In a built FMU (``resources/bundle.json`` present) both are imported
+under private names (``_dp_fmu_<id>``, ``_dp_fmu_<id>_pythonfmu``, the id a hash of the bundled
+code), so the FMU always runs its own code, whatever ``double_pendulum`` or ``pythonfmu`` the host
+process has imported, and a Python host is left as it was found: once an instance exists, the
+FMU's folder is taken off ``sys.path`` and its public modules out of ``sys.modules``
+(:meth:`ComponentSlave._leave_host_as_found`). At build time (no ``bundle.json``) the installed
+``pythonfmu`` and ``double_pendulum`` are used, as pythonfmu's builder needs its own ``Fmi2Slave``.
 """
 
 from __future__ import annotations
 
 import importlib
 import importlib.util
+import json
 import os
 import sys
 from pathlib import Path
+from types import ModuleType
 
-from pythonfmu import Boolean, Fmi2Causality, Fmi2Slave, Fmi2Variability, Real, String
-from pythonfmu.enums import Fmi2Status
-
-_BUNDLE_NAME = "_double_pendulum_fmu_bundle"
+RESOURCES = Path(__file__).resolve().parent
+BUNDLE_FILE = "bundle.json"  # written by the build (double_pendulum.fmu.build): {"id": hash of the bundled code}
 STDERR_SWITCH = "DOUBLE_PENDULUM_FMU_STDERR"  # "0": errors go to the FMI log only
-_FMI_TYPES = {"Real": Real, "Boolean": Boolean, "String": String}
+
+
+def _private_prefix() -> str | None:
+    """``_dp_fmu_<id>`` in a built FMU, None at build time."""
+    try:
+        return "_dp_fmu_" + json.loads((RESOURCES / BUNDLE_FILE).read_text())["id"]
+    except FileNotFoundError:
+        return None
+
+
+def _import_private(name: str, folder: Path, *, run_init: bool = True) -> ModuleType:
+    """Import the package in ``folder`` as ``name`` (once per process); ``run_init=False`` registers it
+    without running its ``__init__.py``, for its submodules alone."""
+    if name not in sys.modules:
+        spec = importlib.util.spec_from_file_location(
+            name, folder / "__init__.py", submodule_search_locations=[str(folder)]
+        )
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        try:
+            if run_init:
+                spec.loader.exec_module(module)
+        except BaseException:
+            del sys.modules[name]
+            raise
+    return sys.modules[name]
+
+
+PRIVATE_PREFIX = _private_prefix()
+if PRIVATE_PREFIX:
+    # pythonfmu's __init__ would also import its builder (argparse, inspect, xml.dom): only the slave side
+    _pythonfmu = _import_private(f"{PRIVATE_PREFIX}_pythonfmu", RESOURCES / "pythonfmu", run_init=False).__name__
+    package = _import_private(PRIVATE_PREFIX, RESOURCES / "double_pendulum")
+else:
+    _pythonfmu = "pythonfmu"
+    package = importlib.import_module("double_pendulum")
+
+_slave = importlib.import_module(f"{_pythonfmu}.fmi2slave")
+_variables = importlib.import_module(f"{_pythonfmu}.variables")
+_enums = importlib.import_module(f"{_pythonfmu}.enums")
+Fmi2Slave = _slave.Fmi2Slave
+DefaultExperiment = importlib.import_module(f"{_pythonfmu}.default_experiment").DefaultExperiment
+Fmi2Causality, Fmi2Variability, Fmi2Status = _enums.Fmi2Causality, _enums.Fmi2Variability, _enums.Fmi2Status
+_FMI_TYPES = {name: getattr(_variables, name) for name in ("Real", "Boolean", "String")}
+Real = _FMI_TYPES["Real"]
 
 
 def _compensate_pythonfmu_release(*objects) -> None:
@@ -42,24 +91,6 @@ def _compensate_pythonfmu_release(*objects) -> None:
 
     for obj in objects:
         ctypes.pythonapi.Py_IncRef(ctypes.py_object(obj))
-
-
-def _load_package():
-    """Import the bundled package (resources/double_pendulum) or, at build time, the installed one."""
-    bundled = Path(__file__).resolve().parent / "double_pendulum"
-    if not (bundled / "__init__.py").is_file():
-        return importlib.import_module("double_pendulum")
-    if _BUNDLE_NAME not in sys.modules:
-        spec = importlib.util.spec_from_file_location(
-            _BUNDLE_NAME, bundled / "__init__.py", submodule_search_locations=[str(bundled)]
-        )
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[_BUNDLE_NAME] = module
-        spec.loader.exec_module(module)
-    return sys.modules[_BUNDLE_NAME]
-
-
-package = _load_package()
 
 
 def runtime_module(name: str):
@@ -84,6 +115,24 @@ class ComponentSlave(Fmi2Slave):
         self._sim = self.make_component()
         for var in self.interface.variables():
             self._register(var)
+        if PRIVATE_PREFIX:
+            self._leave_host_as_found()
+
+    def _leave_host_as_found(self) -> None:
+        """Undo what pythonfmu's binary did to the host's interpreter to load this FMU.
+
+        It put the FMU's resources folder first on ``sys.path`` and imported the adapter (and through
+        it this module) under public names; a later ``import pythonfmu`` or ``import double_pendulum``
+        in the host would find the FMU's copies there. Everything the instance needs is loaded by now
+        (the bundled code under private names), so both go: the folder from ``sys.path``, the modules
+        loaded from it under public names from ``sys.modules``.
+        """
+        folder = os.path.realpath(self.resources or RESOURCES)
+        sys.path[:] = [entry for entry in sys.path if not entry or os.path.realpath(entry) != folder]
+        for name, module in list(sys.modules.items()):
+            origin = getattr(module, "__file__", None)
+            if origin and not name.startswith("_dp_fmu_") and os.path.dirname(os.path.realpath(origin)) == folder:
+                del sys.modules[name]
 
     def make_component(self):
         raise NotImplementedError
