@@ -5,13 +5,6 @@ dict`` (the summary, also written to ``out_dir/summary.json``). ``quick`` shorte
 smoke tests. Each scenario enables only the model parts it needs.
 """
 
-from collections.abc import Sequence
-
-# ``cosimulation`` runs first when scenarios share one process (``run all --jobs 1``): its engines
-# (libcosim, fmpy's container FMU) failed to load the FMUs in a process that had already run the
-# pythonfmu FMU through fmpy for other scenarios (libcosim: "The FMU contains no binary for this
-# platform"; the container aborted). Run first, all pass. :func:`in_process_order` puts it first
-# wherever one process runs several scenarios (``--jobs 1``, the groups of a quick ``run all``).
 SCENARIOS: tuple[str, ...] = (
     "cosimulation",
     "free_swing",
@@ -67,12 +60,3 @@ READS_FITS_OF: dict[str, str] = {"measured_vs_sim": "loss_identification"}
 ``loss_identification``'s air+drag fit of the same mode (on a cold cache, without it, it fits it itself: about 7 s
 more CPU in a quick run). ``run all --quick`` runs each in the process of the one it reads from, after it
 (:func:`double_pendulum.scenario_pool.balanced_groups`); :data:`SCENARIOS` lists each after it too."""
-
-FIRST_IN_A_PROCESS = "cosimulation"
-"""The scenario that must run before the others when one process runs several (see above)."""
-
-
-def in_process_order(names: Sequence[str]) -> list[str]:
-    """``names`` in the order one process can run them: :data:`FIRST_IN_A_PROCESS` first, the others
-    as given."""
-    return sorted(names, key=lambda name: name != FIRST_IN_A_PROCESS)

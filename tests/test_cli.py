@@ -167,12 +167,12 @@ def _recorded_runs(monkeypatch) -> list[str]:
     return runs
 
 
-def test_several_scenarios_run_once_each_with_cosimulation_first_in_one_process(tmp_path, capsys, monkeypatch):
+def test_several_scenarios_run_once_each_in_the_order_given_in_one_process(tmp_path, capsys, monkeypatch):
     runs = _recorded_runs(monkeypatch)
     assert main(["run", "free_swing", "cosimulation", "free_swing", "--jobs", "1", "--out", str(tmp_path)]) == 0
-    assert runs == ["cosimulation", "free_swing"]  # duplicates dropped; cosimulation first (scenarios.in_process_order)
+    assert runs == ["free_swing", "cosimulation"]  # duplicates dropped; libcosim and the container run after fmpy
     out = capsys.readouterr().out
-    assert "[1/2] cosimulation:" in out and "[2/2] free_swing:" in out and "2 of 2 scenarios wrote" in out
+    assert "[1/2] free_swing:" in out and "[2/2] cosimulation:" in out and "2 of 2 scenarios wrote" in out
 
 
 def test_a_child_numbers_its_scenarios_as_its_parent_says_and_leaves_the_sum_to_it(tmp_path, capsys, monkeypatch):

@@ -38,11 +38,11 @@ def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_small_ones_a_
     assert totals == sorted(totals, reverse=True)
 
 
-def test_default_run_groups_keep_cosimulation_first_and_sort_by_their_sum(monkeypatch):
+def test_default_run_groups_sort_by_their_sum_and_keep_the_packing_order(monkeypatch):
     costs = {"a": 100.0, "b": 10.0, "cosimulation": 5.0, "c": 20.0, "d": 30.0}
     monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", costs)
     assert scenario_pool.scenario_groups(list(costs), quick=False, jobs=2) == [
-        ["a"], ["cosimulation", "c", "b"], ["d"]]  # the small ones' 35 s before d's 30 s
+        ["a"], ["c", "b", "cosimulation"], ["d"]]  # the small ones' 35 s before d's 30 s, longest first
 
 
 def test_small_scenarios_are_packed_first_fit_under_the_cap(monkeypatch):
@@ -57,7 +57,7 @@ def test_a_quick_run_shares_the_scenarios_out_longest_first_to_the_least_loaded(
     monkeypatch.setattr(scenario_pool, "EXPECTED_QUICK_CPU_S", costs)
     # a 5 | b 4 | c -> b 7 | d -> a 8 | e -> b 9 | cosimulation -> a 9 | f -> a 9.5 (the first of the least)
     assert scenario_pool.scenario_groups(list(costs), quick=True, jobs=2) == [
-        ["cosimulation", "a", "d", "f"],  # 9.5, cosimulation first in its group, the others longest first
+        ["a", "d", "cosimulation", "f"],  # 9.5, in the order they joined: no scenario needs to run first
         ["b", "c", "e"],  # 9
     ]
 
@@ -73,19 +73,17 @@ def test_a_quick_run_keeps_a_scenario_that_reads_a_cached_fit_after_the_one_that
     # alone the reader would join a (a 5 | writer 4 | b -> 7.5 | reader -> a 8); as a unit: writer + reader 7 | a 5
     # | b -> a 8.5 | cosimulation -> 8
     assert scenario_pool.scenario_groups(list(costs), quick=True, jobs=2) == [
-        ["a", "b"], ["cosimulation", "writer", "reader"]]
+        ["a", "b"], ["writer", "reader", "cosimulation"]]
     assert scenario_pool.scenario_groups(["a", "reader", "cosimulation"], quick=True, jobs=2) == [
-        ["a"], ["cosimulation", "reader"]]  # without its writer the reader is placed alone
+        ["a"], ["reader", "cosimulation"]]  # without its writer the reader is placed alone
 
 
 @pytest.mark.parametrize("jobs", [1, 2, 3, 4, 11, 20])
-def test_quick_groups_hold_every_scenario_once_balanced_and_cosimulation_first(jobs):
+def test_quick_groups_hold_every_scenario_once_and_balanced(jobs):
     groups = scenario_pool.scenario_groups(SCENARIOS, quick=True, jobs=jobs)
     assert len(groups) == min(jobs, len(SCENARIOS))
     assert sorted(name for group in groups for name in group) == sorted(SCENARIOS)
     assert all(group for group in groups)
-    host = next(group for group in groups if "cosimulation" in group)
-    assert host[0] == "cosimulation"
     totals = [sum(EXPECTED_QUICK_CPU_S[name] for name in group) for group in groups]
     assert totals == sorted(totals, reverse=True)  # the largest group starts first
     if len(groups) > 1:  # no group could give its last scenario to the smallest and be better off

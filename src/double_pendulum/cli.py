@@ -20,7 +20,7 @@ from pathlib import Path
 from . import __version__
 from .fmu.build import DEFAULT_FMU_PATH, build_all, build_fmu
 from .scenario_lines import failed_line, header_line, wrote_line
-from .scenarios import SCENARIOS, in_process_order
+from .scenarios import SCENARIOS
 
 PROG = "double-pendulum"
 
@@ -198,10 +198,10 @@ def _cpu_seconds() -> float:
 
 
 def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: Path) -> list[str]:
-    """Run the scenarios one after another in this process (``cosimulation`` first, see
-    :func:`double_pendulum.scenarios.in_process_order`); return the names of those that failed."""
+    """Run the scenarios one after another in this process, in the order given; return the names of those
+    that failed."""
     failed = []
-    order = in_process_order(names)
+    order = list(names)
     indices = _indices(args.index, len(order))
     with _load_fmu(args.fmu, args.rebuild) as runner:
         for index, name in zip(indices, order):

@@ -13,10 +13,9 @@ last, and a scenario cannot disturb another's process; only the small ones (unde
 placed by their sums. A quick run is dominated by the imports
 (NumPy, SciPy, Matplotlib, fmpy: some 2.5 s of CPU per process), so it starts only ``jobs`` children,
 each running its share of the scenarios one after another (:func:`scenario_groups`: balanced by
-:data:`double_pendulum.scenarios.EXPECTED_QUICK_CPU_S`, ``cosimulation`` first in its group, as
-libcosim and fmpy's container FMU failed to load their FMUs in a process that had already run the
-pythonfmu FMU; ``measured_vs_sim`` after ``loss_identification`` in the same group, so it reads that one's
-cached fit instead of fitting it again, :data:`double_pendulum.scenarios.READS_FITS_OF`).
+:data:`double_pendulum.scenarios.EXPECTED_QUICK_CPU_S`; ``measured_vs_sim`` after ``loss_identification``
+in the same group, so it reads that one's cached fit instead of fitting it again,
+:data:`double_pendulum.scenarios.READS_FITS_OF`).
 
 The children's lines reach the terminal as they come, each marked with the name of the scenario
 running in its child (a child's header line ``[k/N] NAME: ...`` says which); their progress
@@ -42,7 +41,7 @@ from .analysis.progress import ENV as PROGRESS_ENV
 from .analysis.progress import progress_bar, write_line
 from .analysis.sweep import WORKERS_ENV
 from .scenario_lines import FAILED, WROTE, failed_line, header_name, outcome
-from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF, in_process_order
+from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF
 
 POLL_S = 0.2
 """How often [s] the parent looks for finished children."""
@@ -75,9 +74,9 @@ def _units(names: Sequence[str]) -> list[list[str]]:
 def balanced_groups(names: Sequence[str], count: int) -> list[list[str]]:
     """``names`` shared out among ``count`` groups of about equal expected quick-run CPU time: each unit
     (a scenario; with fewer groups than scenarios, a scenario and those reading its cached fit,
-    :func:`_units`), the longest first, joins the group with the least so far. Within a group
-    ``cosimulation`` comes first, the others in the order they joined (a reader after the scenario it
-    reads from); the groups come largest first; none is empty."""
+    :func:`_units`), the longest first, joins the group with the least so far. Within a group the
+    scenarios run in the order they joined (a reader after the scenario it reads from); the groups come
+    largest first; none is empty."""
     units = _units(names) if count < len(names) else [[name] for name in longest_first(names, quick=True)]
     units.sort(key=lambda unit: -sum(expected_cpu_s(name, quick=True) for name in unit))  # stable: ties keep order
     groups: list[list[str]] = [[] for _ in range(max(1, min(count, len(units))))]
@@ -87,7 +86,7 @@ def balanced_groups(names: Sequence[str], count: int) -> list[list[str]]:
         groups[least] += unit
         totals[least] += sum(expected_cpu_s(name, quick=True) for name in unit)
     order = sorted(range(len(groups)), key=lambda k: -totals[k])
-    return [in_process_order(groups[k]) for k in order if groups[k]]
+    return [groups[k] for k in order if groups[k]]
 
 
 SMALL_SCENARIO_CPU_S = 30.0
@@ -100,7 +99,7 @@ one large one: the last children to start are short, so the cores finish at abou
 
 def pack_small(names: Sequence[str], cap: float = SMALL_GROUP_CPU_S) -> list[list[str]]:
     """``names`` (longest first) packed first-fit into groups of at most ``cap`` expected default-run CPU
-    seconds (a scenario over ``cap`` alone), each in :func:`in_process_order`."""
+    seconds (a scenario over ``cap`` alone)."""
     groups: list[list[str]] = []
     totals: list[float] = []
     for name in names:
@@ -112,7 +111,7 @@ def pack_small(names: Sequence[str], cap: float = SMALL_GROUP_CPU_S) -> list[lis
         else:
             groups[fit].append(name)
             totals[fit] += cost
-    return [in_process_order(group) for group in groups]
+    return groups
 
 
 def scenario_groups(names: Sequence[str], *, quick: bool, jobs: int) -> list[list[str]]:
