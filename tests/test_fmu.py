@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import subprocess
 import sys
@@ -15,6 +16,7 @@ import pytest
 from conftest import DATA
 from scipy.special import ellipk
 
+from double_pendulum.fmu import loader
 from double_pendulum.fmu.runner import FmuRunError
 from double_pendulum.fmu.simulate import simulate
 from double_pendulum.model.dynamics import linearised_normal_modes
@@ -50,12 +52,18 @@ def test_physical_variables_carry_fmi_units_and_descriptions(fmu_path):
     assert set(OUTPUT_NAMES) <= {sv.get("name") for sv in root.find("ModelVariables")}
 
 
-def test_fmu_bundles_the_package_and_lists_runtime_requirements(fmu_path):
+def test_fmu_bundles_the_package_its_loader_and_the_python_it_was_built_with(fmu_path):
     with zipfile.ZipFile(fmu_path) as z:
         names = z.namelist()
         assert "resources/double_pendulum/model/dynamics.py" in names
         assert "resources/DoublePendulum.py" in names
-        assert "pythonfmu" in z.read("resources/requirements.txt").decode()
+        assert "resources/requirements.txt" not in names  # it needs nothing installed
+        assert len(json.loads(z.read("resources/bundle.json"))["id"]) == 16
+        if sys.platform.startswith("linux") and loader.c_compiler():
+            assert {"binaries/linux64/DoublePendulum.so", "binaries/linux64/libpythonfmu-export.so"} <= set(names)
+            record = z.read("resources/python.cfg").decode()
+            assert f"version={sys.version_info[0]}.{sys.version_info[1]}" in record
+            assert f"home={sys.base_prefix}" in record
         # bytecode only for the FMU's own sources (nothing copied from a local __pycache__)
         for name in (n for n in names if "__pycache__" in n):
             folder, cached = name.split("/__pycache__/")

@@ -1,0 +1,173 @@
+/* A minimal FMI 2.0 co-simulation host in C, for the tests (tests/test_c_host.py): no Python in it.
+ *
+ *   fmi2_host DIR IDENTIFIER GUID STEPS STEP_SIZE [ARG ...]
+ *
+ * DIR is an extracted FMU; the host dlopens DIR/binaries/linux64/IDENTIFIER.so, instantiates it
+ * (co-simulation, logging off), applies the ARGs, sets up, initialises (inputs set in initialisation
+ * mode), runs STEPS doSteps of STEP_SIZE from t = 0 (inputs set before each), reads the outputs,
+ * terminates and frees the instance, and unloads the library.
+ * ARGs: r:VR=VALUE (Real start value), b:VR=0|1 (Boolean), s:VR=TEXT (String), i:VR=VALUE (Real
+ * input set before every doStep), o:VR (Real read at the end, printed as "VR VALUE" with 17 digits).
+ * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE". At the end the host prints
+ * "startup-cpu-seconds T" (the process's CPU time from loading the library to the end of the first
+ * doStep) and "host-unchanged 1" if its environment and its signal handlers are as they were before
+ * it loaded the FMU, else "host-unchanged 0". Exit status: 0 on success, 2 bad usage, 3 library not loaded,
+ * 4 instantiation failed, 5 a call failed. */
+#include <dlfcn.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "fmi2Functions.h"
+
+#define MAX_ARGS 128
+
+extern char **environ;
+static const int SIGNALS[] = {SIGINT, SIGTERM, SIGPIPE, SIGCHLD, SIGXFSZ, SIGSEGV};
+#define N_SIGNALS (sizeof SIGNALS / sizeof SIGNALS[0])
+
+/* The environment and the handlers of SIGNALS, as one comparable record. */
+typedef struct {
+    char environment[65536];
+    struct sigaction actions[N_SIGNALS];
+} host_state;
+
+static void snapshot(host_state *state) {
+    memset(state, 0, sizeof *state);
+    for (char **e = environ; *e; e++) {
+        strncat(state->environment, *e, sizeof state->environment - strlen(state->environment) - 2);
+        strcat(state->environment, "\n");
+    }
+    for (size_t k = 0; k < N_SIGNALS; k++) sigaction(SIGNALS[k], NULL, &state->actions[k]);
+}
+
+static int unchanged(const host_state *before, const host_state *after) {
+    if (strcmp(before->environment, after->environment) != 0) return 0;
+    for (size_t k = 0; k < N_SIGNALS; k++)
+        if (before->actions[k].sa_handler != after->actions[k].sa_handler) return 0;
+    return 1;
+}
+
+static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
+                   fmi2String message, ...) {
+    (void)env;
+    (void)instance;
+    va_list args;
+    va_start(args, message);
+    printf("log %d %s: ", (int)status, category ? category : "");
+    vprintf(message, args);
+    printf("\n");
+    va_end(args);
+    fflush(stdout);
+}
+
+static void *symbol(void *library, const char *name) {
+    void *f = dlsym(library, name);
+    if (!f) {
+        fprintf(stderr, "missing %s\n", name);
+        exit(3);
+    }
+    return f;
+}
+
+#define CHECK(call)                                                                                               \
+    do {                                                                                                          \
+        fmi2Status status_ = (call);                                                                             \
+        if (status_ > fmi2Warning) {                                                                              \
+            fprintf(stderr, "%s failed with status %d\n", #call, (int)status_);                                   \
+            return 5;                                                                                             \
+        }                                                                                                         \
+    } while (0)
+
+int main(int argc, char **argv) {
+    if (argc < 6) {
+        fprintf(stderr, "usage: %s DIR IDENTIFIER GUID STEPS STEP_SIZE [ARG ...]\n", argv[0]);
+        return 2;
+    }
+    const char *dir = argv[1], *identifier = argv[2], *guid = argv[3];
+    long steps = atol(argv[4]);
+    double step_size = atof(argv[5]);
+    char path[4096], resources[4200];
+    snprintf(path, sizeof path, "%s/binaries/linux64/%s.so", dir, identifier);
+    snprintf(resources, sizeof resources, "file://%s/resources", dir);
+
+    static host_state before, after;
+    snapshot(&before);
+    struct timespec start, first_step;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &start);
+    first_step = start;
+    void *library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!library) {
+        fprintf(stderr, "cannot load %s: %s\n", path, dlerror());
+        return 3;
+    }
+    fmi2InstantiateTYPE *instantiate = (fmi2InstantiateTYPE *)symbol(library, "fmi2Instantiate");
+    fmi2FreeInstanceTYPE *free_instance = (fmi2FreeInstanceTYPE *)symbol(library, "fmi2FreeInstance");
+    fmi2SetupExperimentTYPE *setup = (fmi2SetupExperimentTYPE *)symbol(library, "fmi2SetupExperiment");
+    fmi2EnterInitializationModeTYPE *enter = (fmi2EnterInitializationModeTYPE *)symbol(library, "fmi2EnterInitializationMode");
+    fmi2ExitInitializationModeTYPE *exit_init = (fmi2ExitInitializationModeTYPE *)symbol(library, "fmi2ExitInitializationMode");
+    fmi2SetRealTYPE *set_real = (fmi2SetRealTYPE *)symbol(library, "fmi2SetReal");
+    fmi2SetBooleanTYPE *set_boolean = (fmi2SetBooleanTYPE *)symbol(library, "fmi2SetBoolean");
+    fmi2SetStringTYPE *set_string = (fmi2SetStringTYPE *)symbol(library, "fmi2SetString");
+    fmi2GetRealTYPE *get_real = (fmi2GetRealTYPE *)symbol(library, "fmi2GetReal");
+    fmi2DoStepTYPE *do_step = (fmi2DoStepTYPE *)symbol(library, "fmi2DoStep");
+    fmi2TerminateTYPE *terminate = (fmi2TerminateTYPE *)symbol(library, "fmi2Terminate");
+
+    fmi2CallbackFunctions callbacks = {logger, calloc, free, NULL, NULL};
+    fmi2Component c = instantiate("host", fmi2CoSimulation, guid, resources, &callbacks, fmi2False, fmi2False);
+    if (!c) {
+        fprintf(stderr, "fmi2Instantiate returned NULL\n");
+        return 4;
+    }
+
+    fmi2ValueReference inputs[MAX_ARGS], outputs[MAX_ARGS];
+    fmi2Real input_values[MAX_ARGS];
+    size_t n_inputs = 0, n_outputs = 0;
+    for (int k = 6; k < argc && n_inputs < MAX_ARGS && n_outputs < MAX_ARGS; k++) {
+        char kind = argv[k][0];
+        const char *value = strchr(argv[k], '=');
+        fmi2ValueReference vr = (fmi2ValueReference)strtoul(argv[k] + 2, NULL, 10);
+        if (kind == 'o') {
+            outputs[n_outputs++] = vr;
+        } else if (!value || argv[k][1] != ':') {
+            fprintf(stderr, "bad argument %s\n", argv[k]);
+            return 2;
+        } else if (kind == 'r') {
+            fmi2Real real = atof(value + 1);
+            CHECK(set_real(c, &vr, 1, &real));
+        } else if (kind == 'b') {
+            fmi2Boolean boolean = atoi(value + 1) ? fmi2True : fmi2False;
+            CHECK(set_boolean(c, &vr, 1, &boolean));
+        } else if (kind == 's') {
+            fmi2String string = value + 1;
+            CHECK(set_string(c, &vr, 1, &string));
+        } else if (kind == 'i') {
+            inputs[n_inputs] = vr;
+            input_values[n_inputs++] = atof(value + 1);
+        }
+    }
+
+    CHECK(setup(c, fmi2False, 0.0, 0.0, fmi2True, steps * step_size));
+    CHECK(enter(c));
+    if (n_inputs) CHECK(set_real(c, inputs, n_inputs, input_values));
+    CHECK(exit_init(c));
+    for (long k = 0; k < steps; k++) { /* communication points k h, as fmpy's simulate_fmu steps */
+        if (n_inputs) CHECK(set_real(c, inputs, n_inputs, input_values));
+        CHECK(do_step(c, k * step_size, (k + 1) * step_size - k * step_size, fmi2True));
+        if (k == 0) clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &first_step);
+    }
+    fmi2Real values[MAX_ARGS];
+    if (n_outputs) CHECK(get_real(c, outputs, n_outputs, values));
+    for (size_t k = 0; k < n_outputs; k++) printf("%u %.17g\n", outputs[k], values[k]);
+    CHECK(terminate(c));
+    free_instance(c);
+    dlclose(library);
+    snapshot(&after);
+    printf("startup-cpu-seconds %.6f\n",
+           (double)(first_step.tv_sec - start.tv_sec) + 1e-9 * (double)(first_step.tv_nsec - start.tv_nsec));
+    printf("host-unchanged %d\n", unchanged(&before, &after));
+    return 0;
+}

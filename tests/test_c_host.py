@@ -1,0 +1,175 @@
+"""The FMUs in a host that is not Python: a minimal C host (tests/c_host/fmi2_host.c), started with a
+bare environment, loads each FMU that ``double-pendulum build`` writes through its C loader
+(``fmu_src/loader/``, :mod:`double_pendulum.fmu.loader`), runs it as fmpy does and gets fmpy's numbers;
+without a usable Python the FMU refuses to instantiate and says why in one line."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import build_all
+
+HOST_SOURCE = Path(__file__).parent / "c_host" / "fmi2_host.c"
+STEPS, STEP_SIZE = 1000, 1e-3
+RUNS = 10  # C-host runs of each FMU
+
+CASES = {  # file: (start values, inputs held at these values, outputs compared)
+    "DoublePendulum.fmu": (
+        {"phi1_0": 2.0, "phi2_0": 2.0, "air_drag": True, "bearing_friction": True, "solver": "dopri5", "rtol": 1e-8},
+        {"tau1": 0.02, "pivot_ax": 0.3},
+        ["phi1", "phi2", "omega1", "omega2", "E_total", "W_input", "F_pivot_x"],
+    ),
+    "Suspension.fmu": (
+        {"k_x": 5e3, "c_y": 5.0},
+        {"F_x": 1.0, "F_y": -7.0},
+        ["x", "y", "vx", "vy", "E_suspension", "W_in"],
+    ),
+    "PendulumOnSuspension.fmu": (
+        {"DoublePendulum.phi1_0": 1.5, "Suspension.k_x": 5e3},
+        {},
+        ["DoublePendulum.phi1", "DoublePendulum.phi2", "DoublePendulum.F_pivot_x", "Suspension.x", "Suspension.y"],
+    ),
+}
+
+
+def _shared_libpython_here() -> bool:
+    record = dict(line.split("=", 1) for line in loader.python_record().splitlines() if "=" in line)
+    return bool(record["library"]) and Path(record["library"]).is_file()
+
+
+pytestmark = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the C loader and this C host are for Linux"),
+    pytest.mark.skipif(loader.c_compiler() is None, reason="no C compiler ($CC, cc, gcc or clang) to build the C host"),
+    pytest.mark.skipif(not _shared_libpython_here(),
+                       reason="this Python has no shared libpython, which the FMU needs in a host without Python"),
+]
+
+
+@pytest.fixture(scope="module")
+def host(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The C host, compiled for this test session."""
+    path = tmp_path_factory.mktemp("c_host") / "fmi2_host"
+    command = [*loader.c_compiler(), "-O2", f"-I{loader.fmi_headers()}", "-o", str(path), str(HOST_SOURCE), "-ldl"]
+    subprocess.run(command, check=True, capture_output=True)
+    return path
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Every FMU ``double-pendulum build`` writes, by file name."""
+    folder = tmp_path_factory.mktemp("built")
+    return {path.name: path for path in build_all(folder / "DoublePendulum.fmu") if path.suffix == ".fmu"}
+
+
+@pytest.fixture(scope="module")
+def extracted(fmus: dict[str, Path], tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path, object]]:
+    """Each FMU extracted, with its model description."""
+    from fmpy import extract, read_model_description
+
+    folder = tmp_path_factory.mktemp("extracted")
+    return {name: (Path(extract(str(path), str(folder / name))), read_model_description(str(path)))
+            for name, path in fmus.items()}
+
+
+def bare_environment(home: Path, **extra: str) -> dict[str, str]:
+    """What ``env -i PATH=/usr/bin:/bin HOME=...`` gives a process: no LD_PRELOAD, PYTHONHOME or PYTHONPATH."""
+    return {"PATH": "/usr/bin:/bin", "HOME": str(home), **extra}
+
+
+def host_arguments(name: str, description) -> list[str]:
+    """The C host's arguments for CASES[name]: start values, inputs and outputs by value reference."""
+    start, inputs, outputs = CASES[name]
+    variables = {v.name: v for v in description.modelVariables}
+    args = []
+    for variable, value in start.items():
+        kind = {"Boolean": "b", "String": "s"}.get(variables[variable].type, "r")
+        args.append(f"{kind}:{variables[variable].valueReference}={int(value) if kind == 'b' else value}")
+    args += [f"i:{variables[n].valueReference}={value!r}" for n, value in inputs.items()]
+    return args + [f"o:{variables[n].valueReference}" for n in outputs]
+
+
+def run_host(host: Path, folder: Path, description, args: list[str], env: dict[str, str], cwd: Path):
+    identifier = description.coSimulation.modelIdentifier
+    command = [str(host), str(folder), identifier, description.guid, str(STEPS), repr(STEP_SIZE), *args]
+    return subprocess.run(command, capture_output=True, text=True, env=env, cwd=cwd, timeout=120)
+
+
+def parse_outputs(stdout: str) -> dict[int, float]:
+    rows = [line.split() for line in stdout.splitlines() if line[:1].isdigit()]
+    return {int(vr): float(value) for vr, value in rows}
+
+
+def fmpy_outputs(path: Path, name: str) -> list[float]:
+    """The same run through fmpy's simulate_fmu (inputs held at their values), its last row."""
+    from fmpy import simulate_fmu
+
+    start, inputs, outputs = CASES[name]
+    signal = None
+    if inputs:
+        signal = np.array([(0.0, *inputs.values()), (1.0, *inputs.values())],
+                          dtype=[("time", float), *((n, float) for n in inputs)])
+    result = simulate_fmu(str(path), start_values=start, stop_time=STEPS * STEP_SIZE, output_interval=STEP_SIZE,
+                          input=signal, output=outputs)
+    return [float(result[n][-1]) for n in outputs]
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_every_fmu_runs_in_a_c_host_with_a_bare_environment_as_in_fmpy(host, fmus, extracted, tmp_path, name):
+    folder, description = extracted[name]
+    expected = fmpy_outputs(fmus[name], name)
+    args = host_arguments(name, description)
+    for run in range(RUNS):
+        done = run_host(host, folder, description, args, bare_environment(tmp_path), tmp_path)
+        assert done.returncode == 0, f"run {run}: exit {done.returncode}\n{done.stdout[-2000:]}\n{done.stderr[-2000:]}"
+        assert "host-unchanged 1" in done.stdout, "the FMU changed the host's environment or signal handlers"
+        got = list(parse_outputs(done.stdout).values())
+        assert got == pytest.approx(expected, rel=1e-10, abs=1e-10), f"run {run}"
+    assert not os.listdir(tmp_path), "the FMU left files in the host's working folder"
+
+
+@pytest.mark.parametrize("override", ["/nonexistent/python3", "/bin/true"])
+def test_without_a_usable_python_instantiate_returns_null_and_says_why_in_one_line(host, extracted, tmp_path, override):
+    folder, description = extracted["DoublePendulum.fmu"]
+    env = bare_environment(tmp_path, **{loader.OVERRIDE_VARIABLE: override})
+    done = run_host(host, folder, description, [], env, tmp_path)
+    assert done.returncode == 4, done.stdout + done.stderr  # fmi2Instantiate returned NULL: no crash, no hang
+    logged = [line for line in done.stdout.splitlines() if line.startswith("log ")]
+    assert len(logged) == 1 and logged[0].startswith("log 3 ")  # one fmi2Error line through the host's logger
+    for text in (logged[0], done.stderr):
+        assert "no usable Python to run this FMU" in text and f"{loader.OVERRIDE_VARIABLE}={override}" in text
+        assert "CPython >= 3.11 with a shared libpython" in text  # what it needs and how to point it there
+
+
+def test_the_hosts_python_variables_do_not_reach_the_fmus_interpreter(host, extracted, tmp_path):
+    """PYTHONHOME and PYTHONPATH set for some other Python (here: broken ones) leave the FMU unmoved."""
+    poisoned = tmp_path / "poisoned"
+    poisoned.mkdir()
+    (poisoned / "json.py").write_text("raise ImportError('the host PYTHONPATH reached the FMU')\n")
+    folder, description = extracted["DoublePendulum.fmu"]
+    args = host_arguments("DoublePendulum.fmu", description)
+    clean = run_host(host, folder, description, args, bare_environment(tmp_path), tmp_path)
+    env = bare_environment(tmp_path, PYTHONPATH=str(poisoned), PYTHONHOME="/nonexistent")
+    polluted = run_host(host, folder, description, args, env, tmp_path)
+    assert polluted.returncode == 0, polluted.stdout[-2000:] + polluted.stderr[-2000:]
+    assert parse_outputs(polluted.stdout) == parse_outputs(clean.stdout)
+
+
+def test_an_interpreter_with_nothing_installed_runs_the_fmu(host, extracted, tmp_path):
+    """Named by the override, a fresh virtual environment without even pip gives the same numbers."""
+    venv = tmp_path / "empty"
+    subprocess.run([getattr(sys, "_base_executable", sys.executable), "-m", "venv", "--without-pip", str(venv)],
+                   check=True, capture_output=True)
+    folder, description = extracted["DoublePendulum.fmu"]
+    args = host_arguments("DoublePendulum.fmu", description)
+    recorded = run_host(host, folder, description, args, bare_environment(tmp_path), tmp_path)
+    env = bare_environment(tmp_path, **{loader.OVERRIDE_VARIABLE: str(venv / "bin" / "python")})
+    empty = run_host(host, folder, description, args, env, tmp_path)
+    assert empty.returncode == 0, empty.stdout[-2000:] + empty.stderr[-2000:]
+    assert parse_outputs(empty.stdout) == parse_outputs(recorded.stdout)
