@@ -1,22 +1,32 @@
 """Size, file count and start-up time of FMUs, side by side in one run.
 
-    python benchmarks/fmu_footprint.py OLD.fmu NEW.fmu [--repeats 15]
+    python benchmarks/fmu_footprint.py OLD.fmu NEW.fmu [--repeats 15] [--c-host]
 
-Start-up is instantiate .. exitInitializationMode in a fresh process (CPU time, median over
-repeats, the FMUs interleaved so machine noise hits both alike); the first FMU is the reference
-of the ratios.
+Start-up is loading the binary, instantiate .. the first 1 ms doStep, in a fresh process (CPU time,
+median over repeats, the FMUs interleaved so machine noise hits both alike); the first FMU is the
+reference of the ratios. ``--c-host`` also times each FMU in the C host of the tests
+(``tests/c_host/fmi2_host.c``, compiled here), started with a bare environment: an FMU whose Linux
+binary is pythonfmu's own (no loader, e.g. one built before the loader) gets what it needs there,
+``LD_PRELOAD`` of libpython and ``PYTHONHOME``, so both can be compared.
 """
 
 from __future__ import annotations
 
 import argparse
 import statistics
+import subprocess
+import sys
+import sysconfig
 import tempfile
 import zipfile
 from pathlib import Path
 
-from fmpy import extract
+from fmpy import extract, read_model_description
 from fmu_performance import startup_time
+
+from double_pendulum.fmu import loader
+
+HOST_SOURCE = Path(__file__).resolve().parents[1] / "tests" / "c_host" / "fmi2_host.c"
 
 
 def footprint(fmu: Path) -> tuple[int, int, int]:
@@ -27,24 +37,51 @@ def footprint(fmu: Path) -> tuple[int, int, int]:
     return fmu.stat().st_size, len(names), sources
 
 
+def c_host_startup(host: Path, fmu: Path, unzipdir: str, home: str) -> float:
+    """CPU seconds from loading the FMU's binary to the end of its first doStep, in the C host."""
+    md = read_model_description(str(fmu))
+    env = {"PATH": "/usr/bin:/bin", "HOME": home}
+    if not (Path(unzipdir) / "binaries" / loader.PLATFORM / loader.BACKEND_NAME).is_file():  # pythonfmu's own
+        libdir, soname = sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("INSTSONAME")
+        env |= {"LD_PRELOAD": f"{libdir}/{soname}", "PYTHONHOME": sys.base_prefix}
+    command = [str(host), unzipdir, md.coSimulation.modelIdentifier, md.guid, "1", "0.001"]
+    out = subprocess.run(command, capture_output=True, text=True, env=env, check=True).stdout
+    return float(next(line.split()[1] for line in out.splitlines() if line.startswith("startup-cpu-seconds")))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("fmus", nargs="+", type=Path)
     parser.add_argument("--repeats", type=int, default=15)
+    parser.add_argument("--c-host", action="store_true", help="also time each FMU in the C host (bare environment)")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         unzipped = {fmu: extract(str(fmu), unzipdir=str(Path(tmp) / str(i))) for i, fmu in enumerate(args.fmus)}
+        host = None
+        if args.c_host:
+            host = Path(tmp) / "fmi2_host"
+            subprocess.run([*loader.c_compiler(), "-O2", f"-I{loader.fmi_headers()}", "-o", str(host),
+                            str(HOST_SOURCE), "-ldl"], check=True)
         times: dict[Path, list[float]] = {fmu: [] for fmu in args.fmus}
+        c_times: dict[Path, list[float]] = {fmu: [] for fmu in args.fmus}
         for _ in range(args.repeats):
             for fmu in args.fmus:
                 times[fmu].append(startup_time(fmu, unzipped[fmu], 1)[0])
+                if host:
+                    c_times[fmu].append(c_host_startup(host, fmu, unzipped[fmu], tmp))
     reference = statistics.median(times[args.fmus[0]])
-    print(f"{'FMU':40s} {'size [kB]':>10s} {'files':>6s} {'.py':>5s} {'start-up [ms]':>14s} {'ratio':>6s}")
+    c_reference = statistics.median(c_times[args.fmus[0]]) if host else 1.0
+    header = f"{'FMU':40s} {'size [kB]':>10s} {'files':>6s} {'.py':>5s} {'fmpy start-up [ms]':>19s} {'ratio':>6s}"
+    print(header + (f" {'C-host start-up [ms]':>21s} {'ratio':>6s}" if host else ""))
     for fmu in args.fmus:
         size, files, sources = footprint(fmu)
         median = statistics.median(times[fmu])
-        print(f"{str(fmu):40s} {size / 1024:10.0f} {files:6d} {sources:5d} {median * 1e3:14.1f}"
-              f" {median / reference:6.2f}")
+        line = (f"{str(fmu):40s} {size / 1024:10.0f} {files:6d} {sources:5d} {median * 1e3:19.1f}"
+                f" {median / reference:6.2f}")
+        if host:
+            c_median = statistics.median(c_times[fmu])
+            line += f" {c_median * 1e3:21.1f} {c_median / c_reference:6.2f}"
+        print(line)
 
 
 if __name__ == "__main__":

@@ -7,8 +7,9 @@ Usage: ``python benchmarks/fmu_performance.py [--fmu build/DoublePendulum.fmu] [
    start phi1 = phi2 = 2 rad, against the cached reference), output every 10 ms. Target <= 0.5.
 2. The FMU's cost per doStep at a 1 ms communication step versus an empty pythonfmu FMU doing the
    same number of steps (both through fmpy, one output recorded). Target <= 2.
-3. FMU start-up (instantiate + initialise, first instance in a fresh process, so including the
-   import of the bundled package) versus the empty FMU. Target <= 2.
+3. FMU start-up (loading the binary, instantiate + initialise + the first 1 ms doStep, first
+   instance in a fresh process, so including the import of the bundled package) versus the empty
+   FMU. Target <= 2.
 4. The stiff suspension (k = 1e7 N/m, M_s = 0.05 kg, 2 s) with the FMU's stiff solver (rodas4)
    versus SciPy's LSODA called directly, each at the loosest tolerance whose largest error over
    the run is <= 1e-5. Target <= 1.
@@ -146,13 +147,14 @@ STARTUP_SCRIPT = textwrap.dedent('''
     from fmpy import extract, read_model_description
     from fmpy.fmi2 import FMU2Slave
     md = read_model_description(sys.argv[1])
+    t0 = time.process_time()
     fmu = FMU2Slave(guid=md.guid, unzipDirectory=sys.argv[2], modelIdentifier=md.coSimulation.modelIdentifier,
                     instanceName="startup")
-    t0 = time.process_time()
     fmu.instantiate()
     fmu.setupExperiment(startTime=0.0)
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
+    fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=1e-3)
     print(time.process_time() - t0, flush=True)
     os._exit(0)
 ''')
@@ -172,7 +174,7 @@ def bench_startup(runner: FmuRunner, empty: FmuRunner, repeats: int) -> float:
     t_fmu, s_fmu = startup_time(runner.fmu_path, runner.unzipdir, repeats)
     t_empty, s_empty = startup_time(empty.fmu_path, empty.unzipdir, repeats)
     ratio = t_fmu / t_empty
-    print("3. start-up in a fresh process (instantiate .. exitInitializationMode)")
+    print("3. start-up in a fresh process (loading the binary, instantiate .. the first 1 ms doStep)")
     print(f"   FMU {t_fmu * 1e3:.1f} ms ({s_fmu:.0%}), empty pythonfmu FMU {t_empty * 1e3:.1f} ms ({s_empty:.0%})")
     print(f"   ratio = {ratio:.2f}  (target <= 2: {'met' if ratio <= 2 else 'NOT met'})")
     return ratio
