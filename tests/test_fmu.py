@@ -253,3 +253,25 @@ def test_fmu_bundles_only_the_runtime(fmu_path):
     parts = {n.split("/")[2] for n in sources}
     assert parts == {"__init__.py", *RUNTIME_SUBPACKAGES}
     assert not any(word in n for n in sources for word in ("analysis", "plots", "cli", "scenarios", "fmu/"))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the C loader is for Linux")
+def test_without_a_c_compiler_the_build_says_so_once_and_keeps_pythonfmus_binary(tmp_path, monkeypatch, capfd):
+    from pythonfmu.builder import HERE as PYTHONFMU_FOLDER
+
+    from double_pendulum.fmu import build
+
+    monkeypatch.setenv("CC", "/nonexistent/cc")
+    build._loader_binary.cache_clear()
+    try:
+        fmus = [build.build_fmu(tmp_path / f"{name}.fmu", name) for name in ("DoublePendulum", "Suspension")]
+    finally:
+        build._loader_binary.cache_clear()
+    said = capfd.readouterr().err.strip().splitlines()
+    assert len(said) == 1 and "no C compiler found" in said[0] and "only in Python hosts" in said[0]
+    plain = (PYTHONFMU_FOLDER / "resources" / "binaries" / "linux64" / "libpythonfmu-export.so").read_bytes()
+    for fmu in fmus:
+        with zipfile.ZipFile(fmu) as z:
+            binaries = [n for n in z.namelist() if n.startswith("binaries/linux64/")]
+            assert binaries == [f"binaries/linux64/{fmu.stem}.so"] and z.read(binaries[0]) == plain
+            assert "resources/python.cfg" not in z.namelist()
