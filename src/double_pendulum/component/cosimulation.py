@@ -111,6 +111,24 @@ def default_parameter_values() -> dict[str, Any]:
     return {f.name: f.default for group in PARAMETER_GROUPS for f in fields(group)}
 
 
+def with_jump_work(model: Model, y: list[float], old: InputValues, new: InputValues) -> list[float]:
+    """Return ``y`` with the energy jump [J] of switching the inputs ``old -> new`` added to ``W_input``.
+
+    ``model`` is a scene with inputs (its state has ``W_input``). Only the pivot (base) position and
+    velocity change the energy at once: the jump is
+    :math:`E(y, u_{new}) - E(y, u_{old})` with :math:`E = E_{kin} + E_{pot} + E_{suspension}`
+    (:func:`~double_pendulum.model.vector_field.energies`); a consistent hold makes it vanish with
+    the communication step.
+    """
+    config, layout = model.config, model.layout
+    jump = sum(energies(config, y, layout, new)) - sum(energies(config, y, layout, old))
+    if jump == 0.0:
+        return y
+    booked = list(y)
+    booked[layout.index("W_input")] += jump
+    return booked
+
+
 class LazyOutputs(Mapping[str, float]):
     """The outputs at one communication point, computed group by group on first access.
 
@@ -205,7 +223,7 @@ class DoublePendulumCoSimulation:
         if self._outputs_stale:
             self._outputs_stale = False
             new = self._input_values()
-            y = self._with_jump_work(self._y, self._hold.at(self.time), new)  # as it will be booked
+            y = with_jump_work(self.model, self._y, self._hold.at(self.time), new)  # as it will be booked
             self._outputs = self._outputs_at(y, new)
         return self._outputs
 
@@ -214,34 +232,24 @@ class DoublePendulumCoSimulation:
         self._outputs = values
         self._outputs_stale = False
 
+    def state_values(self) -> dict[str, float]:
+        """The model's state at the current communication point, by state name (``model.layout``)."""
+        return dict(zip(self.model.layout.names, self._y))
+
     def _input_values(self) -> InputValues:
         return InputValues(**self.inputs)
-
-    def _with_jump_work(self, y: list[float], old: InputValues, new: InputValues) -> list[float]:
-        """Return ``y`` with the energy jump [J] of switching the inputs ``old -> new`` added to ``W_input``.
-
-        Only the pivot (base) position and velocity change the energy at once; a consistent hold
-        makes the jump vanish with the communication step.
-        """
-        config, layout = self.model.config, self.model.layout
-        jump = sum(energies(config, y, layout, new)) - sum(energies(config, y, layout, old))
-        if jump == 0.0:
-            return y
-        booked = list(y)
-        booked[layout.index("W_input")] += jump
-        return booked
 
     def _start_driving(self) -> None:
         """Switch to the model with inputs at the current point: add ``W_input = 0``, restart."""
         self.driven = True
-        self.model = build_model(self._config())
+        self.model = build_model(self.model_config())
         self._y = self._y + [0.0]  # W_input is the last state
         self._restart(self.time)
 
     def _restart(self, t: float) -> None:
         """Restart the integrator at ``t`` from the current state with the inputs set now."""
         new = self._input_values()
-        self._y = self._with_jump_work(self._y, self._hold.at(t) if self._hold else ZERO_INPUTS, new)
+        self._y = with_jump_work(self.model, self._y, self._hold.at(t) if self._hold else ZERO_INPUTS, new)
         self._hold = InputHold(t, new)
         f = build_vector_field(self.model.config, self.model.evaluate, self._hold)
         self.integrator.restart(t, self._y, f)
@@ -256,13 +264,14 @@ class DoublePendulumCoSimulation:
             raise CoSimulationError(f"invalid start time {start_time!r} s: must be finite")
         self.time = float(start_time)
 
-    def _config(self) -> ModelConfig:
+    def model_config(self, inputs: bool | None = None) -> ModelConfig:
+        """The scene of the parameters set so far, with inputs if ``inputs`` (default: if driven)."""
         return ModelConfig(
             pendulum=self._group(PendulumParameters),
             air=self._group(AirDragParameters),
             bearing=self._group(BearingParameters),
             suspension=self._group(SuspensionParameters),
-            inputs=self.driven,
+            inputs=self.driven if inputs is None else inputs,
         )
 
     def initialise(self) -> None:
@@ -270,7 +279,7 @@ class DoublePendulumCoSimulation:
         self.driven = self.driven or any(self.inputs.values())
         initial = self._group(InitialState)
         settings = self._group(SolverSettings)
-        self.model = build_model(self._config())
+        self.model = build_model(self.model_config())
         y0 = self.model.initial_state(*initial.as_list())
         self._hold = InputHold(self.time, self._input_values()) if self.driven else None
         self.integrator = make_integrator(
@@ -413,4 +422,5 @@ __all__ = [
     "ParameterError",
     "SolverError",
     "default_parameter_values",
+    "with_jump_work",
 ]
