@@ -263,6 +263,7 @@ def test_without_a_c_compiler_the_build_says_so_once_and_keeps_pythonfmus_binary
 
     monkeypatch.setenv("CC", "/nonexistent/cc")
     build._loader_binary.cache_clear()
+    build._note.cache_clear()
     try:
         fmus = [build.build_fmu(tmp_path / f"{name}.fmu", name) for name in ("DoublePendulum", "Suspension")]
     finally:
