@@ -63,9 +63,10 @@ def host(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 @pytest.fixture(scope="module")
 def fmus(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    """Every FMU ``double-pendulum build`` writes, by file name."""
+    """Every FMU ``double-pendulum build`` writes, by path in the build folder (``fmi3/DoublePendulum.fmu``)."""
     folder = tmp_path_factory.mktemp("built")
-    return {path.name: path for path in build_all(folder / "DoublePendulum.fmu") if path.suffix == ".fmu"}
+    return {str(path.relative_to(folder)): path for path in build_all(folder / "DoublePendulum.fmu")
+            if path.suffix == ".fmu"}
 
 
 @pytest.fixture(scope="module")
@@ -173,3 +174,4 @@ def test_an_interpreter_with_nothing_installed_runs_the_fmu(host, extracted, tmp
     empty = run_host(host, folder, description, args, env, tmp_path)
     assert empty.returncode == 0, empty.stdout[-2000:] + empty.stderr[-2000:]
     assert parse_outputs(empty.stdout) == parse_outputs(recorded.stdout)
+

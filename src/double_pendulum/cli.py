@@ -260,16 +260,18 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser: plain-text help, the scenarios listed under ``run --help``."""
     parser = argparse.ArgumentParser(
         prog=PROG,
-        description="A planar double pendulum as an FMI 2.0 co-simulation FMU: build it, run the "
-        "scenarios through fmpy, print its variables.",
+        description="A planar double pendulum as an FMI 2.0 co-simulation FMU (and an FMI 3.0 Model Exchange "
+        "and Co-Simulation FMU): build them, run the scenarios through fmpy, print the variables.",
     )
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p_build = sub.add_parser("build", help="build DoublePendulum.fmu, Suspension.fmu and the coupled system",
+    p_build = sub.add_parser("build", help="build DoublePendulum.fmu, Suspension.fmu, the coupled system and "
+                             "fmi3/DoublePendulum.fmu",
                              description="Build DoublePendulum.fmu and, next to it, Suspension.fmu, "
-                             "PendulumOnSuspension.ssp (SSP, for libcosim) and PendulumOnSuspension.fmu "
-                             "(fmpy's container FMU).")
+                             "PendulumOnSuspension.ssp (SSP, for libcosim), PendulumOnSuspension.fmu "
+                             "(fmpy's container FMU) and fmi3/DoublePendulum.fmu (FMI 3.0, Model Exchange and "
+                             "Co-Simulation).")
     p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="DoublePendulum FMU path or folder")
     p_build.set_defaults(func=cmd_build)
 

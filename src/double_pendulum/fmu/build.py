@@ -311,11 +311,15 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
 
 def build_all(dest: str | Path = DEFAULT_FMU_PATH) -> list[Path]:
     """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it,
-    then the coupled system (:func:`build_systems`)."""
+    then the coupled system (:func:`build_systems`), then the FMI 3.0 ``DoublePendulum`` in the
+    subfolder ``fmi3/`` (:func:`double_pendulum.fmu.build_fmi3.build_fmu3`)."""
+    from .build_fmi3 import build_fmu3
+
     dest = Path(dest)
     first = build_fmu(dest, MODEL_IDENTIFIER)
     others = [build_fmu(first.parent / f"{name}.fmu", name) for name in INTERFACES if name != MODEL_IDENTIFIER]
-    return [first, *others, *build_systems(first)]
+    fmi3 = build_fmu3(first.parent / "fmi3" / f"{MODEL_IDENTIFIER}.fmu")
+    return [first, *others, *build_systems(first), fmi3]
 
 
 def build_systems(
