@@ -267,6 +267,26 @@ def test_an_input_jump_in_event_mode_is_booked_into_w_input(host3, extracted, tm
     assert abs(residual) < 1e-8 * max(1.0, abs(w_input))
 
 
+def test_the_loader_answers_for_out_arguments_pythonfmu3_leaves_unwritten(host3, extracted, tmp_path):
+    """With pythonfmu3's own result of fmi3UpdateDiscreteStates (two of its attributes misspelt, so its
+    C++ layer writes neither discreteStatesNeedUpdate nor nominalsOfContinuousStatesChanged), a strict
+    host that initialised discreteStatesNeedUpdate = true iterated Event Mode forever (pythonfmu3's
+    own binary in fmusim). The loader initialises them: one event iteration, and the run ends."""
+    import shutil
+
+    folder, description = extracted[FMI3]
+    patched = tmp_path / "patched"
+    shutil.copytree(folder, patched)
+    adapter = patched / "resources" / "DoublePendulumFmi3.py"
+    adapter.write_text(adapter.read_text() + (
+        "\nDoublePendulum.update_discrete_states = lambda self: importlib.import_module(\n"
+        "    f'{_library}.modelexchange').Fmi3UpdateDiscreteStatesResult()\n"))
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    done = run_host3(host3, patched, description, "rk4", [f"o:{refs['phi1']}"], bare_environment(tmp_path), tmp_path)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+    assert reported(done.stdout, "event-iterations") == 1
+
+
 def test_fmi3_without_a_usable_python_instantiate_returns_null_and_says_why(host3, extracted, tmp_path):
     folder, description = extracted[FMI3]
     env = bare_environment(tmp_path, **{loader.OVERRIDE_VARIABLE: "/nonexistent/python3"})
