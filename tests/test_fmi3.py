@@ -129,6 +129,16 @@ def test_both_interfaces_follow_the_fmi2_fmu_from_the_chaotic_start(fmu_path, fm
     assert np.max(np.abs(me["energy_residual"])) < 1e-8
 
 
+def test_co_simulation_starts_at_the_start_time_it_is_given(fmu3_path):
+    """pythonfmu3 drops fmi3EnterInitializationMode's start time; the loader passes it on, so a run from
+    t = 1 s steps from there (the motion does not depend on the time origin)."""
+    runs = [simulate_fmu(str(fmu3_path), fmi_type="CoSimulation", start_time=t0, stop_time=t0 + 0.5,
+                         output_interval=0.01, start_values=CHAOTIC, output=ANGLES) for t0 in (0.0, 1.0)]
+    assert runs[1]["time"][0] == 1.0
+    for name in ANGLES:
+        assert runs[1][name] == pytest.approx(runs[0][name], abs=1e-12)
+
+
 FRICTION = {"bearing_friction": True, "c_R1": 0.05, "c_R2": 0.05, "bearing_drag": True, "tau_b1": 2e-3,
             "tau_b2": 1e-3, "b_v1": 1e-4, "air_drag": True, "rod_drag": True, "suspension": True}
 
