@@ -68,13 +68,7 @@ def c_compiler() -> list[str] | None:
 
 
 @functools.cache
-def _compiled(sources: tuple[Path, ...], mtimes: tuple[float, ...]) -> bytes:
-    compiler = c_compiler()
-    if compiler is None:
-        raise LoaderUnavailable(
-            "no C compiler found ($CC, cc, gcc or clang): the FMUs keep pythonfmu's plain binary, "
-            "which runs only in Python hosts (docs/fmu.md)"
-        )
+def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tuple[float, ...]) -> bytes:
     c_files = [str(path) for path in sources if path.suffix == ".c"]
     with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
         output = Path(tmp) / "loader.so"
@@ -86,15 +80,21 @@ def _compiled(sources: tuple[Path, ...], mtimes: tuple[float, ...]) -> bytes:
 
 
 def compiled_loader() -> bytes:
-    """The loader's shared library for this machine (compiled once per process and source version).
+    """The loader's shared library for this machine (compiled once per process, compiler and source version).
 
     Raises :class:`LoaderUnavailable` where it cannot be built (no C compiler; not Linux), and
     ``RuntimeError`` with the compiler's output if compiling fails.
     """
     if not sys.platform.startswith("linux"):
         raise LoaderUnavailable(f"the loader is for Linux; on {sys.platform} the FMU keeps pythonfmu's binary")
+    compiler = c_compiler()
+    if compiler is None:
+        raise LoaderUnavailable(
+            "no C compiler found ($CC, cc, gcc or clang): the FMUs keep pythonfmu's plain binary, "
+            "which runs only in Python hosts (docs/fmu.md)"
+        )
     sources = tuple(loader_sources())
-    return _compiled(sources, tuple(path.stat().st_mtime for path in sources))
+    return _compiled(tuple(compiler), sources, tuple(path.stat().st_mtime for path in sources))
 
 
 def python_record() -> str:
