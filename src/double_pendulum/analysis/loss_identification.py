@@ -801,7 +801,7 @@ def decay_numbers(problem: FitProblem, e_meas: np.ndarray, e_sim: np.ndarray) ->
 
 def air_share_at_defaults(problem: FitProblem, measured_loss: float) -> dict[str, float]:
     """Air drag at the default coefficients (factor 1) on the seed's pendulum: its work over the record [J]
-    and its share of the measured loss (the issue's 'about 1/3' against the model)."""
+    and its share of the measured loss (the seed gives no share: it calls air drag negligible, section 4.2.3)."""
     r = problem.simulate(_air([1.0]), outputs=("W_air",))
     w = float(r["W_air"][-1])
     return {"W_air_J": w, "share_of_measured_loss": w / measured_loss, "cw_rod": AirDragParameters().cw_rod}
