@@ -115,6 +115,13 @@ class ComponentSlave(Fmi2Slave):
         self._sim = self.make_component()
         for var in self.interface.variables():
             self._register(var)
+        # the hot paths of fmi2SetReal and fmi2GetReal (see set_real, get_real)
+        self._real_names = {vr: var.name for vr, var in self.vars.items() if isinstance(var, Real)}
+        input_names = getattr(runtime_module("model.inputs"), "INPUT_NAMES", ())
+        self._input_index = (
+            {vr: input_names.index(name) for vr, name in self._real_names.items() if name in input_names}
+            if hasattr(self._sim, "set_inputs_at") else {}
+        )
         if PRIVATE_PREFIX:
             self._leave_host_as_found()
 
@@ -136,6 +143,32 @@ class ComponentSlave(Fmi2Slave):
 
     def make_component(self):
         raise NotImplementedError
+
+    def set_real(self, vrs, values):
+        """fmi2SetReal: inputs go straight to the component (one float check and a store each, as a
+        master sets them before every step); anything else through pythonfmu and its setter."""
+        index_of = self._input_index
+        try:
+            indices = [index_of[vr] for vr in vrs]
+        except KeyError:  # not inputs only: one by one
+            for vr, value in zip(vrs, values):
+                if vr in index_of:
+                    self._guarded(self._sim.set_inputs_at, (index_of[vr],), (value,))
+                else:
+                    super().set_real([vr], [value])
+            return
+        self._guarded(self._sim.set_inputs_at, indices, values)
+
+    def get_real(self, vrs):
+        """fmi2GetReal: after initialisation straight from the component (outputs computed when read)."""
+        sim = self._sim
+        if not sim.initialised:
+            return super().get_real(vrs)  # the outputs of the values set so far (_output)
+        names, get = self._real_names, sim.get
+        try:
+            return [get(names[vr]) for vr in vrs]
+        except KeyError:  # not a Real: pythonfmu's message
+            return super().get_real(vrs)
 
     def _register(self, var) -> None:
         name = var.name
@@ -203,9 +236,13 @@ class ComponentSlave(Fmi2Slave):
         try:
             return call(*args)
         except Exception as error:
-            self._report(error)
-            _compensate_pythonfmu_release(self.log_queue)
-            raise
+            self._fail(error)
+
+    def _fail(self, error: Exception):
+        """Report ``error`` (:meth:`_report`), balance pythonfmu's release, re-raise it."""
+        self._report(error)
+        _compensate_pythonfmu_release(self.log_queue)
+        raise error
 
     def _report(self, error) -> None:
         """Print the error to stderr, unless the host collects the FMU's log itself.
@@ -228,10 +265,20 @@ class ComponentSlave(Fmi2Slave):
         self._guarded(self._sim.set_state, state)
 
     def do_step(self, current_time, step_size):
+        sim = self._sim
         try:
-            self._sim.do_step(current_time, step_size)
+            sim.do_step(current_time, step_size)
         except Exception as error:  # any failure is a discarded step, never an exception into pythonfmu
             self.log(f"doStep failed: {error}", Fmi2Status.error)
             self._report(error)
             return False
+        if getattr(sim, "notices", None):
+            self._warn(sim.notices)
         return True
+
+    def _warn(self, notices: list) -> None:
+        """Pass the component's warnings to the host's log (fmi2Warning) and stderr, once each."""
+        for notice in notices:
+            self.log(notice, Fmi2Status.warning)
+            self._report(notice)
+        notices.clear()
