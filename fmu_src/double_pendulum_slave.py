@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import importlib
 
-from slave_common import (  # noqa: F401 (runtime_module: the adapters' import)
+from slave_common import (
     ComponentMapping,
     fmi_library,
     leave_host_as_found,
@@ -43,14 +43,53 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
     """
 
     version = package.__version__
-    error_status = Fmi2Status.error
+    error_status, warning_status = Fmi2Status.error, Fmi2Status.warning
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self._sim = self.make_component()
         for var in self.interface.variables():
             self._register(var)
+        # the hot paths of fmi2SetReal and fmi2GetReal (see set_real, get_real)
+        self._real_names = {vr: var.name for vr, var in self.vars.items() if isinstance(var, Real)}
+        input_names = getattr(runtime_module("model.inputs"), "INPUT_NAMES", ())
+        self._input_index = (
+            {vr: input_names.index(name) for vr, name in self._real_names.items() if name in input_names}
+            if hasattr(self._sim, "set_inputs_at") else {}
+        )
         leave_host_as_found(self.resources)
+
+    def set_real(self, vrs, values):
+        """fmi2SetReal: inputs go straight to the component (one float check and a store each, as a
+        master sets them before every step); anything else through pythonfmu and its setter."""
+        index_of = self._input_index
+        try:
+            try:
+                indices = [index_of[vr] for vr in vrs]
+            except KeyError:  # not inputs only: one by one
+                for vr, value in zip(vrs, values):
+                    if vr in index_of:
+                        self._sim.set_inputs_at((index_of[vr],), (value,))
+                    else:
+                        super().set_real([vr], [value])
+                return
+            self._sim.set_inputs_at(indices, values)
+        except Exception as error:
+            self._fail(error)
+
+    def get_real(self, vrs):
+        """fmi2GetReal: after initialisation straight from the component (outputs computed when read)."""
+        sim = self._sim
+        try:
+            if not sim.initialised:
+                return super().get_real(vrs)  # the outputs of the values set so far (_output)
+            names, get = self._real_names, sim.get
+            try:
+                return [get(names[vr]) for vr in vrs]
+            except KeyError:  # not a Real: pythonfmu's message
+                return super().get_real(vrs)
+        except Exception as error:
+            self._fail(error)
 
     def _register(self, var) -> None:
         name = var.name

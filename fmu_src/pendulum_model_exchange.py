@@ -46,6 +46,7 @@ _parameters = runtime_module("model.parameters")
 _inputs = runtime_module("model.inputs")
 _cosimulation = runtime_module("component.cosimulation")
 InputHold, InputValues, INPUT_NAMES = _inputs.InputHold, _inputs.InputValues, _inputs.INPUT_NAMES
+INPUT_ZEROS = _inputs.ZERO_INPUTS
 
 
 def _every_state() -> tuple[str, ...]:
@@ -88,7 +89,8 @@ class PendulumStates:
         self.x = [float(start.get(name, 0.0)) for name in STATES]
         self.evaluations = 0  # derivative evaluations the host asked for
         self._scenes: dict[bool, tuple[Any, list[int]]] = {}
-        self._field: tuple[Any, Any] | None = None  # (inputs, vector field with them)
+        self._hold = InputHold(0.0, INPUT_ZEROS)  # the inputs as set, read by the driven vector field
+        self._field: Any = None  # the driven vector field (built once, on the hold)
         self._outputs = None
         self._derivatives: list[float] | None = None
         # Input jumps: the values set first at the current instant are its left limit.
@@ -128,10 +130,10 @@ class PendulumStates:
             model, slots = self._scene(driven)
             y = self._y(slots)
             if driven:
-                u = self._inputs()
-                if self._field is None or self._field[0] != u:  # the inputs as set, at this instant
-                    self._field = (u, _vector_field.build_vector_field(model.config, model.evaluate, InputHold(0.0, u)))
-                dy = self._field[1](0.0, y)
+                self._hold.reset(0.0, self._inputs())  # the inputs as set, at this instant: no hold
+                if self._field is None:
+                    self._field = _vector_field.build_vector_field(model.config, model.evaluate, self._hold)
+                dy = self._field(0.0, y)
             else:
                 dy = model.vector_field(self.time, y)
             dx = [0.0] * len(STATES)
@@ -171,7 +173,9 @@ class PendulumStates:
         """Book the energy of the input jump at this instant into ``W_input``; True if a state changed.
 
         Called at ``fmi3UpdateDiscreteStates``: the inputs set first at this instant (left limit)
-        against those set now (right limit), :func:`~double_pendulum.component.cosimulation.with_jump_work`.
+        against those set now (right limit), as the co-simulation books a jump
+        (:meth:`~double_pendulum.component.cosimulation.DoublePendulumCoSimulation.with_jump_work`;
+        an input that changed made the component driven, with this scene).
         """
         old, new = InputValues(**self._left), InputValues(**self._known)
         self._left = dict(self._known)
@@ -179,7 +183,7 @@ class PendulumStates:
             return False
         model, slots = self._scene(True)
         y = self._y(slots)
-        booked = _cosimulation.with_jump_work(model, y, old, new)
+        booked = self._component.with_jump_work(y, old, new)
         if booked == y:
             return False
         for slot, value in zip(slots, booked):

@@ -134,7 +134,6 @@ def _guarded_method(method):
     def guarded(self, *args):
         return self._guarded(method, self, *args)
 
-    guarded.guarded = True
     guarded.__name__, guarded.__doc__ = method.__name__, method.__doc__
     return guarded
 
@@ -142,15 +141,15 @@ def _guarded_method(method):
 class ComponentMapping:
     """The part of a slave that does not depend on the FMI version: one co-simulation component.
 
-    Subclasses (with the FMI library's slave class) set ``interface`` (an ``FmuInterface``) and
-    ``error_status`` (the library's error status), keep the component in ``self._sim`` and implement
-    :meth:`make_component`.
+    Subclasses (with the FMI library's slave class) set ``interface`` (an ``FmuInterface``),
+    ``error_status`` and ``warning_status`` (the library's statuses), keep the component in
+    ``self._sim`` and implement :meth:`make_component`.
     """
 
     author = "double-pendulum-fmu contributors"
     license = "MIT"
     interface = None
-    error_status = None
+    error_status = warning_status = None
 
     def make_component(self):
         raise NotImplementedError
@@ -181,40 +180,56 @@ class ComponentMapping:
 
     def __init_subclass__(cls, **kwargs) -> None:
         """Guard the FMI library's variable access too: an unknown value reference or a wrong type
-        raises in the library's own code, and that exception releases the references as well."""
+        raises in the library's own code, and that exception releases the references as well. (An
+        accessor a slave class of ours defines guards itself, with :meth:`_fail`.)"""
         super().__init_subclass__(**kwargs)
         for name in ACCESSORS:
-            method = getattr(cls, name, None)
-            if method is not None and not getattr(method, "guarded", False):
-                setattr(cls, name, _guarded_method(method))
+            owner = next((k for k in cls.__mro__ if name in vars(k)), None)
+            if owner is not None and not issubclass(owner, ComponentMapping):
+                setattr(cls, name, _guarded_method(getattr(cls, name)))
 
     def _guarded(self, call, *args):
-        """Run ``call``; on error also print the message to stderr, then re-raise.
-
-        pythonfmu turns the exception into fmi2Fatal (pythonfmu3: fmi3Fatal) and passes its message
-        to the host's logger (pythonfmu: only when logging is on); stderr makes it visible to a user
-        with logging off too. The references the library will release are balanced once per
-        exception (:func:`compensate_release`), however many guarded calls it passes through.
-        """
+        """Run ``call``; on error report it and re-raise (:meth:`_fail`)."""
         try:
             return call(*args)
         except Exception as error:
-            if not getattr(error, "_dp_fmu_balanced", False):
-                error._dp_fmu_balanced = True
-                self._report(error)
-                compensate_release(type(self), self, self.log_queue)
-            raise
+            self._fail(error)
+
+    def _fail(self, error: Exception):
+        """Print ``error`` to stderr, balance the references the FMI library will release, re-raise it.
+
+        pythonfmu turns the exception into fmi2Fatal (pythonfmu3: fmi3Fatal) and passes its message
+        to the host's logger (pythonfmu: only when logging is on); stderr makes it visible to a user
+        with logging off too. Both happen once per exception (:func:`compensate_release`), however
+        many guarded calls it passes through.
+        """
+        if not getattr(error, "_dp_fmu_balanced", False):
+            error._dp_fmu_balanced = True
+            self._report(error)
+            compensate_release(type(self), self, self.log_queue)
+        raise error
 
     def _report(self, error) -> None:
         report(self.instance_name, self.interface.model_identifier, error)
 
     def _component_step(self, current_time: float, step_size: float) -> bool:
         """doStep of the component; any failure is a discarded step (False), never an exception into
-        the FMI library: the message goes to the host's log and to stderr."""
+        the FMI library: the message goes to the host's log and to stderr. The component's warnings
+        (``notices``) go there too, once each."""
+        sim = self._sim
         try:
-            self._sim.do_step(current_time, step_size)
+            sim.do_step(current_time, step_size)
         except Exception as error:
             self.log(f"doStep failed: {error}", self.error_status)
             self._report(error)
             return False
+        if getattr(sim, "notices", None):
+            self._warn(sim.notices)
         return True
+
+    def _warn(self, notices: list) -> None:
+        """Pass the component's warnings to the host's log (warning status) and stderr, once each."""
+        for notice in notices:
+            self.log(notice, self.warning_status)
+            self._report(notice)
+        notices.clear()

@@ -1,13 +1,16 @@
 """Scenario ``base_excitation``: the pivot driven through the FMU's inputs by fmpy (``simulate_fmu(input=...)``).
 
 1. **Kapitza**: in the single-pendulum limit (m2 = 1e-4 m1) the upright threshold amplitude of a
-   vertical vibration y = a sin(omega t) at omega = 50 rad/s, bisected through the FMU, against
-   a^2 omega^2 = 2 g l (and the exact Mathieu bound).
-2. **Acheson**: a map over amplitude and frequency of the inverted double pendulum staying upright
-   or falling over, against the linear theory (each normal mode an inverted simple pendulum of
-   length g / omega_i^2 obeying Mathieu's equation), with example runs.
+   vertical vibration y = a sin(omega t) at omega = 50 rad/s, bisected on the Floquet multipliers of
+   the system as simulated (the monodromy matrix of one period through the FMU, the acceleration held
+   over each communication step), against the exact bound of that held input, the exact Mathieu bound
+   of the continuous sinusoid and a^2 omega^2 = 2 g l.
+2. **Acheson**: a map over amplitude and frequency of the inverted double pendulum's upright position,
+   stable or not by its simulated Floquet multipliers, against the linear theory (each normal mode an
+   inverted simple pendulum of length g / omega_i^2: Mathieu's equation, and its held-input version),
+   with example runs.
 3. **Resonance**: pivot torque tau1 = T0 sin(omega t) with a viscous pivot bearing; steady-state
-   amplitudes against omega near the two normal modes, peaks against the small-angle modes.
+   amplitudes against omega near the two normal modes, peaks against the damped linear response.
 
 Analysis: ``double_pendulum.analysis`` excitation, excitation_theory, excitation_study,
 excitation_report; figures: ``double_pendulum.plots.excitation``. Map and resonance runs go through
@@ -24,6 +27,7 @@ import numpy as np
 from double_pendulum.analysis import excitation_report as rep
 from double_pendulum.analysis import excitation_study as study
 from double_pendulum.analysis.excitation import TORQUE_OUTPUTS, run_cases, run_torque
+from double_pendulum.analysis.excitation_theory import held_floquet_exponent
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.plots import excitation as fig
 from double_pendulum.results_io import write_json, write_results_csv, write_table_csv, write_text
@@ -48,8 +52,8 @@ FULL = Plan(
     None,
 )
 QUICK = Plan(
-    study.KapitzaSetup(stop_time=2.5, steps_per_period=20, iterations=3),
-    study.AchesonSetup(omegas=(100.0, 200.0), amplitudes=(0.005, 0.02, 0.04), stop_time=1.0,
+    study.KapitzaSetup(stop_time=2.5, steps_per_period=20, iterations=8),
+    study.AchesonSetup(omegas=(100.0, 200.0), amplitudes=(0.005, 0.02, 0.04),
                        example_amplitudes=(0.022,), example_stop_time=1.0),
     study.ResonanceSetup(settle_time=6.0, window=4.0, step=0.025, n_broad=3, offsets=(-0.025, 0.0, 0.025)),
     1,
@@ -73,11 +77,13 @@ def write_tables(out: Path, kap: study.KapitzaResult, map_rows: list, bands: lis
 def draw(out: Path, kap: study.KapitzaResult, map_rows: list, examples: dict, res_rows: list, peaks: list,
          plan: Plan) -> None:
     """The figures: Kapitza threshold, Acheson map and example runs, resonance curve."""
-    lines = {"theory a^2 omega^2 = 2 g l1": kap.theory_point_mass, "exact Mathieu bound": kap.mathieu_exact,
-             "measured threshold": kap.bisection.threshold}
-    runs = {f"a = {kap.bisection.falls_at * 1e3:.3f} mm (falls)": kap.bisection.results["falls"],
-            f"a = {kap.bisection.stable_at * 1e3:.3f} mm (stays up)": kap.bisection.results["stable"]}
-    fig.plot_kapitza_threshold(kap.bisection.probes, lines, runs, kap.setup.growth_limit, kap.setup.theta0,
+    lines = {"averaged a^2 omega^2 = 2 g l1": kap.theory_point_mass,
+             "exact, continuous sinusoid (Mathieu)": kap.mathieu_exact,
+             "exact, input held over each step": kap.held_exact, "simulated threshold": kap.bisection.threshold}
+    amplitudes = np.linspace(*(f * kap.theory_point_mass for f in (0.97, 1.03)), 241)
+    exponents = np.array([held_floquet_exponent(a, kap.setup.omega, kap.effective_length, kap.params.g,
+                                                kap.setup.steps_per_period) for a in amplitudes])
+    fig.plot_kapitza_threshold(kap.bisection.probes, (amplitudes, exponents), lines, kap.examples, kap.setup.theta0,
                                out / "kapitza_threshold.png")
     curve = np.linspace(min(plan.acheson.omegas) - 10.0, max(plan.acheson.omegas) + 10.0, 200)
     theory = study.theory_boundaries(curve)
@@ -85,7 +91,7 @@ def draw(out: Path, kap: study.KapitzaResult, map_rows: list, examples: dict, re
         "theory, lower bound (slow mode, exact Mathieu)": theory["lower_m"],
         "theory, averaged a^2 omega^2 = 2 g L_slow (on the solid line)": theory["kapitza_m"],
         "theory, flutter bound (fast mode, exact Mathieu)": theory["upper_m"]}, out / "acheson_map.png")
-    fig.plot_upright_runs({study.example_label(a, r, plan.acheson): r for a, r in examples.items()},
+    fig.plot_upright_runs({study.example_label(a, plan.acheson): r for a, r in examples.items()},
                           out / "acheson_examples.png")
     fig.plot_resonance_curve(res_rows, study.normal_modes(), peaks, plan.resonance.torque, out / "resonance_curve.png")
 
@@ -99,14 +105,14 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     # 2./3. Acheson map and resonance curve: through fmpy in worker processes
     map_cases, res_cases = study.acheson_cases(plan.acheson), study.resonance_cases(plan.resonance)
     outcomes = run_cases(map_cases + res_cases, str(runner.fmu_path), max_workers=plan.workers)
-    map_rows = study.acheson_rows(outcomes[:len(map_cases)])
+    map_rows = study.acheson_rows(outcomes[:len(map_cases)], plan.acheson.steps_per_period)
     res_rows = outcomes[len(map_cases):]
-    bands, peaks = study.measured_bands(map_rows), study.resonance_peaks(res_rows)
+    bands, peaks = study.measured_bands(map_rows), study.resonance_peaks(res_rows, plan.resonance)
     examples = study.acheson_examples(runner, plan.acheson)
     slow_case = min(res_cases, key=lambda c: abs(c.omega - study.normal_modes()[0]))
     # files
-    for name, result in (("kapitza_falls", kap.bisection.results["falls"]),
-                         ("kapitza_stays_up", kap.bisection.results["stable"]),
+    below, above = kap.examples.values()
+    for name, result in (("kapitza_below_threshold", below), ("kapitza_above_threshold", above),
                          ("resonance_slow_mode", run_torque(slow_case, runner, TORQUE_OUTPUTS))):
         write_results_csv(out / f"{name}.csv", result, runner.units)
     for a, result in examples.items():

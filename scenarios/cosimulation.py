@@ -20,6 +20,7 @@ runs first. Plain Jacobi runs down to h = 0.1 ms, the container FMU
 from __future__ import annotations
 
 import itertools
+import math
 import tempfile
 import time
 from pathlib import Path
@@ -94,6 +95,10 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict[str, A
         "order_pivot": study.orders(rows, "pivot_error_m"),
         "order_energy": study.orders(rows, "energy_error_J"),
         "order_coupling_energy": study.orders(rows, "coupling_energy_J"),
+        "orders_unresolved": {q: study.unresolved_orders(rows, f"{q}_{unit}") for q, unit in
+                              (("angle", "error_rad"), ("pivot", "error_m"), ("energy", "error_J"))},
+        "orders_unresolved_means": f"log|error| is not linear in log h (R^2 < {study.ORDER_MIN_R2:g}): the fitted "
+                                   "slope is no order of convergence",
         "cheapest_to_1e-4_rad": study.cheapest(rows, 1e-4),
         "unstable_runs": [r["message"] for r in rows if not r["stable"]],
         "stability": {scheme: {"zeta": plan["zeta"],
@@ -101,6 +106,17 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict[str, A
                                                   for hw, bracket in study.measured_limit(points, scheme).items()},
                                "derived_limit": {f"h_omega_{hw:g}": critical_mass_ratio(hw, plan["zeta"], scheme)
                                                  for hw in plan["h_omegas"]},
+                               "criterion": "spectral radius of the step map fitted to the run <= 1 + "
+                                            f"{study.STABILITY_TOLERANCE:g}",
+                               "max_abs_fitted_minus_derived_spectral_radius": max(
+                                   (abs(p["spectral_radius_fitted"] - p["spectral_radius_derived"]) for p in points
+                                    if p["scheme"] == scheme and math.isfinite(p["spectral_radius_fitted"])),
+                                   default=math.nan),
+                               "points_too_short_to_fit": sum(not math.isfinite(p["spectral_radius_fitted"])
+                                                              for p in points if p["scheme"] == scheme),
+                               "brackets_hold_derived_limit": all(
+                                   lo <= critical_mass_ratio(hw, plan["zeta"], scheme) <= hi
+                                   for hw, (lo, hi) in study.measured_limit(points, scheme).items()),
                                "derived_limit_small_step": 1.0} for scheme in MAP_SCHEMES},
         "cpu_s_by_method": {m: sum(r["cpu_s"] for r in rows if r["method"] == m) for m in methods},
     }

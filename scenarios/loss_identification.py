@@ -6,18 +6,19 @@ load-proportional bearing friction, bearing drag torque, viscous joint damping a
 suspension, and compares them by AIC/BIC with the residuals' correlation accounted for
 (:mod:`double_pendulum.analysis.loss_identification`). Outputs in ``results/loss_identification/``:
 
-- ``energy.csv``: per fitted frame the measured energy, its error, the best model's simulated energy
+- ``energy.csv``: per fitted frame the measured energy, its error, the top model's simulated energy
   (FMU run) and its dissipated work per mechanism;
 - ``energy_fit.png``, ``loss_shares.png``, ``profiles.png`` (``--thorough`` only);
-- ``summary.json``: ``best_model``, ``b_measured_per_s``, ``b_sim_per_s``, ``p_measured``,
-  ``p_measured_stderr``, ``p_sim``, ``shares`` and the model comparison;
+- ``summary.json``: ``top_model`` (lowest AIC, not a verdict: ``supported_models`` lists every model within
+  delta AIC 2), ``b_measured_per_s``, ``b_sim_per_s``, ``p_measured``,
+  ``p_measured_stderr``, ``p_sim`` and ``top_model_shares`` (the top model's) and the model comparison;
 - ``report.md``.
 
 Default: the one- and two-mechanism models but air+drag2
 (:data:`~double_pendulum.analysis.loss_identification.FULL_MODELS`), about 80 s of CPU on one worker
 process per core (the worker pool is started once for every fitting round). ``thorough``
 (``--thorough``) adds air+drag2 (one drag torque per joint), the three-mechanism models
-air+drag+bearing, air+drag+viscous and air+drag+suspension, with 30 runs for every fit, and the best
+air+drag+bearing, air+drag+viscous and air+drag+suspension, with 30 runs for every fit, and the top
 model's profile likelihood (about 2.5 min more CPU; in the last runs the added models ended at or above
 their parent's optimum, so they change no figure of the default run, and the profile intervals matched
 the curvature errors). ``quick``: air+drag alone in this process, one Gauss-Newton step (6 runs) at
@@ -47,7 +48,7 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False, thorough: bool = Fal
                                E_simulated=ident.e_sim, **ident.works)  # fmt: skip
     units = {"t": "s", "E_measured": "J", "sigma_E": "J", "E_simulated": "J", **{w: "J" for w in ident.works}}
     write_results_csv(out_dir / "energy.csv", table, units)
-    best = s["best_model"]
+    best = s["top_model"]
     plots.plot_energy_fit(ident.t, ident.e_measured, ident.sigma, ident.e_sim, best, out_dir / "energy_fit.png")
     plots.plot_loss_shares(s["models"], out_dir / "loss_shares.png")
     if s["profile_likelihood"]:

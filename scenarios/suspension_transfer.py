@@ -165,6 +165,24 @@ TASK_COST = {"trace": 12.0, "window": 6.0, "fisher": 3.0, "frames": 1.5, "flow":
 """Rough CPU seconds per task (to start the long ones first)."""
 
 
+CONDITIONAL_ON = {
+    "k": "assumed (the parameter default), not measured",
+    "M_s": "assumed (the parameter default), not measured",
+    "losses": "the default air drag, rod drag and rolling friction (settings.losses), not fitted",
+    "model": "a suspension model the data reject: it reproduces neither b nor the loss exponent p (refit)",
+    "valley": "equally good fits lie along valley.linearised: c is not an identified property of the stand",
+}
+"""What the identified c is conditional on (``summary["identified"]["conditional_on"]``)."""
+VALLEY_K_FACTORS = (0.8, 0.9, 1.0, 1.1, 1.25)
+"""k over the identified k at which :func:`valley_points` states c along the linearised valley."""
+
+
+def valley_points(k: float, c: float, slope: float) -> list[dict[str, float]]:
+    """c [N s/m] along the linearised valley through (``k`` [N/m], ``c``): ln c = ln c0 + ``slope`` ln(k/k0),
+    at :data:`VALLEY_K_FACTORS` times k (the Fisher matrix's valley, not refitted: equally good fits)."""
+    return [{"k_N_per_m": f * k, "c_N_s_per_m": c * f**slope} for f in VALLEY_K_FACTORS]
+
+
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool = False) -> dict:
     """Identify, sweep, check, write CSVs, plots, summary and report (see the module docstring);
     ``thorough``: the maps at the other suspension masses too (:data:`THOROUGH`)."""
@@ -223,12 +241,14 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
                      "losses": LOSSES},
         "measured": study.measured_summary(md, SEED_B),
         "start_state": model.start.as_dict(),
-        "identified": {**point_summary(md, ident, ident.chi2), "fixed": {"k": ident.k, "M_s": ident.m_s}},
+        "identified": {**point_summary(md, ident, ident.chi2), "fixed": {"k": ident.k, "M_s": ident.m_s},
+                       "conditional_on": CONDITIONAL_ON},
         "refit": {label: study.run_summary(md, r, ident.chi2) for label, r in runs.items()},
         "valley": {
             "fisher": fisher,
             "trace": [point_summary(md, f, ident.chi2) for f in trace],
             "resonant_end": None if resonant is None else study.resonant_summary(resonant, plan.m_s_main, spectrum),
+            "linearised": valley_points(ident.k, ident.c, fisher["valley_slope_dlnc_dlnk"]),
         },
         "window_checks": windows,
         "spectrum": study.spectrum_summary(spectrum, ident),

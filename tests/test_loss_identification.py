@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
+from double_pendulum.analysis import loss_claims
 from double_pendulum.analysis import loss_identification as li
 from double_pendulum.analysis import measurement as ms
 from double_pendulum.fmu.simulate import simulate
@@ -86,13 +87,17 @@ def test_profile_interval_interpolates_the_crossings():
     assert lo == pytest.approx(2.0 - 0.5 / 3.5) and hi == pytest.approx(4.0 + 0.5 / 3.5)
 
 
-def test_best_model_on_the_real_data_quick(quick_results):
+def test_top_model_on_the_real_data_quick(quick_results):
     """Quick settings (air+drag alone, no profiles): the shares sum to 1; the suspension question is not
     answered without a suspension model."""
     _, s = quick_scenario(quick_results, "loss_identification")
-    assert s["best_model"] == "air+drag" and s["models_fitted"] == list(li.QUICK_MODELS)
-    assert sum(s["shares"].values()) == pytest.approx(1.0, abs=1e-12)
-    assert all(0.0 <= v <= 1.0 for v in s["shares"].values())
+    assert s["top_model"] == "air+drag" and s["models_fitted"] == list(li.QUICK_MODELS)
+    assert sum(s["top_model_shares"].values()) == pytest.approx(1.0, abs=1e-12)
+    assert all(0.0 <= v <= 1.0 for v in s["top_model_shares"].values())
+    # the fitted torque against the seed's rolling friction c_R r_b M g at the pivot
+    seed = s["drag_torque_against_seed_rolling_friction"]
+    assert seed["fitted_over_seed"][0] == pytest.approx(s["parameters"]["tau_b"]["value"] / seed["torque_N_m"][0])
+    assert seed["fitted_over_seed"][0] == pytest.approx(2.0 * seed["fitted_over_seed"][1])  # c_R 0.5e-3 and 1e-3
     assert s["suspension_dominates"] is None and s["answer"].startswith("Not tested")
     assert s["profile_likelihood"] == {}
     for key in ("b_measured_per_s", "b_sim_per_s", "p_measured", "p_measured_stderr", "p_sim"):
@@ -127,17 +132,24 @@ def test_a_nested_model_warm_started_from_its_parent_ends_no_worse(synthetic_pro
     assert li.converged(fit, [parent, fit])
 
 
-def test_models_within_two_aic_of_the_best_are_named_as_equally_supported():
+def test_models_within_two_aic_are_reported_with_weights_and_the_range_of_the_air_share():
     rows = [
-        {"model": "air+drag", "delta_aic": 0.0, "converged": True, "shares": {"air drag": 0.4}},
-        {"model": "air+viscous", "delta_aic": 1.2, "converged": True, "shares": {"viscous joint damping": 0.9}},
-        {"model": "air", "delta_aic": 23.5, "converged": True, "shares": {"air drag": 1.0}},
-        {"model": "air+suspension", "delta_aic": 0.5, "converged": False, "shares": {"damped suspension": 1.0}},
+        {"model": "air+drag", "delta_aic": 0.0, "akaike_weight": 0.5, "converged": True,
+         "shares": {"air drag": 0.4, "bearing drag torque": 0.6}, "b_sim_per_s": -0.0253},
+        {"model": "air+viscous", "delta_aic": 1.2, "akaike_weight": 0.3, "converged": True,
+         "shares": {"air drag": 0.1, "viscous joint damping": 0.9}, "b_sim_per_s": -0.0256},
+        {"model": "air", "delta_aic": 23.5, "akaike_weight": 0.0, "converged": True, "shares": {"air drag": 1.0},
+         "b_sim_per_s": -0.0252},
+        {"model": "air+suspension", "delta_aic": 0.5, "akaike_weight": 0.0, "converged": False,
+         "shares": {"damped suspension": 1.0}},
     ]
-    out = li.equally_supported(rows)
-    assert list(out["models"]) == ["air+viscous"]
-    assert "air+viscous (delta AIC 1.2: viscous joint damping 90%)" in out["text"]
-    assert li.equally_supported(rows[:1] + rows[2:])["models"] == {}
+    out = loss_claims.supported_models(rows)
+    assert list(out["models"]) == ["air+drag", "air+viscous"]  # the top model too: no winner
+    assert out["air_share_range"] == [0.1, 0.4]
+    assert "air+viscous (delta AIC 1.20, weight 0.30: air drag 10%, viscous joint damping 90%)" in out["text"]
+    assert "from 10% to 40%" in out["text"]
+    assert loss_claims.b_sim_range(rows) == [-0.0256, -0.0252]  # air alone reproduces b as well
+    assert loss_claims.supported_models([{**rows[2], "delta_aic": 0.0}])["air_share_range"] == [1.0, 1.0]
 
 
 def test_the_suspension_joins_a_fitted_model_at_each_damping_of_its_scan():

@@ -215,7 +215,8 @@ def test_quick_run_compares_both_starts_with_the_track(quick_results):
     rms = summary["rms_error_first_second_m"]
     assert rms["lsq_start_identified"]["lower_bob"] < rms["seed_start_identified"]["lower_bob"]
     assert rms["lsq_geometry_identified"]["lower_bob"] < rms["lsq_start_identified"]["lower_bob"]
-    labels = ["seed_start_frictionless", "seed_start_identified", "lsq_start_identified", "lsq_geometry_identified"]
+    labels = ["seed_start_frictionless", "seed_start_identified", "lsq_start_identified",
+              "lsq_fixed_geometry_identified", "lsq_pivot_shift_identified", "lsq_geometry_identified"]
     for key in ("horizons_smoothed_s", "horizons_raw_s"):
         assert list(summary[key]) == labels and key in summary["null_means"]
         assert all(list(h) == tc.horizon_keys() for h in summary[key].values())
@@ -242,6 +243,18 @@ def test_quick_run_compares_both_starts_with_the_track(quick_results):
         assert (tmp_path / f"{name}.png").stat().st_size > 10_000
     report = (tmp_path / "report.md").read_text()
     assert "Prediction horizons" in report
+    # a horizon that reaches the end of the prediction is censored and claimed as "> span (censored)"
+    for suffix, label in (("", "lsq_geometry_identified"), ("_fixed_geometry", "lsq_fixed_geometry_identified"),
+                          ("_pivot_shift", "lsq_pivot_shift_identified")):
+        crossing = tc.horizon(t, tc.smoothed(t, errors[f"e2_{label}"]), 0.05)
+        assert summary[f"horizon_5cm_censored{suffix}"] == (crossing is None)
+        assert summary[f"horizon_5cm_s{suffix}"] == (summary["prediction_s"] if crossing is None else crossing)
+        if crossing is None:
+            assert f"> {summary['prediction_s']:.1f} s (censored)" in report
+    assert set(summary["starts"]["least_squares_pivot_shift"]["geometry"]) == set(tc.PIVOT_SHIFT_GEOMETRY)
+    assert "geometry" not in summary["starts"]["least_squares_fixed_geometry"] or not summary["starts"][
+        "least_squares_fixed_geometry"]["geometry"]
+    assert "in-sample" in report
     # the fit-window check belongs to --thorough; the report says so instead of leaving it out silently
     assert not summary["thorough"] and "fit_window_sensitivity" not in summary
     assert "are fitted with ``--thorough``" in report

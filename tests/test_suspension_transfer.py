@@ -102,5 +102,10 @@ def test_quick_run_writes_its_files_and_closes_the_energy_budget(quick_results):
     report = (tmp_path / "report.md").read_text()
     assert "curve, not a point" in report
     ident = summary["identified"]
-    assert f"**c = {ident['c_N_s_per_m']:.1f} +- {ident['c_stderr']:.1f} N s/m**" in report
+    assert f"c = {ident['c_N_s_per_m']:.1f} +- {ident['c_stderr']:.1f} N s/m" in report
+    # c is stated as conditional, and the valley beside the point: c along it rises with k at the fitted slope
+    assert set(ident["conditional_on"]) == {"k", "M_s", "losses", "model", "valley"} and "is conditional" in report
+    valley, slope = summary["valley"]["linearised"], summary["valley"]["fisher"]["valley_slope_dlnc_dlnk"]
+    ratio = valley[-1]["c_N_s_per_m"] / valley[0]["c_N_s_per_m"]
+    assert ratio == pytest.approx((valley[-1]["k_N_per_m"] / valley[0]["k_N_per_m"]) ** slope)
     assert f"b = {summary['measured']['b_per_s']:.5f} +- " in report

@@ -33,35 +33,10 @@
 #include <string.h>
 
 #include "fmi3Functions.h"
+#include "host_common.h"
 
-#define MAX_ARGS 128
 #define MAX_STATES 64
 #define MAX_ITERATIONS 100
-
-extern char **environ;
-static const int SIGNALS[] = {SIGINT, SIGTERM, SIGPIPE, SIGCHLD, SIGXFSZ, SIGSEGV};
-#define N_SIGNALS (sizeof SIGNALS / sizeof SIGNALS[0])
-
-typedef struct {
-    char environment[65536];
-    struct sigaction actions[N_SIGNALS];
-} host_state;
-
-static void snapshot(host_state *state) {
-    memset(state, 0, sizeof *state);
-    for (char **e = environ; *e; e++) {
-        strncat(state->environment, *e, sizeof state->environment - strlen(state->environment) - 2);
-        strcat(state->environment, "\n");
-    }
-    for (size_t k = 0; k < N_SIGNALS; k++) sigaction(SIGNALS[k], NULL, &state->actions[k]);
-}
-
-static int unchanged(const host_state *before, const host_state *after) {
-    if (strcmp(before->environment, after->environment) != 0) return 0;
-    for (size_t k = 0; k < N_SIGNALS; k++)
-        if (before->actions[k].sa_handler != after->actions[k].sa_handler) return 0;
-    return 1;
-}
 
 static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
     (void)env;
@@ -71,24 +46,7 @@ static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String ca
 
 static void *library;
 
-static void *symbol(const char *name) {
-    void *f = dlsym(library, name);
-    if (!f) {
-        fprintf(stderr, "missing %s\n", name);
-        exit(3);
-    }
-    return f;
-}
-#define FUNCTION(name) name##TYPE *name = (name##TYPE *)symbol(#name)
-
-#define CHECK(call)                                                                                               \
-    do {                                                                                                          \
-        fmi3Status status_ = (call);                                                                             \
-        if (status_ > fmi3Warning) {                                                                              \
-            fprintf(stderr, "%s failed with status %d\n", #call, (int)status_);                                   \
-            return 5;                                                                                             \
-        }                                                                                                         \
-    } while (0)
+#define FUNCTION(name) name##TYPE *name = (name##TYPE *)symbol(library, #name)
 
 /* The host's inputs: continuous values, and jumps in Event Mode. */
 static fmi3ValueReference inputs[MAX_ARGS], jumps[MAX_ARGS];
@@ -259,31 +217,19 @@ int main(int argc, char **argv) {
     fmi3ValueReference outputs[MAX_ARGS];
     size_t n_outputs = 0;
     for (int k = 7; k < argc && n_inputs < MAX_ARGS && n_jumps < MAX_ARGS && n_outputs < MAX_ARGS; k++) {
-        char kind = argv[k][0];
-        const char *value = strchr(argv[k], '=');
-        fmi3ValueReference vr = (fmi3ValueReference)strtoul(argv[k] + 2, NULL, 10);
-        if (kind == 'o') {
-            outputs[n_outputs++] = vr;
-        } else if (!value || argv[k][1] != ':') {
+        host_argument a;
+        if (!parse_argument(argv[k], &a)) {
             fprintf(stderr, "bad argument %s\n", argv[k]);
             return 2;
-        } else if (kind == 'r') {
-            fmi3Float64 real = atof(value + 1);
-            CHECK(fmi3SetFloat64(c, &vr, 1, &real, 1));
-        } else if (kind == 'b') {
-            fmi3Boolean boolean = atoi(value + 1) ? fmi3True : fmi3False;
-            CHECK(fmi3SetBoolean(c, &vr, 1, &boolean, 1));
-        } else if (kind == 's') {
-            fmi3String string = value + 1;
-            CHECK(fmi3SetString(c, &vr, 1, &string, 1));
-        } else if (kind == 'i') {
-            inputs[n_inputs] = vr;
-            input_values[n_inputs++] = atof(value + 1);
-        } else if (kind == 'j' && strchr(value, '@')) {
-            jumps[n_jumps] = vr;
-            jump_values[n_jumps] = atof(value + 1);
-            jump_times[n_jumps++] = atof(strchr(value, '@') + 1);
         }
+        fmi3ValueReference vr = a.vr;
+        fmi3Boolean boolean = atoi(a.text) ? fmi3True : fmi3False;
+        if (a.kind == 'o') outputs[n_outputs++] = vr;
+        else if (a.kind == 'r') CHECK(fmi3SetFloat64(c, &vr, 1, &a.real, 1));
+        else if (a.kind == 'b') CHECK(fmi3SetBoolean(c, &vr, 1, &boolean, 1));
+        else if (a.kind == 's') CHECK(fmi3SetString(c, &vr, 1, &a.text, 1));
+        else if (a.kind == 'i') inputs[n_inputs] = vr, input_values[n_inputs++] = a.real;
+        else jumps[n_jumps] = vr, jump_values[n_jumps] = a.real, jump_times[n_jumps++] = a.at;
     }
 
     CHECK(fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3True, steps * h));

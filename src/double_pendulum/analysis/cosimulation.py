@@ -25,7 +25,7 @@ import numpy as np
 from ..component.cosimulation import DoublePendulumCoSimulation
 from ..component.suspension import SuspensionCoSimulation
 from ..fmu.coupling import CouplingError, coupling_energy, run_coupled, split_values
-from .coupling_stability import critical_mass_ratio
+from .coupling_stability import critical_mass_ratio, spectral_radius
 
 STARTS: dict[str, dict[str, float]] = {
     "regular": {"phi1_0": 0.3, "phi2_0": 0.2},
@@ -66,8 +66,11 @@ def monolith(values: Mapping[str, Any], stop_time: float, n_steps: int = 200) ->
     return {n: float(sim.get(n)) for n in ("phi1", "phi2", "xs", "ys", "E_total")}
 
 
-def _in_process(values: Mapping[str, Any], stop_time: float, h: float, scheme: str) -> np.ndarray:
+def _in_process(values: Mapping[str, Any], stop_time: float, h: float, scheme: str,
+                load_factor: float = 1.0) -> np.ndarray:
+    """The split system in-process; ``load_factor`` scales the suspension's static load ``F_static_y``."""
     pendulum_values, suspension_values = split_values(values)
+    suspension_values["F_static_y"] *= load_factor
     pendulum, suspension = DoublePendulumCoSimulation(), SuspensionCoSimulation()
     for name, value in pendulum_values.items():
         pendulum.set(name, value)
@@ -148,32 +151,89 @@ def add_errors(rows: list[dict[str, Any]], references: Mapping[tuple[str, str], 
         row["energy_error_J"] = abs(row["E_pendulum"] + row["E_suspension"] - ref["E_total"])
 
 
-def fitted_order(steps: Sequence[float], errors: Sequence[float], floor: float = 1e-12) -> float:
-    """Slope of log|error| over log(h) (least squares), from the finite |errors| above ``floor``."""
+ORDER_MIN_R2 = 0.95
+"""A fitted order counts as resolved if log|error| is that close to linear in log h (R^2 of the fit)."""
+
+
+def _order_fit(steps: Sequence[float], errors: Sequence[float], floor: float = 1e-12) -> tuple[float, float]:
+    """``(slope, R^2)`` of log|error| over log(h) (least squares) from the finite |errors| above ``floor``."""
     pairs = [(h, abs(e)) for h, e in zip(steps, errors) if math.isfinite(e) and abs(e) > floor]
     if len(pairs) < 3:
-        return math.nan
+        return math.nan, math.nan
     x, y = np.log([p[0] for p in pairs]), np.log([p[1] for p in pairs])
-    return float(np.polyfit(x, y, 1)[0])
+    slope, intercept = np.polyfit(x, y, 1)
+    residual = y - (slope * x + intercept)
+    spread = float(np.sum((y - y.mean()) ** 2))
+    return float(slope), 1.0 - float(np.sum(residual**2)) / spread if spread > 0.0 else math.nan
+
+
+def fitted_order(steps: Sequence[float], errors: Sequence[float], floor: float = 1e-12) -> float:
+    """Slope of log|error| over log(h) (least squares), from the finite |errors| above ``floor``."""
+    return _order_fit(steps, errors, floor)[0]
+
+
+def _order_runs(rows: list[dict[str, Any]], max_step: float) -> dict[str, list[dict[str, Any]]]:
+    """The stable runs with h <= ``max_step`` per "start / suspension / method"."""
+    return {" / ".join(key): [r for r in rows if (r["start"], r["suspension"], r["method"]) == key and r["stable"]
+                              and r["macro_step_s"] <= max_step]
+            for key in sorted({(r["start"], r["suspension"], r["method"]) for r in rows})}
 
 
 def orders(rows: list[dict[str, Any]], quantity: str, max_step: float = 5e-3) -> dict[str, float]:
     """Fitted order of ``quantity`` per "start / suspension / method", over the stable runs with h <= ``max_step``."""
-    result = {}
-    for key in sorted({(r["start"], r["suspension"], r["method"]) for r in rows}):
-        sel = [r for r in rows if (r["start"], r["suspension"], r["method"]) == key and r["stable"]
-               and r["macro_step_s"] <= max_step]
-        result[" / ".join(key)] = fitted_order([r["macro_step_s"] for r in sel], [r[quantity] for r in sel])
-    return result
+    return {key: fitted_order([r["macro_step_s"] for r in sel], [r[quantity] for r in sel])
+            for key, sel in _order_runs(rows, max_step).items()}
+
+
+def unresolved_orders(rows: list[dict[str, Any]], quantity: str, max_step: float = 5e-3) -> list[str]:
+    """The "start / suspension / method" whose errors of ``quantity`` do not follow a power of h: the fit of
+    log|error| over log h has R^2 below :data:`ORDER_MIN_R2` (or too few errors), so its slope is no order."""
+    out = []
+    for key, sel in _order_runs(rows, max_step).items():
+        r2 = _order_fit([r["macro_step_s"] for r in sel], [r[quantity] for r in sel])[1]
+        if not r2 >= ORDER_MIN_R2:
+            out.append(key)
+    return out
+
+
+MAP_LOAD_STEP = 0.01
+"""The stability map's excitation: the suspension's static load is set 1 % off the pendulum's weight, a
+step of the load that sets the coupled loop moving from rest (any amount gives the same spectral radius:
+the hanging pendulum's vertical loop is linear)."""
+STABILITY_TOLERANCE = 1e-6
+"""Unstable: the fitted spectral radius of the step map exceeds 1 by more than this (its fit error is
+below 1e-8 on the map; a growth of 1e-4 % a step)."""
+
+
+def step_map_spectral_radius(rows: np.ndarray, scheme: str) -> float:
+    """Spectral radius of the coupled step map fitted to a run: least squares X_{n+1} = G X_n + b.
+
+    X_n are the values a macro step carries over, as in
+    :func:`~double_pendulum.analysis.coupling_stability.amplification_matrix`: the suspension's
+    displacement and velocity and the pendulum's pivot force, (y_n, v_n, F_n) for ``jacobi_sequential`` and
+    (y_n, v_n, F_n, F_{n-1}) for ``jacobi`` (columns ``y``, ``vy``, ``F_pivot_y`` of
+    :func:`~double_pendulum.fmu.coupling.run_coupled`; the constant b takes the static load). Returns the
+    largest |eigenvalue| of G, the growth factor per macro step of the fastest mode; ``inf`` if the run
+    ended before it had twice as many steps as unknowns.
+    """
+    y, v, f = rows["y"], rows["vy"], rows["F_pivot_y"]
+    x = np.column_stack([y[1:], v[1:], f[1:], f[:-1]]) if scheme == "jacobi" else np.column_stack([y, v, f])
+    if len(x) < 2 * (x.shape[1] + 1) + 1:
+        return math.inf
+    x = x / np.where(np.abs(x).max(axis=0) > 0.0, np.abs(x).max(axis=0), 1.0)  # columns of order 1
+    coef, *_ = np.linalg.lstsq(np.column_stack([x[:-1], np.ones(len(x) - 1)]), x[1:], rcond=None)
+    return float(max(abs(np.linalg.eigvals(coef[:-1].T))))
 
 
 def stability_run(item: tuple[float, float, float, int, str]) -> dict[str, Any]:
-    """One point of the stability map ``(mu, h omega, zeta, steps, scheme)``: in-process, bounded or not.
+    """One point of the stability map ``(mu, h omega, zeta, steps, scheme)``: in-process, its fitted growth.
 
-    The suspension has omega = 100 rad/s and damping ratio zeta in both axes, M_s = (m1 + m2) / mu;
-    the pendulum starts hanging nearly straight (phi1 = 0.1 rad). Unstable: the run blew up
-    (:class:`~double_pendulum.fmu.coupling.CouplingError`) or the pivot acceleration in the last
-    third of the run exceeds 10 times its maximum in the first third.
+    The suspension has omega = 100 rad/s and damping ratio zeta in both axes, M_s = (m1 + m2) / mu; the
+    pendulum hangs straight at rest and the suspension's static load is :data:`MAP_LOAD_STEP` off its
+    weight, so the run is the vertical loop of the derivation, set moving by a step of the load. Stable if
+    the spectral radius of the step map fitted to the run (:func:`step_map_spectral_radius`) is at most
+    1 + :data:`STABILITY_TOLERANCE`; a run that blew up (:class:`~double_pendulum.fmu.coupling.CouplingError`)
+    is fitted on the rows it kept.
     """
     from ..model.parameters import PendulumParameters
 
@@ -182,19 +242,17 @@ def stability_run(item: tuple[float, float, float, int, str]) -> dict[str, Any]:
     omega = 100.0
     m_s = (p.m1 + p.m2) / mu
     k, c = m_s * omega**2, 2.0 * zeta * m_s * omega
-    values = {"phi1_0": 0.1, "phi2_0": 0.0, "M_s": m_s, "k_x": k, "k_y": k, "c_x": c, "c_y": c}
+    values = {"phi1_0": 0.0, "phi2_0": 0.0, "M_s": m_s, "k_x": k, "k_y": k, "c_x": c, "c_y": c}
     h = h_omega / omega
     try:
-        rows = _in_process(values, steps * h, h, scheme)
-        a = np.hypot(rows["ax"], rows["ay"])
-        third = max(1, len(a) // 3)
-        growth = float(a[-third:].max() / max(a[:third].max(), 1e-300))
-        stable, message = growth < 10.0, ""
+        rows, message = _in_process(values, steps * h, h, scheme, 1.0 + MAP_LOAD_STEP), ""
     except CouplingError as error:
-        growth, stable, message = math.inf, False, str(error)
-    return {"scheme": scheme, "mass_ratio": mu, "h_omega": h_omega, "zeta": zeta, "stable": stable,
-            "growth": growth, "derived_critical_mass_ratio": critical_mass_ratio(h_omega, zeta, scheme),
-            "message": message}
+        rows, message = error.rows, str(error)
+    rho = step_map_spectral_radius(rows, scheme)
+    return {"scheme": scheme, "mass_ratio": mu, "h_omega": h_omega, "zeta": zeta,
+            "stable": bool(rho <= 1.0 + STABILITY_TOLERANCE), "spectral_radius_fitted": rho,
+            "spectral_radius_derived": spectral_radius(mu, h_omega, zeta, scheme), "steps_run": len(rows) - 1,
+            "derived_critical_mass_ratio": critical_mass_ratio(h_omega, zeta, scheme), "message": message}
 
 
 def run_item(item: tuple[str, tuple]) -> dict[str, Any]:

@@ -92,18 +92,14 @@ def simulate_signal(
 UPRIGHT_OUTPUTS = ("phi1", "phi2", "omega1", "omega2", "ys", "vys", "E_total", "W_input", "energy_residual")
 
 
-def upright_deviation(phi: np.ndarray) -> np.ndarray:
-    """Angle from the upright position [rad], wrapped into [-pi, pi): ``phi - pi`` modulo 2 pi."""
-    return np.mod(np.asarray(phi), 2.0 * math.pi) - math.pi
-
-
 @dataclass(frozen=True)
 class VibrationCase:
-    """The pendulum started near upright on a pivot vibrating at ``a`` [m], ``omega`` [rad/s].
+    """The pendulum started near upright on a pivot vibrating at ``a`` [m], ``omega`` [rad/s]: an example run.
 
     ``start``: FMU start values (parameters, angles, angular velocities); ``stop_time`` [s];
-    ``steps_per_period``: communication steps per vibration period; judged stable if
-    ``max |phi_i - pi| <= growth_limit * theta0`` [rad] for the rods in ``rods`` over the run.
+    ``steps_per_period``: communication steps per vibration period; ``theta0``: the start tilt [rad]
+    the figures scale by. Stability is not judged on such a run (a run that has not yet fallen over
+    may still grow): :func:`floquet_outcome` decides it.
     """
 
     a: float
@@ -112,8 +108,6 @@ class VibrationCase:
     stop_time: float
     steps_per_period: int
     theta0: float
-    growth_limit: float
-    rods: tuple[int, ...] = (1, 2)
     outputs: tuple[str, ...] = field(default=UPRIGHT_OUTPUTS)
 
     @property
@@ -129,17 +123,72 @@ def run_vibration(case: VibrationCase, where: RunnerLike) -> np.ndarray:
                            case.outputs)
 
 
-def judge_upright(case: VibrationCase, result: np.ndarray) -> dict[str, Any]:
-    """The verdict on one run: ``max_deviation_rad`` (largest |phi_i - pi|), ``growth`` (over theta0), ``stable``."""
-    deviation = max(float(np.max(np.abs(upright_deviation(result[f"phi{i}"])))) for i in case.rods)
-    growth = deviation / case.theta0
-    return {"amplitude_m": case.a, "omega_rad_per_s": case.omega, "max_deviation_rad": deviation,
-            "growth": growth, "stable": bool(growth <= case.growth_limit)}
+# ------------------------------------------------------------------------------ Floquet multipliers as simulated
+FLOQUET_PERTURBATION = 1e-4
+"""Perturbation [rad, rad/s] of each state component from upright for the monodromy matrix: the
+nonlinearity (cubic about upright) changes it by O(1e-8) relative, the integration at
+:data:`FLOQUET_SETTINGS` by at most rtol |phi| / 1e-4 = 3e-7 (measured: 2e-10 on the unit circle)."""
+FLOQUET_SETTINGS = {"solver": "dop853", "rtol": 1e-11, "atol": 1e-13}
+"""Integration of the one-period runs of :func:`simulated_monodromy`."""
+FLOQUET_TOLERANCE = 1e-6
+"""Unstable: the largest |Floquet multiplier| exceeds 1 by more than this (a growth of 1e-4 % a period;
+a stable frictionless upright pendulum has every multiplier on the unit circle, and the simulated
+monodromy puts them there to about 2e-10)."""
+STATE_OUTPUTS = ("phi1", "phi2", "omega1", "omega2")
 
 
-def vibration_outcome(case: VibrationCase, where: RunnerLike = None) -> dict[str, Any]:
-    """Run ``case`` and judge it (:func:`judge_upright`); module level, so workers can run it."""
-    return judge_upright(case, run_vibration(case, where))
+@dataclass(frozen=True)
+class FloquetCase:
+    """The upright pendulum on a pivot vibrating at ``a`` [m], ``omega`` [rad/s], ``steps_per_period``
+    communication steps a period; ``parameters``: FMU start values other than the state (masses...)."""
+
+    a: float
+    omega: float
+    parameters: Mapping[str, Any]
+    steps_per_period: int
+
+    @property
+    def period(self) -> float:
+        """The vibration period [s]."""
+        return 2.0 * math.pi / self.omega
+
+
+def simulated_monodromy(case: FloquetCase, where: RunnerLike = None) -> np.ndarray:
+    r"""The monodromy matrix (4x4) of the upright state as simulated, by finite differences.
+
+    Five runs of one period through ``where`` (the FMU, or in-process), with the vibration's inputs
+    held over each communication step as in every other run: from upright
+    :math:`(\pi, \pi, 0, 0)` and from upright plus :data:`FLOQUET_PERTURBATION` in each state component
+    j; column j is the difference of the end states over the perturbation. Its eigenvalues are the
+    Floquet multipliers of the upright periodic orbit (upright is a fixed point of a vertical vibration).
+    """
+    step = case.period / case.steps_per_period
+    t, stop = time_grid(case.period, step)
+    signal = vertical_vibration(case.a, case.omega, t)
+    upright = np.array([math.pi, math.pi, 0.0, 0.0])
+
+    def end_state(x0: np.ndarray) -> np.ndarray:
+        start = {**case.parameters, **FLOQUET_SETTINGS,
+                 **dict(zip(("phi1_0", "phi2_0", "omega1_0", "omega2_0"), x0.tolist()))}
+        result = simulate_signal(where, start, signal, stop, step, STATE_OUTPUTS)
+        end = np.flatnonzero(np.isclose(result["time"], stop, rtol=0.0, atol=1e-9 * stop))[0]
+        return np.array([result[n][end] for n in STATE_OUTPUTS])
+
+    base = end_state(upright)
+    columns = [(end_state(upright + FLOQUET_PERTURBATION * e) - base) / FLOQUET_PERTURBATION for e in np.eye(4)]
+    return np.column_stack(columns)
+
+
+def floquet_outcome(case: FloquetCase, where: RunnerLike = None) -> dict[str, Any]:
+    """The verdict from the Floquet multipliers of :func:`simulated_monodromy`.
+
+    ``spectral_radius``: the largest |multiplier| (the growth factor per period of the fastest-growing
+    perturbation); ``floquet_exponent_per_s`` = ln(spectral radius) / period [1/s]; ``stable`` if the
+    spectral radius is at most 1 + :data:`FLOQUET_TOLERANCE`.
+    """
+    rho = float(max(abs(np.linalg.eigvals(simulated_monodromy(case, where)))))
+    return {"amplitude_m": case.a, "omega_rad_per_s": case.omega, "spectral_radius": rho,
+            "floquet_exponent_per_s": math.log(rho) / case.period, "stable": bool(rho <= 1.0 + FLOQUET_TOLERANCE)}
 
 
 @dataclass
@@ -147,37 +196,33 @@ class Bisection:
     """Result of :func:`bisect_threshold`: the threshold [m], the final bracket and every probe."""
 
     threshold: float
-    falls_at: float
+    unstable_at: float
     stable_at: float
     probes: list[dict[str, Any]]
-    results: dict[str, np.ndarray]  # the runs at the final bracket ends: "falls", "stable"
 
 
-def bisect_threshold(
-    probe: Callable[[float], tuple[dict[str, Any], np.ndarray]], low: float, high: float, iterations: int
-) -> Bisection:
-    """Bisect on the amplitude [m] between ``low`` (must fall) and ``high`` (must stay upright).
+def bisect_threshold(probe: Callable[[float], dict[str, Any]], low: float, high: float, iterations: int) -> Bisection:
+    """Bisect on the amplitude [m] between ``low`` (must be unstable) and ``high`` (must be stable).
 
-    ``probe(a) -> (verdict, result)`` with ``verdict["stable"]``. Raises ``ValueError`` if the
-    bracket's ends do not fall / stay up. The threshold is the bracket's midpoint after
-    ``iterations`` halvings (uncertainty +-(high - low) / 2**(iterations + 1)).
+    ``probe(a) -> verdict`` with ``verdict["stable"]``. Raises ``ValueError`` if the bracket's ends are
+    not unstable / stable. The threshold is the bracket's midpoint after ``iterations`` halvings
+    (uncertainty +-(high - low) / 2**(iterations + 1)).
     """
-    probes, results = [], {}
+    probes = []
     for a, want in ((low, False), (high, True)):
-        verdict, result = probe(a)
+        verdict = probe(a)
         probes.append(verdict)
         if verdict["stable"] != want:
-            raise ValueError(f"bad bracket: a = {a:.6g} m {'stays up' if verdict['stable'] else 'falls'}")
-        results["stable" if want else "falls"] = result
+            raise ValueError(f"bad bracket: a = {a:.6g} m is {'stable' if verdict['stable'] else 'unstable'}")
     for _ in range(iterations):
         mid = 0.5 * (low + high)
-        verdict, result = probe(mid)
+        verdict = probe(mid)
         probes.append(verdict)
         if verdict["stable"]:
-            high, results["stable"] = mid, result
+            high = mid
         else:
-            low, results["falls"] = mid, result
-    return Bisection(0.5 * (low + high), low, high, probes, results)
+            low = mid
+    return Bisection(0.5 * (low + high), low, high, probes)
 
 
 # ------------------------------------------------------------------------------ forced response
@@ -233,19 +278,22 @@ def torque_outcome(case: TorqueCase, where: RunnerLike = None) -> dict[str, Any]
     return row
 
 
-def case_outcome(case: VibrationCase | TorqueCase, where: RunnerLike = None) -> dict[str, Any]:
-    """The outcome of either kind of case (:func:`vibration_outcome`, :func:`torque_outcome`)."""
-    return vibration_outcome(case, where) if isinstance(case, VibrationCase) else torque_outcome(case, where)
+Case = TorqueCase | FloquetCase
 
 
-def case_cost(case: VibrationCase | TorqueCase) -> float:
+def case_outcome(case: Case, where: RunnerLike = None) -> dict[str, Any]:
+    """The outcome of either kind of case (:func:`floquet_outcome`, :func:`torque_outcome`)."""
+    return floquet_outcome(case, where) if isinstance(case, FloquetCase) else torque_outcome(case, where)
+
+
+def case_cost(case: Case) -> float:
     """Communication steps of a case (its cost, for ordering parallel work)."""
-    if isinstance(case, VibrationCase):
-        return case.stop_time / case.step
+    if isinstance(case, FloquetCase):
+        return 5.0 * case.steps_per_period + 50.0  # five one-period runs, each with its start-up
     return (case.settle_time + case.window) / case.step
 
 
-def run_cases(cases: Sequence[VibrationCase | TorqueCase], fmu_path: str | None, *,
+def run_cases(cases: Sequence[Case], fmu_path: str | None, *,
               max_workers: int | None = None, progress: bool | None = None) -> list[dict[str, Any]]:
     """Outcomes of all ``cases`` (in their order), in parallel worker processes (:func:`parallel_map`).
 

@@ -4,8 +4,11 @@
   (``m2 = mass_ratio * m1``: the upper rod then moves as a point mass on a massless rod of length
   l1; the lower bob, a test mass, changes the equivalent length ``g / omega_slow**2`` of the slow
   mode by a relative ``O(m2/m1)``, reported). The upright threshold amplitude at a fixed frequency
-  is bisected with :func:`~double_pendulum.analysis.excitation.bisect_threshold` and compared with
-  ``a = sqrt(2 g l1) / omega`` and with the exact Mathieu bound.
+  is bisected with :func:`~double_pendulum.analysis.excitation.bisect_threshold` on the Floquet
+  multipliers of the system as simulated (:func:`~double_pendulum.analysis.excitation.floquet_outcome`:
+  the monodromy matrix of one period through the FMU, the input held over each communication step)
+  and compared with the exact bound of the held input, the exact Mathieu bound of the continuous
+  sinusoid and ``a = sqrt(2 g l1) / omega``.
 * **Acheson** (:func:`acheson_cases`, :func:`acheson_rows`): the default double pendulum started
   0.01 rad from upright on a grid of amplitude and frequency, each point judged upright-stable or
   falling, against the linear theory (:mod:`double_pendulum.analysis.excitation_theory`).
@@ -18,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -29,17 +32,21 @@ from ..model.parameters import PendulumParameters
 from .excitation import (
     UPRIGHT_OUTPUTS,
     Bisection,
+    FloquetCase,
     RunnerLike,
     TorqueCase,
     VibrationCase,
     bisect_threshold,
-    judge_upright,
+    floquet_outcome,
     peak_frequency,
     resonance_frequencies,
     run_vibration,
 )
 from .excitation_theory import (
+    damped_peak_frequency,
     equivalent_lengths,
+    held_lower_amplitude,
+    held_upright_stable,
     kapitza_amplitude,
     mathieu_lower_amplitude,
     mathieu_upper_amplitude,
@@ -52,16 +59,18 @@ from .excitation_theory import (
 # ------------------------------------------------------------------------------ Kapitza
 @dataclass(frozen=True)
 class KapitzaSetup:
-    """Kapitza bisection: frequency [rad/s], start tilt [rad], criterion, run length [s], bracket."""
+    """Kapitza bisection on the Floquet multipliers: frequency [rad/s], communication steps a period,
+    bisection steps, bracket; the two example runs' start tilt [rad], length [s] and distance from the
+    threshold (relative)."""
 
     omega: float = 50.0
     theta0: float = 0.01
-    growth_limit: float = 3.0  # stable: max |phi1 - pi| <= growth_limit * theta0 over the run
     stop_time: float = 4.0
     steps_per_period: int = 24
-    iterations: int = 8
+    iterations: int = 16
     bracket: tuple[float, float] = (0.9, 1.15)  # times sqrt(2 g l1) / omega
     mass_ratio: float = 1e-4  # m2 / m1: the single-pendulum limit
+    example_offset: float = 0.02  # the example runs at the threshold times (1 -+ example_offset)
 
 
 @dataclass
@@ -74,7 +83,9 @@ class KapitzaResult:
     theory_point_mass: float  # sqrt(2 g l1) / omega
     effective_length: float  # g / omega_slow**2 [m] of the limit pendulum
     theory_effective: float  # sqrt(2 g L) / omega
-    mathieu_exact: float  # exact linear bound for L (a_0(q) = delta)
+    mathieu_exact: float  # exact linear bound for L, continuous sinusoid (a_0(q) = delta)
+    held_exact: float  # exact linear bound for L, acceleration held over each step (as simulated)
+    examples: dict[str, np.ndarray]  # tilt runs below and above the threshold: label -> result
 
 
 def kapitza_parameters(setup: KapitzaSetup) -> PendulumParameters:
@@ -84,79 +95,90 @@ def kapitza_parameters(setup: KapitzaSetup) -> PendulumParameters:
 
 
 def kapitza_case(a: float, setup: KapitzaSetup, params: PendulumParameters) -> VibrationCase:
-    """Both rods tilted ``theta0`` from upright (on the slow motion), judged on the upper rod only."""
+    """Both rods tilted ``theta0`` from upright (on the slow motion): an example run, not judged."""
     start = {"m1": params.m1, "m2": params.m2, **upright_start((setup.theta0, setup.theta0), a, setup.omega, params)}
-    return VibrationCase(a, setup.omega, start, setup.stop_time, setup.steps_per_period, setup.theta0,
-                         setup.growth_limit, rods=(1,))
+    return VibrationCase(a, setup.omega, start, setup.stop_time, setup.steps_per_period, setup.theta0)
 
 
 def kapitza_study(where: RunnerLike, setup: KapitzaSetup) -> KapitzaResult:
-    """Bisect the upright threshold amplitude [m] of the single-pendulum limit (runs through ``where``)."""
+    """Bisect the upright threshold amplitude [m] of the single-pendulum limit on the Floquet multipliers
+    of the system as simulated (runs through ``where``); run the upper rod just below and above it."""
     params = kapitza_parameters(setup)
     length = equivalent_lengths(params)[0]
     a_point = kapitza_amplitude(setup.omega, params.l1, params.g)
+    masses = {"m1": params.m1, "m2": params.m2}
 
-    def probe(a: float) -> tuple[dict[str, Any], np.ndarray]:
-        case = kapitza_case(a, setup, params)
-        result = run_vibration(case, where)
-        return judge_upright(case, result), result
+    def probe(a: float) -> dict[str, Any]:
+        return floquet_outcome(FloquetCase(a, setup.omega, masses, setup.steps_per_period), where)
 
     low, high = (f * a_point for f in setup.bracket)
     bisection = bisect_threshold(probe, low, high, setup.iterations)
+    examples = {}
+    for sign, word in ((-1.0, "below"), (1.0, "above")):
+        a = bisection.threshold * (1.0 + sign * setup.example_offset)
+        examples[f"a = {a * 1e3:.2f} mm ({100 * setup.example_offset:g} % {word} the threshold)"] = run_vibration(
+            kapitza_case(a, setup, params), where)
     return KapitzaResult(setup, params, bisection, a_point, length,
                          kapitza_amplitude(setup.omega, length, params.g),
-                         mathieu_lower_amplitude(setup.omega, length, params.g))
+                         mathieu_lower_amplitude(setup.omega, length, params.g),
+                         held_lower_amplitude(setup.omega, length, params.g, setup.steps_per_period), examples)
 
 
 # ------------------------------------------------------------------------------ Acheson
 @dataclass(frozen=True)
 class AchesonSetup:
-    """The stability map: grid [rad/s] x [m], start tilt (upper rod) [rad], criterion, run length [s]."""
+    """The stability map: grid [rad/s] x [m] judged by the Floquet multipliers as simulated, communication
+    steps a period; the example runs' start tilt (upper rod) [rad], frequency, amplitudes and length [s]."""
 
     omegas: tuple[float, ...]
     amplitudes: tuple[float, ...]
     theta0: float = 0.01
-    growth_limit: float = 5.0
-    stop_time: float = 1.5
     steps_per_period: int = 16
     example_omega: float = 200.0
     example_amplitudes: tuple[float, ...] = (0.008, 0.022, 0.036)
     example_stop_time: float = 3.0
 
 
-def acheson_case(a: float, omega: float, setup: AchesonSetup, stop_time: float | None = None) -> VibrationCase:
-    """The default pendulum, upper rod ``theta0`` from upright, lower rod upright (on the slow motion)."""
-    start = upright_start((setup.theta0, 0.0), a, omega, PendulumParameters())
-    return VibrationCase(a, omega, start, stop_time or setup.stop_time, setup.steps_per_period, setup.theta0,
-                         setup.growth_limit, outputs=("phi1", "phi2"))
+def acheson_case(a: float, omega: float, setup: AchesonSetup) -> FloquetCase:
+    """One map point: the default pendulum's upright Floquet multipliers at ``a`` [m], ``omega`` [rad/s]."""
+    return FloquetCase(a, omega, {}, setup.steps_per_period)
 
 
-def acheson_cases(setup: AchesonSetup) -> list[VibrationCase]:
+def acheson_cases(setup: AchesonSetup) -> list[FloquetCase]:
     """One case per grid point, frequency-major (``omegas`` outer, ``amplitudes`` inner)."""
     return [acheson_case(a, w, setup) for w in setup.omegas for a in setup.amplitudes]
 
 
 def acheson_examples(where: RunnerLike, setup: AchesonSetup) -> dict[float, np.ndarray]:
-    """Longer runs with every output at ``example_omega`` for each example amplitude [m]."""
+    """Runs with every output at ``example_omega``, upper rod ``theta0`` from upright and lower rod upright
+    (on the slow motion), for each example amplitude [m]."""
     out = {}
     for a in setup.example_amplitudes:
-        case = acheson_case(a, setup.example_omega, setup, setup.example_stop_time)
-        out[a] = run_vibration(replace(case, outputs=UPRIGHT_OUTPUTS), where)
+        start = upright_start((setup.theta0, 0.0), a, setup.example_omega, PendulumParameters())
+        case = VibrationCase(a, setup.example_omega, start, setup.example_stop_time, setup.steps_per_period,
+                             setup.theta0, outputs=UPRIGHT_OUTPUTS)
+        out[a] = run_vibration(case, where)
     return out
 
 
-def example_label(a: float, result: np.ndarray, setup: AchesonSetup) -> str:
-    """``omega = .. rad/s, a = .. mm: stays upright`` (or ``falls over``), judged as the map's points."""
-    verdict = judge_upright(acheson_case(a, setup.example_omega, setup), result)
-    outcome = "stays upright" if verdict["stable"] else "falls over"
-    return (f"omega = {setup.example_omega:g} rad/s, a = {a * 1e3:g} mm: {outcome}"
-            f" (largest tilt {verdict['max_deviation_rad']:.3f} rad)")
+def example_label(a: float, setup: AchesonSetup) -> str:
+    """``omega = .. rad/s, a = .. mm: stable`` (or ``unstable``) by the Floquet multipliers, as the map's points
+    (computed in-process: the same component as the FMU)."""
+    verdict = floquet_outcome(acheson_case(a, setup.example_omega, setup))
+    outcome = "stable" if verdict["stable"] else "unstable"
+    return (f"omega = {setup.example_omega:g} rad/s, a = {a * 1e3:g} mm: upright {outcome}"
+            f" (largest Floquet multiplier {verdict['spectral_radius']:.4f} a period)")
 
 
-def acheson_rows(outcomes: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
-    """The map's table: each outcome with the linear theory's verdict (``theory_stable``)."""
+def acheson_rows(outcomes: Sequence[dict[str, Any]], steps_per_period: int) -> list[dict[str, Any]]:
+    """The map's table: each outcome with the linear theory's verdicts, for the acceleration held over each of
+    ``steps_per_period`` steps as simulated (``theory_stable``) and for the continuous sinusoid
+    (``theory_continuous_stable``)."""
     params = PendulumParameters()
-    return [{**o, "theory_stable": upright_stable(o["amplitude_m"], o["omega_rad_per_s"], params)} for o in outcomes]
+    return [{**o, "theory_stable": held_upright_stable(o["amplitude_m"], o["omega_rad_per_s"], params,
+                                                       steps_per_period),
+             "theory_continuous_stable": upright_stable(o["amplitude_m"], o["omega_rad_per_s"], params)}
+            for o in outcomes]
 
 
 def theory_boundaries(omegas: np.ndarray, params: PendulumParameters | None = None) -> dict[str, np.ndarray]:
@@ -226,13 +248,18 @@ def resonance_cases(setup: ResonanceSetup) -> list[TorqueCase]:
             for w in resonance_frequencies(normal_modes(), setup.n_broad, setup.offsets)]
 
 
-def resonance_peaks(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per mode and angle: the fitted peak frequency [rad/s] against the normal mode, relative error."""
+def resonance_peaks(rows: Sequence[dict[str, Any]], setup: ResonanceSetup) -> list[dict[str, Any]]:
+    """Per mode and angle: the fitted peak frequency [rad/s] against the peak of the damped linear response
+    (:func:`~double_pendulum.analysis.excitation_theory.damped_peak_frequency`, with the run's viscous pivot
+    bearing), its relative error, and the undamped normal mode with the shift damping causes."""
     omegas = np.array([r["omega_rad_per_s"] for r in rows])
+    params = PendulumParameters()
     out = []
     for mode_name, mode in zip(("slow", "fast"), normal_modes()):
-        for angle in ("phi1", "phi2"):
+        for i, angle in enumerate(("phi1", "phi2")):
             peak = peak_frequency(omegas, np.array([r[f"{angle}_amplitude_rad"] for r in rows]), mode)
-            out.append({"mode": mode_name, "angle": angle, "normal_mode_rad_per_s": mode, "peak_rad_per_s": peak,
-                        "relative_error": peak / mode - 1.0})
+            damped = damped_peak_frequency(mode, i, params, setup.b_v1)
+            out.append({"mode": mode_name, "angle": angle, "normal_mode_rad_per_s": mode,
+                        "damped_linear_peak_rad_per_s": damped, "peak_rad_per_s": peak,
+                        "relative_error": peak / damped - 1.0, "damping_shift": damped / mode - 1.0})
     return out

@@ -59,6 +59,7 @@ import numpy as np
 
 from ..fmu.simulate import simulate
 from ..model.parameters import SEED_RIGID_LINKS, AirDragParameters
+from . import loss_claims
 from .decay_fit import AUTOCORRELATION_LAG_S, MODELS, effective_sample_factor, fit_model
 from .measurement import FPS, FRAME_INTERVAL, Reconstruction, load_track, reconstruct
 from .result_cache import cached
@@ -800,7 +801,7 @@ def decay_numbers(problem: FitProblem, e_meas: np.ndarray, e_sim: np.ndarray) ->
 
 def air_share_at_defaults(problem: FitProblem, measured_loss: float) -> dict[str, float]:
     """Air drag at the default coefficients (factor 1) on the seed's pendulum: its work over the record [J]
-    and its share of the measured loss (the issue's 'about 1/3' against the model)."""
+    and its share of the measured loss (the seed gives no share: it calls air drag negligible, section 4.2.3)."""
     r = problem.simulate(_air([1.0]), outputs=("W_air",))
     w = float(r["W_air"][-1])
     return {"W_air_J": w, "share_of_measured_loss": w / measured_loss, "cw_rod": AirDragParameters().cw_rod}
@@ -840,7 +841,7 @@ class LossIdentification:
 
 def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """Does the suspension dominate the loss? From the suspension's share in every model that has it
-    and the best model's composition (a plain sentence and the numbers); not asked (``None``) when no
+    and the top model's composition (a plain sentence and the numbers); not asked (``None``) when no
     fitted model has a suspension (the quick run)."""
     label = MECHANISMS["suspension"].label
     if not any("suspension" in r["model"].split("+") for r in rows):
@@ -852,36 +853,16 @@ def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     dominates = bool(label in best["shares"] and best["shares"][label] > 0.5)
     if dominates:
         share = best["shares"][label]
-        text = f"Yes: the best model ({best['model']}) loses {share:.0%} of its energy in the suspension."
+        text = f"Yes: the top model ({best['model']}) loses {share:.0%} of its energy in the suspension."
     else:
         parts = ", ".join(f"{m}: {s:.0%} (delta AIC {next(r['delta_aic'] for r in rows if r['model'] == m):.1f})"
                           for m, s in with_susp.items())  # fmt: skip
         if label in best["shares"]:
-            text = f"No: the suspension carries {best['shares'][label]:.0%} of the loss in the best model"
+            text = f"No: the suspension carries {best['shares'][label]:.0%} of the loss in the top model"
         else:
-            text = f"No: the best model ({best['model']}) needs no suspension loss"
+            text = f"No: the top model ({best['model']}) needs no suspension loss"
         text += f"; suspension share where it is fitted: {parts}." if parts else "."
     return {"suspension_dominates": dominates, "answer": text, "suspension_share_by_model": with_susp}
-
-
-EQUALLY_SUPPORTED_DAIC = 2.0
-"""Models within this AIC of the best are supported about as well by the data (Burnham & Anderson)."""
-
-
-def equally_supported(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
-    """The converged models other than the best within :data:`EQUALLY_SUPPORTED_DAIC` of its AIC: delta AIC
-    and loss shares by model, and a plain sentence (the energy record alone cannot rank them)."""
-    rivals = {r["model"]: {"delta_aic": r["delta_aic"], "shares": r["shares"]}
-              for r in rows[1:] if r["converged"] and r["delta_aic"] < EQUALLY_SUPPORTED_DAIC}  # fmt: skip
-    if not rivals:
-        text = f"No other model comes within {EQUALLY_SUPPORTED_DAIC:g} of the best model's AIC."
-    else:
-        parts = "; ".join(f"{m} (delta AIC {v['delta_aic']:.1f}: "
-                          + ", ".join(f"{k} {x:.0%}" for k, x in v["shares"].items()) + ")"
-                          for m, v in rivals.items())  # fmt: skip
-        text = (f"Supported about as well (delta AIC < {EQUALLY_SUPPORTED_DAIC:g}): {parts}. The energy record "
-                f"alone does not rank these against {rows[0]['model']}; the split of the loss between them is open.")
-    return {"models": rivals, "text": text}
 
 
 def goal_checks(numbers: Mapping[str, float], halves: Mapping[str, Any]) -> dict[str, Any]:
@@ -947,10 +928,12 @@ def identify_losses(
         "thorough": thorough,
         "models_fitted": list(models),
         "workers": workers,
-        "best_model": best.model,
+        "top_model": best.model,
+        "top_model_means": "the lowest AIC; models within delta AIC 2 (supported_models) fit about as well, so "
+                           "b_sim_per_s, p_sim, parameters and top_model_shares are the top model's, not a verdict",
         **numbers,
-        "shares": shares(result, best.model),
-        "shares_stderr": share_errors(best, shares(result, best.model), factor),
+        "top_model_shares": shares(result, best.model),
+        "top_model_shares_stderr": share_errors(best, shares(result, best.model), factor),
         "parameters": parameter_table(best, factor),
         "identifiability": identifiability(best, factor),
         "profile_likelihood": profile,
@@ -961,7 +944,11 @@ def identify_losses(
         "measured_loss_J": loss,
         "simulated_loss_J": float(sum(float(result[w][-1]) for w in works)),
         **suspension_answer(rows),
-        "equally_supported": equally_supported(rows),
+        "supported_models": loss_claims.supported_models(rows),
+        "b_sim_range_all_models_per_s": loss_claims.b_sim_range(rows),
+        "drag_torque_against_seed_rolling_friction": next(
+            (loss_claims.seed_rolling_friction(rec.params, r["parameters"]["tau_b"]["value"]) for r in rows
+             if r["model"] == "air+drag"), None),
         "air_drag_at_defaults": air_share_at_defaults(problem, loss),
         "models": rows,
         "suspension_fixed": {"k_N_per_m": SUSPENSION_K, "M_s_kg": SUSPENSION_M},

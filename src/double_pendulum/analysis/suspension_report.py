@@ -207,13 +207,24 @@ def _identification_section(s: Mapping[str, Any]) -> str:
             f"(p = {s['refit']['resonant']['p']:.2f})."
         )
     )
+    valley = " | ".join(f"{p['k_N_per_m']:.3g} N/m: {p['c_N_s_per_m']:.3g}" for p in v["linearised"])
+    refit = s["refit"]["identified"]
     return f"""## Identification
 
 Least squares of the simulated E_pendulum against the measured energy per frame (calibrated errors),
 k = {i["fixed"]["k"]:g} N/m and M_s = {i["fixed"]["M_s"]:g} kg fixed (the parameter defaults), c free:
-**c = {i["c_N_s_per_m"]:.1f} +- {i["c_stderr"]:.1f} N s/m** (+- {i["c_stderr_uncorrelated"]:.1f} from the Jacobian,
+c = {i["c_N_s_per_m"]:.1f} +- {i["c_stderr"]:.1f} N s/m (+- {i["c_stderr_uncorrelated"]:.1f} from the Jacobian,
 inflated by sqrt({i["autocorrelation_factor"]:.1f}) for the correlated residuals), chi2 = {i["chi2"]:.1f} for
 {i["n_frames"]} frames (chi2_red {i["chi2_red"]:.2f}), {i["n_fmu_runs"]} FMU runs.
+
+**What this c is.** It is conditional: on the assumed k and M_s (not measured), on the default air drag and
+rolling friction beside it (not fitted), and on a model the data reject: refitted, it gives
+b = {refit["b_E_pendulum_per_s"]:.4f} 1/s against the measured {s["measured"]["b_per_s"]:.4f} 1/s
+({refit["difference_in_measured_sigma"]:.1f} standard errors off) and a loss exponent p = {refit["p"]:.2f}
+against the measured {s["measured"]["decay_shape"]["p"]:.2f} +- {s["measured"]["decay_shape"]["p_stderr"]:.2f}.
+Equally good fits lie along a valley (below), so c is not an identified property of the stand. Along the
+linearised valley through the fitted point (d ln c / d ln k = {f["valley_slope_dlnc_dlnk"]:.1f}; not refitted):
+k: c [N s/m] = {valley}.
 
 **The degenerate direction.** The energy fixes one combination of (k, c, M_s). The Jacobian in
 (ln k, ln c, ln M_s) at the identified point has Fisher eigenvalues {", ".join(f"{e:.3g}" for e in f["eigenvalues"])};
@@ -386,7 +397,9 @@ def report_text(summary: Mapping[str, Any]) -> str:
 Air drag and bearing friction at the seed's estimates take b = {b0:.4f} 1/s
 of the measured {summary["measured"]["b_per_s"]:.4f} 1/s. How much can a damped suspension of the pivot add, which
 suspensions reproduce the measurement, and is that the explanation? Run time {summary["wall_time_s"]:.0f} s.
-The fitted c is a fit parameter, not a measured property: it drifts with the fit window (below), and
+The fitted c is a fit parameter, not a measured property: conditional on an assumed k and M_s and on the
+default losses, of a model that reproduces neither b nor the decay's shape, along a valley of equally good
+fits (Identification), it drifts with the fit window (below), and
 ``loss_identification`` finds that a suspension does not explain the decay's shape as well as a
 load-independent bearing drag torque with air drag (see its report).
 

@@ -87,10 +87,14 @@ ENSEMBLE_SEED = 20240611
 """Seed of the random start states of :func:`chaos_spread`."""
 RUN_OUTPUTS: tuple[str, ...] = (*POSITION_OUTPUTS, "phi1", "phi2", "omega1", "omega2", "E_pendulum")
 """FMU outputs recorded for each prediction (positions [m], angles [rad], rates [rad/s], energy [J])."""
+PIVOT_SHIFT_GEOMETRY: tuple[str, ...] = ("pivot_offset_x", "pivot_offset_y", "l2")
+"""The alternative to the camera's rotation: the same fit without it (the pivot moves sideways instead)."""
 RUN_TITLES = {
     "seed_start_frictionless": "seed's start, frictionless model",
     "seed_start_identified": "seed's start, identified losses",
     "lsq_start_identified": "least-squares start (state only), identified losses",
+    "lsq_fixed_geometry_identified": "least-squares start over the geometry fit's window, geometry fixed",
+    "lsq_pivot_shift_identified": "least-squares start, pivot offset and l2 (no rotation), identified losses",
     "lsq_geometry_identified": "least-squares start and geometry, identified losses",
 }
 """Plain words for the prediction labels (which also name their CSV files) in figures."""
@@ -130,6 +134,20 @@ def _horizons(
         out[f"lower_bob_{100 * th:g}cm_s"] = horizon(t, lower, th)
         out[f"both_bobs_{100 * th:g}cm_s"] = horizon(t, both, th)
     return out
+
+
+def headline_horizon(prediction: Prediction, span_s: float, threshold: float = 0.05) -> dict[str, Any]:
+    """The lower bob's smoothed horizon at ``threshold`` [m] as a claim: ``horizon_s`` [s] (the prediction's
+    length ``span_s`` if never exceeded), ``censored`` (True then: the horizon is only known to exceed the
+    record), the largest smoothed error [m] and when [s], the margin below the threshold [m] and the first
+    crossing of the raw per-frame error [s] (None: never)."""
+    e2 = smoothed(prediction.t, prediction.e2)
+    value = horizon(prediction.t, e2, threshold)
+    peak = int(np.argmax(e2))
+    return {"horizon_s": span_s if value is None else value, "censored": value is None,
+            "smoothed_error_peak_m": float(e2[peak]), "smoothed_error_peak_at_s": float(prediction.t[peak]),
+            "margin_below_threshold_m": threshold - float(e2[peak]),
+            "raw_horizon_s": horizon(prediction.t, prediction.e2, threshold)}
 
 
 def horizon_keys(thresholds: Sequence[float] = THRESHOLDS_M) -> list[str]:

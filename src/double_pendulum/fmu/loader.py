@@ -72,7 +72,7 @@ def c_compiler() -> list[str] | None:
 
 
 @functools.cache
-def _compiled(sources: tuple[Path, ...], mtimes: tuple[float, ...], compiler: tuple[str, ...]) -> bytes:
+def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tuple[float, ...]) -> bytes:
     c_files = [str(path) for path in sources if path.suffix == ".c"]
     with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
         output = Path(tmp) / "loader.so"
@@ -85,7 +85,7 @@ def _compiled(sources: tuple[Path, ...], mtimes: tuple[float, ...], compiler: tu
 
 def compiled_loader(fmi_version: int = 2) -> bytes:
     """The FMI ``fmi_version`` loader's shared library for this machine (compiled once per process,
-    source version and compiler).
+    compiler and source version).
 
     Raises :class:`LoaderUnavailable` where it cannot be built (no C compiler; not Linux), and
     ``RuntimeError`` with the compiler's output if compiling fails.
@@ -99,7 +99,7 @@ def compiled_loader(fmi_version: int = 2) -> bytes:
             "which runs only in Python hosts (docs/fmu.md)"
         )
     sources = tuple(loader_sources(fmi_version))
-    return _compiled(sources, tuple(path.stat().st_mtime for path in sources), tuple(compiler))
+    return _compiled(tuple(compiler), sources, tuple(path.stat().st_mtime for path in sources))
 
 
 def python_record() -> str:

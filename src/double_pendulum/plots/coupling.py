@@ -44,13 +44,15 @@ def plot_against(rows: list[dict[str, Any]], x: str, y: str, path: str | Path, *
 
 def plot_stability_map(points: list[dict[str, Any]], curves: dict[str, tuple[np.ndarray, np.ndarray]],
                        path: str | Path) -> Path:
-    """Per scheme: bounded (dots) and blown-up (crosses) runs over h omega and mass ratio, with the derived limit."""
+    """Per scheme: stable (dots) and unstable (crosses) runs over h omega and mass ratio, judged by the spectral
+    radius of the step map fitted to each run, with the derived limit."""
     fig, axes = plt.subplots(1, len(curves), figsize=(5.0 * len(curves) + 1.5, 4.5), squeeze=False, sharey=True)
     for ax, (scheme, curve) in zip(axes[0], curves.items()):
-        for stable, marker, color, label in ((True, "o", "tab:green", "bounded"), (False, "x", "tab:red", "blows up")):
+        for stable, marker, color, label in ((True, "o", "tab:green", "stable, fitted growth per step <= 1"),
+                                                   (False, "x", "tab:red", "unstable, fitted growth per step > 1")):
             sel = [(p["h_omega"], p["mass_ratio"]) for p in points if p["stable"] == stable and p["scheme"] == scheme]
             if sel:
-                ax.scatter(*zip(*sel), marker=marker, color=color, label=f"measured: {label}")
+                ax.scatter(*zip(*sel), marker=marker, color=color, label=f"run: {label}")
         ax.plot(*curve, color="k", label="derived limit (rigid vertical load)")
         ax.set_xscale("log")
         ax.set_yscale("log")

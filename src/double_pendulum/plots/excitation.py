@@ -19,36 +19,40 @@ def _deviation(phi: np.ndarray) -> np.ndarray:
 
 def plot_kapitza_threshold(
     probes: Sequence[Mapping[str, Any]],
+    theory: tuple[np.ndarray, np.ndarray],
     lines: Mapping[str, float],
     runs: Mapping[str, np.ndarray],
-    growth_limit: float,
     theta0: float,
     path: str | Path,
 ) -> Path:
-    """Left: each bisection run's largest tilt over its start tilt against the amplitude [mm], with the
-    threshold lines (``lines``: label -> amplitude [m]). Right: the upper rod's tilt [rad] over time [s]
-    for the runs at the final bracket ends (``runs``: label -> result)."""
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.8))
+    """Left: the Floquet exponent [1/s] of each bisection probe (from the simulated monodromy matrix) against
+    the amplitude [mm], the linear theory's exponent (``theory``: amplitudes [m], exponents [1/s]) and the
+    threshold lines (``lines``: label -> amplitude [m]). Right: the upper rod's tilt over its start tilt
+    against time [s] for the example runs (``runs``: label -> result)."""
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12.5, 5.2))
     a = np.array([p["amplitude_m"] for p in probes]) * 1e3
-    growth = np.array([p["growth"] for p in probes])
+    exponent = np.array([p["floquet_exponent_per_s"] for p in probes])
     stable = np.array([p["stable"] for p in probes])
-    ax.semilogy(a[stable], growth[stable], "o", color="tab:green", label="stayed upright")
-    ax.semilogy(a[~stable], growth[~stable], "x", color="tab:red", ms=8, label="fell over")
-    ax.axhline(growth_limit, color="0.4", lw=0.8, ls=":", label=f"criterion: {growth_limit:g} x start tilt")
-    for (label, value), style in zip(lines.items(), ("--", "-.", "-")):
+    ax.plot(theory[0] * 1e3, theory[1], color="0.6", lw=2.5, label="linear theory, input held over each step")
+    ax.plot(a[stable], exponent[stable], "o", color="tab:green",
+            label="simulated: stable (multipliers on the unit circle)")
+    ax.plot(a[~stable], exponent[~stable], "x", color="tab:red", ms=8, label="simulated: unstable")
+    for (label, value), style in zip(lines.items(), (":", "-.", "--", "-")):
         ax.axvline(value * 1e3, color="k", ls=style, lw=1.0, label=f"{label}: {value * 1e3:.3f} mm")
+    ax.set_xlim(theory[0][0] * 1e3, theory[0][-1] * 1e3)
     ax.set_xlabel("vibration amplitude a [mm]")
-    ax.set_ylabel("largest tilt / start tilt")
-    ax.set_title("Bisection runs through the FMU")
+    ax.set_ylabel("Floquet exponent ln(largest |multiplier|) / period [1/s]")
+    ax.set_title("Growth rate of the upright position (monodromy matrix through the FMU)", fontsize=10)
     ax.legend(fontsize=7.5, loc="upper right", framealpha=0.95)
     for label, result in runs.items():
         bx.plot(result["time"], _deviation(result["phi1"]) / theta0, lw=0.8, label=label)
     bx.set_xlabel("time [s]")
     bx.set_ylabel("upper rod tilt from upright / start tilt")
-    bx.set_ylim(-2.0, 3 * growth_limit)
-    bx.set_title("Upper rod at the final bracket ends")
+    bx.set_ylim(-6.0, 12.0)
+    bx.set_title("Upper rod just below and above the threshold", fontsize=10)
     bx.legend(fontsize=8, loc="upper left")
-    fig.suptitle("Kapitza's inverted pendulum (single-pendulum limit): stability threshold of the upright position")
+    fig.suptitle("Kapitza's inverted pendulum (single-pendulum limit, omega = 50 rad/s): threshold of the upright"
+                 " position")
     return save(fig, path)
 
 
@@ -58,21 +62,22 @@ def plot_stability_map(
     boundaries: Mapping[str, np.ndarray],
     path: str | Path,
 ) -> Path:
-    """Upright-stable (green) and falling (red) grid points over frequency [rad/s] and amplitude [mm],
+    """Upright-stable (green) and unstable (red) grid points over frequency [rad/s] and amplitude [mm],
     with the theoretical boundaries (``boundaries``: label -> amplitude [m] on ``omega_curve``)."""
     fig, ax = plt.subplots(figsize=(10, 7))
     w = np.array([r["omega_rad_per_s"] for r in rows])
     a = np.array([r["amplitude_m"] for r in rows]) * 1e3
     ok = np.array([r["stable"] for r in rows])
-    ax.scatter(w[ok], a[ok], s=60, marker="s", color="tab:green", label="simulated: stays upright")
-    ax.scatter(w[~ok], a[~ok], s=40, marker="x", color="tab:red", label="simulated: falls over")
+    ax.scatter(w[ok], a[ok], s=60, marker="s", color="tab:green",
+               label="simulated: upright stable (Floquet multipliers of one period)")
+    ax.scatter(w[~ok], a[~ok], s=40, marker="x", color="tab:red", label="simulated: upright unstable")
     for (label, values), (color, style) in zip(boundaries.items(), (("k", "-"), ("tab:blue", "--"), ("k", ":"))):
         ax.plot(omega_curve, values * 1e3, color=color, ls=style, lw=1.6, label=label)
     ax.set_xlim(omega_curve[0], omega_curve[-1])
     ax.set_ylim(0, 1.08 * a.max())
     ax.set_xlabel("vibration angular frequency omega [rad/s]")
     ax.set_ylabel("vibration amplitude a [mm]")
-    ax.set_title("Inverted double pendulum on a vertically vibrated pivot: upright-stable or falling over")
+    ax.set_title("Inverted double pendulum on a vertically vibrated pivot: is the upright position stable?")
     ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
     return save(fig, path)
 
@@ -98,8 +103,9 @@ def plot_resonance_curve(
     torque: float,
     path: str | Path,
 ) -> Path:
-    """Steady-state amplitudes of both angles [rad] against the drive frequency [rad/s], the
-    small-angle normal modes (vertical lines) and the fitted peaks."""
+    """Steady-state amplitudes of both angles [rad] against the drive frequency [rad/s], the undamped
+    small-angle normal modes (dashed), the fitted peaks (dotted) and the damped linear response's peaks
+    (crosses at the top)."""
     fig, ax = plt.subplots(figsize=(10.5, 5))
     rows = sorted(rows, key=lambda r: r["omega_rad_per_s"])
     w = np.array([r["omega_rad_per_s"] for r in rows])
@@ -110,12 +116,13 @@ def plot_resonance_curve(
         ax.annotate(f"{name} normal mode\n{mode:.3f} rad/s", (mode, 1.0), xycoords=("data", "axes fraction"),
                     xytext=(4, -28), textcoords="offset points", fontsize=8)
     for p in peaks:
+        color = "tab:blue" if p["angle"] == "phi1" else "tab:orange"
         if np.isfinite(p["peak_rad_per_s"]):
-            ax.axvline(p["peak_rad_per_s"], color="tab:blue" if p["angle"] == "phi1" else "tab:orange",
-                       ls=":", lw=0.8)
+            ax.axvline(p["peak_rad_per_s"], color=color, ls=":", lw=0.8)
+        ax.plot(p["damped_linear_peak_rad_per_s"], 0.97, "x", color=color, ms=7, transform=ax.get_xaxis_transform())
     ax.set_xlabel("drive angular frequency omega [rad/s]")
     ax.set_ylabel("steady-state amplitude [rad]")
     ax.set_title(f"Resonance curve: pivot torque {torque * 1e3:g} mN m x sin(omega t), viscous pivot bearing"
-                 " (dotted: fitted peaks)", fontsize=10)
+                 " (dotted: fitted peaks; x: damped linear theory)", fontsize=10)
     ax.legend(fontsize=8, loc="upper right")
     return save(fig, path)

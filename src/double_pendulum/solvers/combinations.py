@@ -14,6 +14,7 @@ is safe to ``exec``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from functools import cache
 
@@ -55,6 +56,59 @@ def weighted_sum(row: SparseRow, n: int) -> Callable[[Sequence[list[float]]], li
     """Return ``g(ks) -> [sum_j w_j ks[j][c] for c in range(n)]``."""
     body = ", ".join(_terms(row, c) for c in range(n))
     return _compile("weighted", "ks", row, body)
+
+
+@cache
+def explicit_stages(a: tuple[SparseRow, ...], c: tuple[float, ...], n_stages: int, b: SparseRow, n: int) -> Callable:
+    """Return ``g(f, t, y, k0, h) -> (y_new, [k0, ..., k_{s-1}])``: one explicit Runge-Kutta step as one
+    straight-line function (tableau rows ``a``, nodes ``c``, the first ``n_stages`` stages, weights ``b``).
+
+    The state and each stage derivative are unpacked into locals once, so the stage inputs
+    ``y_c + (h a_ij) k_j[c] + ...`` cost no list indexing and no call per stage; the arithmetic is
+    exactly that of :func:`step_combination` (products ``h a_ij`` first, summed left to right from
+    ``y_c``), so the step is bit-identical to the loop over stages.
+    """
+
+    def unpack(name: str) -> str:
+        return f"    {', '.join(f'{name}_{i}' for i in range(n))}, = {name}\n"
+
+    def combination(row: SparseRow, prefix: str) -> str:
+        scaled = "".join(f"    {prefix}{j} = h * {w!r}\n" for j, w in row)
+        terms = [f"y_{i}" + "".join(f" + {prefix}{j} * k{j}_{i}" for j, _ in row) for i in range(n)]
+        return scaled, f"[{', '.join(terms)}]"
+
+    source = "def stages(f, t, y, k0, h):\n" + unpack("y") + unpack("k0")
+    for i in range(1, n_stages):
+        scaled, state = combination(a[i], f"ha{i}_")
+        source += scaled + f"    k{i} = f(t + {c[i]!r} * h, {state})\n" + unpack(f"k{i}")
+    scaled, y_new = combination(b, "hb")
+    source += scaled + f"    return {y_new}, [{', '.join(f'k{i}' for i in range(n_stages))}]\n"
+    namespace: dict = {}
+    exec(compile(source, "<stages>", "exec"), namespace)  # noqa: S102 - literals and indices only
+    return namespace["stages"]
+
+
+@cache
+def scaled_error_norm(row: SparseRow, n: int) -> Callable[..., float]:
+    """Return ``g(y, y_new, ks, h, rtol, atol)``: the scaled RMS norm of an embedded error estimate.
+
+    With ``e_c = h * sum_j w_j ks[j][c]`` (``row``: the sparse weights of the error estimate) and
+    ``s_c = atol + rtol * max(|y_c|, |y_new_c|)`` it returns ``sqrt(sum_c (e_c / s_c)^2 / n)``, in
+    the order of operations of the plain loop (``runge_kutta.scaled_rms``), as straight-line code.
+    """
+    lines = ["def norm(y, y_new, ks, h, rtol, atol):"]
+    lines += [f"    k{j} = ks[{j}]" for j in sorted({j for j, _ in row})]
+    terms = []
+    for c in range(n):
+        lines.append(f"    e{c} = h * ({_terms(row, c)})")
+        lines.append(f"    a{c} = abs(y[{c}])")
+        lines.append(f"    b{c} = abs(y_new[{c}])")
+        lines.append(f"    s{c} = atol + rtol * (b{c} if b{c} > a{c} else a{c})")
+        terms.append(f"(e{c} / s{c}) ** 2")
+    lines.append(f"    return sqrt((0.0 + {' + '.join(terms)}) / {n})")
+    namespace: dict = {"sqrt": math.sqrt}
+    exec(compile("\n".join(lines) + "\n", "<norm>", "exec"), namespace)  # noqa: S102 - literals and indices only
+    return namespace["norm"]
 
 
 def sparse(weights: Sequence[float]) -> SparseRow:
