@@ -211,6 +211,38 @@ def test_the_fmu_state_round_trips_under_model_exchange(fmu3):
         second.close()
 
 
+def test_the_fmu_state_round_trips_under_co_simulation(fmu3):
+    """The same for Co-Simulation: the component's state, integrator included, through fmi3SerializeFMUState."""
+    from fmpy.fmi3 import FMU3Slave
+
+    unzipdir, md = fmu3
+    refs = {v.name: v.valueReference for v in md.modelVariables}
+    instances = []
+    for name in ("first", "second"):
+        fmu = FMU3Slave(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier="DoublePendulum", instanceName=name)
+        fmu.instantiate()
+        fmu.enterInitializationMode()
+        fmu.setFloat64([refs["phi1_0"], refs["phi2_0"]], [2.0, 2.0])
+        fmu.exitInitializationMode()
+        instances.append(fmu)
+    first, second = instances
+    for k in range(20):
+        first.doStep(k * 0.01, 0.01)
+    state = first.getFMUState()
+    saved = first.serializeFMUState(state)
+    first.freeFMUState(state)
+    for k in range(20, 40):
+        first.doStep(k * 0.01, 0.01)
+    second.setFMUState(second.deserializeFMUState(saved))
+    for k in range(20, 40):
+        second.doStep(k * 0.01, 0.01)
+    angles = [refs["phi1"], refs["phi2"], refs["omega1"]]
+    assert second.getFloat64(angles) == first.getFloat64(angles)
+    for fmu in instances:
+        fmu.terminate()
+        fmu.freeInstance()
+
+
 @pytest.mark.parametrize(("name", "value", "message"), [
     ("l1", -0.3, "invalid l1 = -0.3 m: must be > 0"),
     ("omega_reg", 0.0, "invalid omega_reg = 0.0 rad/s: must be > 0"),
