@@ -164,9 +164,8 @@ class ComponentSlave(Fmi2Slave):
         sim = self._sim
         if not sim.initialised:
             return super().get_real(vrs)  # the outputs of the values set so far (_output)
-        names, get = self._real_names, sim.get
         try:
-            return [get(names[vr]) for vr in vrs]
+            return list(map(sim.get, map(self._real_names.__getitem__, vrs)))
         except KeyError:  # not a Real: pythonfmu's message
             return super().get_real(vrs)
 
@@ -272,7 +271,7 @@ class ComponentSlave(Fmi2Slave):
             self.log(f"doStep failed: {error}", Fmi2Status.error)
             self._report(error)
             return False
-        if getattr(sim, "notices", None):
+        if sim.notices:
             self._warn(sim.notices)
         return True
 
