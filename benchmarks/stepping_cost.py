@@ -80,13 +80,13 @@ def component_profile(steps: int, driven: bool) -> dict[str, float]:
         sim.set(name, value)
     sim.initialise()
     values = [shaker(k * H) for k in range(steps)]
+    indices = list(range(len(INPUT_NAMES)))
     parts = dict.fromkeys(("inputs", "doStep", "outputs"), 0.0)
     clock = time.process_time
     for k in range(steps):
         t0 = clock()
         if driven:
-            for name, value in zip(INPUT_NAMES, values[k]):
-                sim.set_input(name, value)
+            sim.set_inputs_at(indices, values[k])  # as the FMU's fmi2SetReal does
         t1 = clock()
         sim.do_step(k * H, H)
         t2 = clock()

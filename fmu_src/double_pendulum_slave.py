@@ -83,9 +83,8 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
         try:
             if not sim.initialised:
                 return super().get_real(vrs)  # the outputs of the values set so far (_output)
-            names, get = self._real_names, sim.get
             try:
-                return [get(names[vr]) for vr in vrs]
+                return list(map(sim.get, map(self._real_names.__getitem__, vrs)))
             except KeyError:  # not a Real: pythonfmu's message
                 return super().get_real(vrs)
         except Exception as error:

@@ -223,7 +223,7 @@ class ComponentMapping:
             self.log(f"doStep failed: {error}", self.error_status)
             self._report(error)
             return False
-        if getattr(sim, "notices", None):
+        if sim.notices:
             self._warn(sim.notices)
         return True
 

@@ -172,6 +172,7 @@ class DoublePendulumCoSimulation:
         self._u: list[float] = [0.0] * len(INPUT_NAMES)  # the inputs as set, in INPUT_NAMES order
         self.driven = False  # the model with inputs is running (from the first non-zero input on)
         self._hold: InputHold | None = None  # the hold the integrator is integrating (reset in place)
+        self._fixed_step = False  # the solver is a fixed-step one (its blow-up is checked per step)
         self._pivot_samples: PositionSamples | None = None  # pivot_input = position: the last positions
         self._position_watch: PositionOnlyWatch | None = None  # pivot_input = acceleration: position-only wiring
         self.notices: list[str] = []  # warnings for the host's log, taken by the FMU adapter
@@ -351,6 +352,7 @@ class DoublePendulumCoSimulation:
             fixed_step=settings.fixed_step,
             max_steps_per_call=max(1, int(settings.max_steps)),
         )
+        self._fixed_step = not self.integrator.method.adaptive
         self._start_pivot_input()
         self.initial_energy = None
         self._y = y0
@@ -389,10 +391,12 @@ class DoublePendulumCoSimulation:
         :class:`SolverError` when the integrator gives up; the state is then left at the last
         successful communication point. The outputs are computed when read.
         """
-        check_step_call(self.initialised and self.integrator is not None, self.time, current_time, step_size)
+        if not (current_time == self.time and 0.0 < step_size < math.inf and self.initialised):
+            check_step_call(self.initialised and self.integrator is not None, self.time, current_time, step_size)
         t_end = current_time + step_size
         land = False
-        self._read_pivot_input()
+        if self.driven or self._pivot_samples is not None:
+            self._read_pivot_input()
         try:
             if self.driven:
                 if not self._hold.continued_by(self.time, self._u):
@@ -404,7 +408,7 @@ class DoublePendulumCoSimulation:
             y = self.integrator.advance_to(t_end, land=land)
         except ModelError as error:
             raise SolverError(str(error)) from error
-        if not self.integrator.method.adaptive:  # adaptive methods reject non-finite or inaccurate steps
+        if self._fixed_step:  # adaptive methods reject non-finite or inaccurate steps
             self._check_bounded(y, self._outputs_at(y, self._hold.at(t_end) if self.driven else None), t_end)
         self.time = t_end
         self._y = y

@@ -111,20 +111,78 @@ def scaled_error_norm(row: SparseRow, n: int) -> Callable[..., float]:
     return namespace["norm"]
 
 
+def dense_columns(
+    extra: Sequence[tuple[int, SparseRow, float]], d_rows: Sequence[SparseRow], n: int
+) -> Callable[..., list[tuple[float, ...]]]:
+    """Return ``g(f, t, y, y_new, fy, f_new, h, ks)``: the coefficients of DOP853's dense output per component.
+
+    ``extra`` lists the extra stages ``(index, sparse row, node)`` evaluated first (appended to the
+    step's ``ks``); then for each component ``c``, with ``dy = y_new[c] - y[c]``, the column
+    ``(h D_3.k, h D_2.k, h D_1.k, h D_0.k, 2 dy - h (fy + f_new), h fy - dy, dy)`` (highest first,
+    as :func:`alternating_horner` takes it), in the arithmetic of the plain loops, as one
+    straight-line function.
+    """
+    used = sorted({j for _, row, _ in extra for j, _ in row} | {j for row in d_rows for j, _ in row})
+    source = "def dense(f, t, y, y_new, fy, f_new, h, ks):\n"
+    source += "".join(f"    k{j} = ks[{j}]\n" for j in used if j < min(i for i, _, _ in extra))
+    for index, row, node in extra:
+        scaled = "".join(f"    ha{index}_{j} = h * {w!r}\n" for j, w in row)
+        state = ", ".join(f"y[{c}]" + "".join(f" + ha{index}_{j} * k{j}[{c}]" for j, _ in row) for c in range(n))
+        source += scaled + f"    k{index} = f(t + {node!r} * h, [{state}])\n"
+    columns = []
+    for c in range(n):
+        source += f"    dy{c} = y_new[{c}] - y[{c}]\n"
+        ds = [f"h * ({_terms(row, c)})" for row in d_rows]
+        hermite = [f"2.0 * dy{c} - h * (fy[{c}] + f_new[{c}])", f"h * fy[{c}] - dy{c}", f"dy{c}"]
+        columns.append(f"({', '.join([*reversed(ds), *hermite])})")
+    source += f"    return [{', '.join(columns)}]\n"
+    namespace: dict = {}
+    exec(compile(source, "<dense>", "exec"), namespace)  # noqa: S102 - literals and indices only
+    return namespace["dense"]
+
+
+@cache
+def two_estimate_error_norm(row5: SparseRow, row3: SparseRow, n: int) -> Callable[..., float]:
+    """Return ``g(y, y_new, ks, h, rtol, atol)``: DOP853's error norm from its 5th- and 3rd-order estimates.
+
+    With ``e5_c, e3_c`` the estimates' weighted stage sums and ``s_c`` as in :func:`scaled_error_norm`,
+    ``n5 = sum_c (e5_c / s_c)^2``, ``n3`` alike: ``|h| n5 / sqrt((n5 + 0.01 n3) n)`` (0 if both are 0;
+    Hairer, Norsett, Wanner, code DOP853), as straight-line code in the order of the plain loop.
+    """
+    lines = ["def norm(y, y_new, ks, h, rtol, atol):"]
+    lines += [f"    k{j} = ks[{j}]" for j in sorted({j for j, _ in (*row5, *row3)})]
+    fives, threes = [], []
+    for c in range(n):
+        lines.append(f"    a{c} = abs(y[{c}])")
+        lines.append(f"    b{c} = abs(y_new[{c}])")
+        lines.append(f"    s{c} = atol + rtol * (b{c} if b{c} > a{c} else a{c})")
+        fives.append(f"(({_terms(row5, c)}) / s{c}) ** 2")
+        threes.append(f"(({_terms(row3, c)}) / s{c}) ** 2")
+    lines.append(f"    n5 = 0.0 + {' + '.join(fives)}")
+    lines.append(f"    n3 = 0.0 + {' + '.join(threes)}")
+    lines.append("    if n5 == 0.0 and n3 == 0.0:")
+    lines.append("        return 0.0")
+    lines.append(f"    return abs(h) * n5 / sqrt((n5 + 0.01 * n3) * {n})")
+    namespace: dict = {"sqrt": math.sqrt}
+    exec(compile("\n".join(lines) + "\n", "<norm>", "exec"), namespace)  # noqa: S102 - literals and indices only
+    return namespace["norm"]
+
+
 def sparse(weights: Sequence[float]) -> SparseRow:
     """Turn dense weights into a sparse row ``((j, w_j), ...)`` of the non-zero ones."""
     return tuple((j, float(w)) for j, w in enumerate(weights) if w != 0.0)
 
 
 @cache
-def alternating_horner(n: int, m: int) -> Callable[[float, Sequence[Sequence[float]], Sequence[float]], list[float]]:
-    """Return ``g(x, columns, y)`` evaluating DOP853's dense-output polynomial for ``n`` components.
+def alternating_horner(n: int, m: int) -> Callable[[Sequence[Sequence[float]], Sequence[float], float], list[float]]:
+    """Return ``g(columns, y, x)`` evaluating DOP853's dense-output polynomial for ``n`` components
+    (``x`` last, so ``functools.partial(g, columns, y)`` is the interpolant).
 
     For each component with coefficients ``(c_0, ..., c_{m-1})`` (highest first) it computes
     ``((((c_0 x + c_1)(1-x) + c_2) x + c_3)(1-x) ...) + y`` -- factors alternating ``x`` and
     ``1 - x`` starting with ``x`` -- in the same order as the equivalent loop.
     """
-    lines = ["def horner(x, columns, y):", "    u = 1.0 - x"]
+    lines = ["def horner(columns, y, x):", "    u = 1.0 - x"]
     results = []
     for c in range(n):
         names = [f"a{c}_{i}" for i in range(m)]

@@ -262,6 +262,8 @@ class Integrator:
         side evaluations (DOP853: 3). Otherwise stepping past ``t_out`` keeps the step sequence
         independent of the communication points.
         """
+        if self.t_prev < t_out < self.t and self._interp is not None:  # within the last step (as state_at)
+            return self._interp((t_out - self.t_prev) / (self.t - self.t_prev))
         if t_out < self.t_prev:
             raise SolverError(f"cannot return to t = {t_out:.9g} s: the integrator is at t = {self.t:.9g} s")
         if land and self.t < t_out and self._short_landing(t_out):

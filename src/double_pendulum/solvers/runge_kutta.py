@@ -26,14 +26,17 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from functools import partial
 
 from . import tableaus as tb
 from .combinations import (
     alternating_horner,
+    dense_columns,
     explicit_stages,
     scaled_error_norm,
     sparse,
     step_combination,
+    two_estimate_error_norm,
     weighted_sum,
 )
 
@@ -92,6 +95,10 @@ def _stages(a: SparseRows, c: Sequence[float], n_stages: int, b: SparseRows, n: 
 _DOPRI5_B_ROW = sparse(tb.DOPRI5_B)
 _DOPRI5_E_ROW = sparse(tb.DOPRI5_E)
 _DOP853_B_ROW = sparse(tb.DOP853_B)
+_DOP853_E5_ROW = sparse(tb.DOP853_E5)
+_DOP853_E3_ROW = sparse(tb.DOP853_E3)
+_DOP853_EXTRA_STAGES = tuple((i, tuple(tb.DOP853_A[i]), tb.DOP853_C[i]) for i in (13, 14, 15))
+_DOP853_D_ROWS = tuple(sparse(row) for row in tb.DOP853_D)
 _RK4_B_ROW = sparse(tb.RK4_B)
 _DOPRI5_P_COLUMNS = tuple(tuple(row[k] for row in tb.DOPRI5_P) for k in range(len(tb.DOPRI5_P[0])))
 
@@ -164,38 +171,16 @@ class Dop853:
         return y_new, f_new, ks
 
     def error_norm(self, y, y_new, ks, h, rtol, atol) -> float:
-        err5 = _constant_kernel(tb.DOP853_E5, len(y), dense_weights=True)(ks)
-        err3 = _constant_kernel(tb.DOP853_E3, len(y), dense_weights=True)(ks)
-        n5 = n3 = 0.0
-        for e5, e3, u, v in zip(err5, err3, y, y_new):
-            s = atol + rtol * max(abs(u), abs(v))
-            n5 += (e5 / s) ** 2
-            n3 += (e3 / s) ** 2
-        if n5 == 0.0 and n3 == 0.0:
-            return 0.0
-        return abs(h) * n5 / math.sqrt((n5 + 0.01 * n3) * len(y))
+        n = len(y)
+        norm = _tableau_kernel(tb.DOP853_E5, n, lambda: two_estimate_error_norm(_DOP853_E5_ROW, _DOP853_E3_ROW, n))
+        return norm(y, y_new, ks, h, rtol, atol)
 
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):
-        ks = list(ks)
-        for i in (13, 14, 15):
-            ks.append(f(t + tb.DOP853_C[i] * h, _constant_kernel(tb.DOP853_A[i], len(y))(y, h, ks)))
-        dy = [v - u for u, v in zip(y, y_new)]
-        coeffs = [
-            dy,
-            [h * a - d for a, d in zip(fy, dy)],
-            [2.0 * d - h * (a + b) for d, a, b in zip(dy, fy, f_new)],
-        ]
-        for row in tb.DOP853_D:
-            coeffs.append([h * v for v in _constant_kernel(row, len(y), dense_weights=True)(ks)])
-        coeffs.reverse()
-        columns = list(zip(*coeffs))  # per component: its 7 coefficients, highest first
-        horner = alternating_horner(len(y), len(coeffs))
-
-        def evaluate(theta: float) -> list[float]:
-            # y + F0 x + F1 x(1-x) + F2 x^2(1-x) + ..., Horner-like with factors alternating x and 1-x
-            return horner(theta, columns, y)
-
-        return evaluate
+        n = len(y)
+        dense = _tableau_kernel(tb.DOP853_D, n, lambda: dense_columns(_DOP853_EXTRA_STAGES, _DOP853_D_ROWS, n))
+        columns = dense(f, t, y, y_new, fy, f_new, h, ks)  # per component: its 7 coefficients, highest first
+        # y + F0 x + F1 x(1-x) + F2 x^2(1-x) + ..., Horner-like with factors alternating x and 1-x
+        return partial(alternating_horner(n, 7), columns, y)
 
 
 class ClassicRK4:
