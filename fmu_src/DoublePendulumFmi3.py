@@ -3,13 +3,13 @@
 Parameters, inputs and outputs are those of the FMI 2 FMU (same names, descriptions and start
 values, from :data:`double_pendulum.component.variables.INTERFACES`), with ``time`` (the
 independent variable) and, for Model Exchange, the continuous states and their derivatives
-``der(<state>)`` (:mod:`pendulum_model_exchange`).
+``der(<state>)`` (:mod:`double_pendulum.component.model_exchange`).
 
 * **Co-Simulation**: the component
   :class:`double_pendulum.component.cosimulation.DoublePendulumCoSimulation` does every doStep,
   exactly as in the FMI 2 FMU (same integrator, same numbers).
 * **Model Exchange**: the host integrates the states; the FMU gives their derivatives from the
-  runtime's vector field, no event indicators (:mod:`pendulum_model_exchange`).
+  runtime's vector field, no event indicators (:mod:`double_pendulum.component.model_exchange`).
 
 pythonfmu3 builds the same Python object for either interface and does not say which; the
 Model Exchange functions (``fmi3SetTime`` after initialisation, ``fmi3Get/SetContinuousStates``,
@@ -24,8 +24,11 @@ from __future__ import annotations
 import importlib
 from types import SimpleNamespace
 
-from pendulum_model_exchange import DERIVATIVE_UNITS, LOCAL_STATES, STATES, PendulumStates, state_variable
 from slave_common import ComponentMapping, fmi_library, leave_host_as_found, runtime_module, runtime_package
+
+_exchange = runtime_module("component.model_exchange")
+DERIVATIVE_UNITS, LOCAL_STATES, STATES = _exchange.DERIVATIVE_UNITS, _exchange.LOCAL_STATES, _exchange.STATES
+PendulumStates, state_variable = _exchange.PendulumStates, _exchange.state_variable
 
 _library = fmi_library("pythonfmu3")
 _variables = importlib.import_module(f"{_library}.variables")
@@ -167,7 +170,7 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
         return list(self._guarded(lambda: self._model_exchange().derivatives()))
 
     def get_event_indicators(self) -> list[float]:
-        return []  # a smooth right-hand side (pendulum_model_exchange)
+        return []  # a smooth right-hand side (double_pendulum.component.model_exchange)
 
     def update_discrete_states(self) -> SimpleNamespace:
         """Event Mode: book an input jump's energy into W_input; there are no discrete states.

@@ -38,7 +38,7 @@ SCRIPT = textwrap.dedent("""
     out["public_fmu_modules"] = sorted(name for name in added if not name.startswith("_dp_fmu_") and any(
         name == p or name.startswith(p + ".") for p in ("pythonfmu", "pythonfmu3", "double_pendulum", "DoublePendulum",
                                                          "double_pendulum_slave", "slave_common",
-                                                         "DoublePendulumFmi3", "pendulum_model_exchange")))
+                                                         "DoublePendulumFmi3")))
     maps = Path("/proc/self/maps").read_text() if Path("/proc/self/maps").exists() else ""
     out["libpythons"] = sorted({line.split()[-1] for line in maps.splitlines() if "libpython3" in line})
 

@@ -2,7 +2,7 @@
 
 The adapter ``fmu_src/DoublePendulumFmi3.py`` maps the FMI 3 calls onto the same component as the
 FMI 2 FMU (Co-Simulation) and onto the runtime's vector field (Model Exchange,
-``fmu_src/pendulum_model_exchange.py``); the runtime is bundled as for FMI 2
+``double_pendulum.component.model_exchange``); the runtime is bundled as for FMI 2
 (:mod:`double_pendulum.fmu.build`), with pythonfmu3's Python part imported under a private name.
 The build then
 
@@ -34,7 +34,7 @@ from .build import (
 
 DEFAULT_FMU3_PATH = Path("build") / "fmi3" / f"{MODEL_IDENTIFIER}.fmu"
 ADAPTER = "DoublePendulumFmi3.py"  # the pythonfmu3 class DoublePendulum
-SHARED = ("slave_common.py", "pendulum_model_exchange.py")  # bundled beside it
+SHARED = ("slave_common.py",)  # bundled beside it
 
 
 def adapter_sources() -> list[Path]:

@@ -1,5 +1,8 @@
 r"""Model Exchange of the FMI 3 ``DoublePendulum`` FMU: its continuous states and their derivatives.
 
+Runtime code (standard library only), bundled into the FMU; the adapter
+``fmu_src/DoublePendulumFmi3.py`` maps pythonfmu3's calls onto it.
+
 The host integrates :math:`\dot x = f(x, u)`; the FMU gives :math:`f` from the runtime's vector
 field (:func:`double_pendulum.model.vector_field.build_vector_field`, the same function the
 co-simulation integrates), nothing re-derived here.
@@ -39,12 +42,11 @@ from __future__ import annotations
 
 from typing import Any
 
-from slave_common import runtime_module
+from ..model import inputs as _inputs
+from ..model import parameters as _parameters
+from ..model import vector_field as _vector_field
+from . import cosimulation as _cosimulation
 
-_vector_field = runtime_module("model.vector_field")
-_parameters = runtime_module("model.parameters")
-_inputs = runtime_module("model.inputs")
-_cosimulation = runtime_module("component.cosimulation")
 InputHold, InputValues, INPUT_NAMES = _inputs.InputHold, _inputs.InputValues, _inputs.INPUT_NAMES
 INPUT_ZEROS = _inputs.ZERO_INPUTS
 
