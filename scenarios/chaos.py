@@ -31,8 +31,14 @@ from typing import Any
 import numpy as np
 
 from double_pendulum import plots
-from double_pendulum.analysis import chaos, lyapunov_study, phase_space, predictability
-from double_pendulum.analysis.ensemble import initial_states, pendulum_field, rod_field
+from double_pendulum.analysis.chaos import flips, lyapunov_study, phase_space, predictability, releases
+from double_pendulum.analysis.chaos.ensemble import initial_states, pendulum_field, rod_field
+from double_pendulum.analysis.chaos.lyapunov import (
+    Integration,
+    LyapunovResult,
+    lyapunov_benettin,
+    lyapunov_two_trajectory,
+)
 from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.sweep import default_workers, parallel_map, run_sweep
 from double_pendulum.fmu.runner import FmuRunner
@@ -52,8 +58,9 @@ THRESHOLDS = (0.01, 0.10)  # m, spread of the lower bob that ends predictability
 SNAPSHOTS = (0.0, 1.0, 2.0, 3.0, 5.0, 8.0)  # s, clouds of the 5 mm ensemble
 RENORM = 0.5  # s, Benettin renormalisation interval
 H = 1e-3  # s, RK4 step of the ensembles, maps and sections
-METHODS = {"dop853": chaos.Integration("dop853", rtol=1e-10, atol=1e-12),  # the high-accuracy estimate
-           "rk4_h": chaos.Integration("rk4", h=H), "rk4_h_half": chaos.Integration("rk4", h=H / 2)}  # step halving
+METHODS = {"dop853": Integration("dop853", rtol=1e-10, atol=1e-12),  # the high-accuracy estimate
+           "rk4_h": Integration("rk4", h=H),
+           "rk4_h_half": Integration("rk4", h=H / 2)}  # step halving
 RK4_STEPS = {"rk4_h": "h", "rk4_h_half": "h / 2"}  # the RK4 integrations' steps, as the precision text names them
 
 
@@ -84,7 +91,7 @@ class Plan:
     # safe: in a trial its trajectory stayed chaotic to 200 s where rtol 1e-8 settled on a regular orbit by 110 s;
     # when it settles is itself a matter of chance: with the runtime's DOP853, not the batch one, by 150 s)
 
-    def methods(self) -> dict[str, chaos.Integration]:
+    def methods(self) -> dict[str, Integration]:
         """The integrations of the largest exponent in this plan (DOP853 at :attr:`lyap_rtol`)."""
         dop853 = dataclasses.replace(METHODS["dop853"], rtol=self.lyap_rtol, atol=self.lyap_rtol * 1e-2)
         return {"dop853": dop853, **{name: METHODS[name] for name in self.rk4}}
@@ -177,21 +184,21 @@ def ensembles(out: Path, plan: Plan, params: PendulumParameters, lyapunov: float
 
 def lyapunov_starts(plan: Plan, params: PendulumParameters) -> np.ndarray:
     """The default start and its ``lyap_members`` neighbours drawn within 5 mm."""
-    return chaos.release_ensemble(*PHI0, START_UNCERTAINTY, plan.lyap_members + 1, params, seed=SEED,
+    return releases.release_ensemble(*PHI0, START_UNCERTAINTY, plan.lyap_members + 1, params, seed=SEED,
                                   include_nominal=True)
 
 
-def benettin_part(plan: Plan, params: PendulumParameters, name: str) -> tuple[chaos.LyapunovResult, float]:
+def benettin_part(plan: Plan, params: PendulumParameters, name: str) -> tuple[LyapunovResult, float]:
     """Largest exponent of the Lyapunov starts by the integration ``METHODS[name]``, and its wall time [s]."""
     start = time.perf_counter()
-    res = chaos.lyapunov_benettin(pendulum_field(params), lyapunov_starts(plan, params), plan.lyap_t_end,
+    res = lyapunov_benettin(pendulum_field(params), lyapunov_starts(plan, params), plan.lyap_t_end,
                                   renorm_interval=RENORM, integration=plan.methods()[name])
     return res, time.perf_counter() - start
 
 
 def two_trajectory_part(plan: Plan, params: PendulumParameters) -> np.ndarray:
     """The two-trajectory estimate (RK4) of the Lyapunov starts: running estimates ``(n_t, N)``."""
-    _, two = chaos.lyapunov_two_trajectory(pendulum_field(params), lyapunov_starts(plan, params), plan.lyap_t_end,
+    _, two = lyapunov_two_trajectory(pendulum_field(params), lyapunov_starts(plan, params), plan.lyap_t_end,
                                            renorm_interval=RENORM)
     return two
 
@@ -252,7 +259,7 @@ def with_friction(out: Path, plan: Plan, params: PendulumParameters) -> dict:
 
 def flip_map(out: Path, plan: Plan, params: PendulumParameters) -> dict:
     """Time to the first flip on a grid of release angles; check the energetic bound on every start."""
-    fmap = chaos.flip_time_map(plan.flip_n, plan.flip_n, params, t_max=plan.flip_t_max, h=H, max_workers=plan.workers)
+    fmap = flips.flip_time_map(plan.flip_n, plan.flip_n, params, t_max=plan.flip_t_max, h=H, max_workers=plan.workers)
     write_results_csv(out / "flip_map.csv", *phase_space.flip_map_table(fmap))
     plots.plot_flip_map(fmap.phi1, fmap.phi2, fmap.time, fmap.energy, fmap.threshold, out / "flip_map.png",
                         t_max=fmap.t_max)

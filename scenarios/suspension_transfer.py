@@ -10,15 +10,15 @@ on; b is fitted to E_pendulum (the bobs, what the camera sees) on the measured f
 
 Steps: identify c at the default k and M_s from the measured energy, with its valley in
 (k, c, M_s) and the decay shape p of dE/dt = -k E^p
-(:mod:`~double_pendulum.analysis.suspension_identification`); sweep b over (k, c) at a few M_s and
+(:mod:`~double_pendulum.analysis.suspension.identification`); sweep b over (k, c) at a few M_s and
 check the map against the linear response to the fixed-pivot force spectrum (the default run maps
 M_s = 2 kg, the identified mass; ``--thorough`` adds coarser maps at 0.5 and 8 kg and the fits on the
 first 7 and 14 s)
-(:mod:`~double_pendulum.analysis.decay_map`, :mod:`~double_pendulum.analysis.suspension_response`);
+(:mod:`~double_pendulum.analysis.suspension.decay_map`, :mod:`~double_pendulum.analysis.suspension.response`);
 run the identified suspension (and the resonant one on the same iso-b curve) again and follow the
-energy into the suspension (:mod:`~double_pendulum.analysis.energy_flow`). Summary entries, tables
-and figure inputs: :mod:`~double_pendulum.analysis.suspension_transfer`; the report:
-:mod:`~double_pendulum.analysis.suspension_report`.
+energy into the suspension (:mod:`~double_pendulum.analysis.suspension.energy_flow`). Summary entries, tables
+and figure inputs: :mod:`~double_pendulum.analysis.suspension.transfer`; the report:
+:mod:`~double_pendulum.analysis.suspension.report`.
 
 Outputs in ``results/suspension_transfer/``: ``decay_rate_map.csv`` (the sweep), ``frames.csv``
 (measured and simulated energy per frame), ``identified.csv`` / ``resonant.csv`` (energy-flow runs),
@@ -42,8 +42,9 @@ import numpy as np
 from double_pendulum.scenarios.energy_decay import SEED_FIT
 
 from double_pendulum import plots
-from double_pendulum.analysis import suspension_transfer as study
-from double_pendulum.analysis.decay_map import (
+from double_pendulum.analysis.progress import step
+from double_pendulum.analysis.suspension import transfer as study
+from double_pendulum.analysis.suspension.decay_map import (
     BASE_SETTINGS,
     MAP_SETTINGS,
     MAP_UNITS,
@@ -51,10 +52,8 @@ from double_pendulum.analysis.decay_map import (
     map_summary,
     trace_valley,
 )
-from double_pendulum.analysis.energy_flow import energy_flow_run, energy_flow_summary
-from double_pendulum.analysis.measurement import load_track, reconstruct
-from double_pendulum.analysis.progress import step
-from double_pendulum.analysis.suspension_identification import (
+from double_pendulum.analysis.suspension.energy_flow import energy_flow_run, energy_flow_summary
+from double_pendulum.analysis.suspension.identification import (
     DEFAULT_SUSPENSION,
     FIT_SETTINGS,
     LOSSES,
@@ -67,8 +66,9 @@ from double_pendulum.analysis.suspension_identification import (
     valley_fisher,
     window_check,
 )
-from double_pendulum.analysis.suspension_report import report_text
+from double_pendulum.analysis.suspension.report import report_text
 from double_pendulum.analysis.sweep import runner_map
+from double_pendulum.analysis.track.measurement import load_track, reconstruct
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv, write_text
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis.cosimulation import fitted_order, stability_run
-from double_pendulum.analysis.coupling_stability import critical_mass_ratio, oscillator_step, spectral_radius
+from double_pendulum.analysis.coupling.cosimulation import fitted_order, stability_run
+from double_pendulum.analysis.coupling.stability import critical_mass_ratio, oscillator_step, spectral_radius
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.component.suspension import SuspensionCoSimulation
 from double_pendulum.fmu.coupling import CouplingError, run_coupled, split_values
@@ -99,7 +99,7 @@ def test_quick_scenario_writes_csv_plots_summary_and_report(quick_results):
 def test_libcosim_is_skipped_with_a_reason_when_libcosimpy_is_missing(monkeypatch):
     import importlib.util
 
-    from double_pendulum.analysis import cosimulation
+    from double_pendulum.analysis.coupling import cosimulation
 
     real = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "libcosimpy" else real(name, *a))

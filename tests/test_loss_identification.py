@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis import loss_claims
-from double_pendulum.analysis import loss_identification as li
-from double_pendulum.analysis import measurement as ms
+from double_pendulum.analysis.losses import claims as loss_claims
+from double_pendulum.analysis.losses import identification as li
+from double_pendulum.analysis.track import measurement as ms
 from double_pendulum.fmu.simulate import simulate
 from double_pendulum.model.parameters import SEED_RIGID_LINKS
 
