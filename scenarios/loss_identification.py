@@ -32,7 +32,8 @@ from pathlib import Path
 from typing import Any
 
 from double_pendulum import plots
-from double_pendulum.analysis.losses.identification import identify_losses, parameters_of
+from double_pendulum.analysis.losses.identification import identify_losses
+from double_pendulum.analysis.losses.mechanisms import parameters_of
 from double_pendulum.analysis.losses.report import report_text
 from double_pendulum.results_io import table_from_columns, write_json, write_results_csv, write_text
 

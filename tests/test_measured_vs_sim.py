@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis.losses.identification import ComponentRunner
+from double_pendulum.analysis.losses.fitting import ComponentRunner
 from double_pendulum.analysis.prediction import comparison as tc
 from double_pendulum.analysis.prediction.report import cause_text, fmt_horizon, regime_text
 from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, load_track, reconstruct

@@ -41,7 +41,7 @@ from ...fmu.runner import FmuRunner
 from ...model.parameters import SEED_RIGID_LINKS, PendulumParameters
 from ..chaos import flips, lyapunov, lyapunov_study
 from ..chaos.ensemble import batch_energy, initial_states, pendulum_field
-from ..losses import identification as loss_identification
+from ..losses import comparison, fitting, identification, mechanisms
 from ..suspension.identification import START_FIT_FRAMES
 from ..sweep import runner_map
 from ..track.measurement import FRAME_INTERVAL, Reconstruction
@@ -223,7 +223,7 @@ class IdentifiedLosses:
     @property
     def values(self) -> dict[str, Any]:
         """Every FMU start value except the state: pendulum, losses and the friction regularisation."""
-        return {**self.pendulum, **self.losses, "omega_reg": loss_identification.OMEGA_REG}
+        return {**self.pendulum, **self.losses, "omega_reg": mechanisms.OMEGA_REG}
 
 
 def identified_losses(rec: Reconstruction, window_s: float | None = None, *, quick: bool = False) -> IdentifiedLosses:
@@ -232,16 +232,16 @@ def identified_losses(rec: Reconstruction, window_s: float | None = None, *, qui
     (:func:`~double_pendulum.analysis.losses.identification.identified_fit`: the same start, run budget and
     integration settings, so the cached fit of either scenario serves the other); ``window_s``: only the
     first seconds after the release (None: the whole record)."""
-    md = loss_identification.measured(rec, window_s)
-    problem = loss_identification.problem_from_track(rec, md, quick=quick)
-    fit = loss_identification.identified_fit(LOSS_MODEL, problem, quick=quick)
-    factor = loss_identification.common_factor([fit])
+    md = identification.measured(rec, window_s)
+    problem = fitting.problem_from_track(rec, md, quick=quick)
+    fit = fitting.identified_fit(LOSS_MODEL, problem, quick=quick)
+    factor = comparison.common_factor([fit])
     pendulum = {k: problem.base[k] for k in ("l1", "l2", "m1", "m2", *SEED_RIGID_LINKS)}
     return IdentifiedLosses(
         model=LOSS_MODEL,
         pendulum=pendulum,
-        losses=loss_identification.model_values(LOSS_MODEL, fit.theta),
-        parameters=loss_identification.parameter_table(fit, factor),
+        losses=mechanisms.model_values(LOSS_MODEL, fit.theta),
+        parameters=comparison.parameter_table(fit, factor),
         record_s=float(problem.t[-1] - problem.t[0]),
         n_runs=fit.n_runs,
     )
