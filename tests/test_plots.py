@@ -6,7 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from double_pendulum.plots import decay, style, trajectories
+from double_pendulum.plots import decay, style, suspension, trajectories
 
 
 @pytest.fixture
@@ -27,7 +27,7 @@ def _panel(m_s: float) -> dict:
 
 def test_decay_rate_map_orders_panels_by_mass_with_one_colour_bar_and_the_legend_outside(captured):
     panels = {f"M_s = {m:g} kg": _panel(m) for m in (2.0, 0.5, 8.0)}
-    decay.plot_decay_rate_map(panels, {"measured": -0.03}, "unused.png", points={"identified": (2e4, 40.0)},
+    suspension.plot_decay_rate_map(panels, {"measured": -0.03}, "unused.png", points={"identified": (2e4, 40.0)},
                               slope_through=(2e4, 40.0))
     fig = captured[0]
     data_axes = [ax for ax in fig.axes if ax.get_title().startswith("M_s")]
@@ -40,7 +40,7 @@ def test_decay_rate_map_orders_panels_by_mass_with_one_colour_bar_and_the_legend
 
 def test_smooth_log_field_keeps_the_grid_values_and_stays_within_their_range():
     p = _panel(2.0)
-    k, c, b = decay.smooth_log_field(p["k"], p["c"], p["b"], n=41)
+    k, c, b = suspension.smooth_log_field(p["k"], p["c"], p["b"], n=41)
     assert k[0] == pytest.approx(p["k"][0]) and c[-1] == pytest.approx(p["c"][-1]) and b.shape == (41, 41)
     assert b.min() >= p["b"].min() - 1e-12 and b.max() <= p["b"].max() + 1e-12
     assert b[0, 0] == pytest.approx(p["b"][0, 0]) and b[-1, -1] == pytest.approx(p["b"][-1, -1])

@@ -533,3 +533,34 @@ def error_curves(
         curves[f"{run_title(p.label)}: lower bob, smoothed"] = (p.t, smoothed(p.t, p.e2))
     curves["fit's uncertainty: spread of runs drawn from its covariance (median)"] = spread
     return curves
+
+
+def headline_entries(headlines: dict[str, dict[str, Any]]) -> dict[str, Any]:
+    """The summary's headline horizons: the lower bob's smoothed 5 cm horizon of the least-squares start with
+    geometry, with fixed geometry and with a pivot shift (``headlines`` by run label, from
+    :func:`headline_horizon`), whether each is censored, and what they mean."""
+    entries: dict[str, Any] = {}
+    for suffix, label in (("", "lsq_geometry_identified"), ("_fixed_geometry", "lsq_fixed_geometry_identified"),
+                          ("_pivot_shift", "lsq_pivot_shift_identified")):  # fmt: skip
+        entries[f"horizon_5cm_s{suffix}"] = headlines[label]["horizon_s"]
+        entries[f"horizon_5cm_censored{suffix}"] = headlines[label]["censored"]
+    entries["horizon_5cm_details"] = headlines
+    entries["horizon_statement"] = (
+        "lower bob, smoothed error, 5 cm; censored: never exceeded within the record, so the horizon is only known "
+        "to exceed horizon_5cm_s. In-sample: the losses are fitted to the same record. The motion is regular, so a "
+        "horizon measures how well frequencies and damping match, not predictability."
+    )
+    return entries
+
+
+def goal_entry(reached: float | None, prediction_s: float, goal_s: float) -> dict[str, Any]:
+    """The goal: the lower bob's smoothed error below 5 cm for at least ``goal_s`` [s] after t0 (least-squares
+    start and geometry); ``reached`` [s] is None where the error never exceeded 5 cm within ``prediction_s``."""
+    return {
+        "statement": f"the lower bob's smoothed error stays below 5 cm for at least {goal_s:g} s after t0, "
+                     "least-squares start and geometry",
+        "required_s": goal_s,
+        "reached_s": prediction_s if reached is None else reached,
+        "reached_is_lower_bound": reached is None,
+        "met": bool(reached is None or reached >= goal_s),
+    }
