@@ -16,7 +16,6 @@ in-process with the same component (:func:`double_pendulum.fmu.simulate.simulate
 from __future__ import annotations
 
 import math
-import multiprocessing.util
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -26,12 +25,10 @@ import numpy as np
 from ...fmu.runner import FmuRunner
 from ...fmu.simulate import simulate
 from ...model.inputs import INPUT_NAMES
-from ..sweep import parallel_map
+from ..sweep import parallel_map, process_runner
 
 RunnerLike = FmuRunner | str | None
 """Where a case runs: an FMU runner, the path of the FMU (one runner per process), or None (in-process)."""
-
-_RUNNERS: dict[str, FmuRunner] = {}
 
 
 def time_grid(stop_time: float, step: float) -> tuple[np.ndarray, float]:
@@ -65,12 +62,9 @@ def pivot_torque(amplitude: float, omega: float, t: np.ndarray) -> np.ndarray:
 
 
 def runner_for(path: str) -> FmuRunner:
-    """This process's runner for the FMU at ``path`` (extracted once, removed at process exit)."""
-    if path not in _RUNNERS:
-        runner = FmuRunner(path)
-        multiprocessing.util.Finalize(runner, runner.close, exitpriority=10)
-        _RUNNERS[path] = runner
-    return _RUNNERS[path]
+    """This process's runner for the FMU at ``path`` (extracted once:
+    :func:`~double_pendulum.analysis.sweep.process_runner`)."""
+    return process_runner(f"path:{path}", lambda: path)[0]
 
 
 def simulate_signal(
