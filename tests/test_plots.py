@@ -14,6 +14,7 @@ def captured(monkeypatch):
     """Keep figures open: ``save`` records the figure instead of closing it."""
     figures = []
     monkeypatch.setattr(decay, "save", lambda fig, path: figures.append(fig) or path)
+    monkeypatch.setattr(suspension, "save", lambda fig, path: figures.append(fig) or path)
     monkeypatch.setattr(trajectories, "save", lambda fig, path: figures.append(fig) or path)
     yield figures
     plt.close("all")
@@ -102,3 +103,30 @@ def test_draft_figures_are_smaller_and_drop_the_minor_ticks_of_log_axes(tmp_path
     h_draft, w_draft = matplotlib.image.imread(tmp_path / "draft.png").shape[:2]
     assert w_draft == pytest.approx(w_full * style.DRAFT_DPI / style.FIGURE_DPI, rel=0.15)
     assert h_draft == pytest.approx(h_full * style.DRAFT_DPI / style.FIGURE_DPI, rel=0.15)
+
+
+def test_figures_ask_for_no_font_the_machine_lacks(tmp_path, monkeypatch, caplog):
+    """Math text (log-axis tick labels) on a machine whose Matplotlib lacks the STIX fonts, even with a matplotlibrc
+    asking for them: no findfont warning."""
+    import logging
+
+    import matplotlib
+    import matplotlib.pyplot as plt
+    from matplotlib import font_manager
+
+    manager = font_manager.fontManager
+    monkeypatch.setattr(manager, "ttflist", [font for font in manager.ttflist if not font.name.startswith("STIX")])
+    font_manager.FontManager._findfont_cached.cache_clear()  # lookups made with the full list
+    try:
+        with matplotlib.rc_context({"mathtext.fontset": "stix", "mathtext.fallback": "stix"}):
+            style.use_installed_fonts()  # as importing the plots does
+            assert plt.rcParams["mathtext.fontset"] == "custom" and plt.rcParams["mathtext.fallback"] is None
+            fig, ax = plt.subplots()
+            ax.semilogy([1.0, 10.0, 100.0])  # tick labels 10^0 ... 10^2 are math text
+            ax.set_title(r"$\alpha$ [1/s]")
+            with caplog.at_level(logging.WARNING, logger="matplotlib.font_manager"):
+                style.save(fig, tmp_path / "math.png")
+    finally:
+        font_manager.FontManager._findfont_cached.cache_clear()
+    assert [r.getMessage() for r in caplog.records if "findfont" in r.getMessage()] == []
+    assert (tmp_path / "math.png").stat().st_size > 1000

@@ -9,6 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib import patheffects
 from matplotlib.colors import Normalize
+from matplotlib.ticker import FuncFormatter, LogLocator
 
 from .style import legend_below, legend_outside, running_mean, save
 
@@ -74,6 +75,9 @@ def _decay_panel(ax: plt.Axes, p: Mapping[str, np.ndarray], levels: Mapping[str,
     ax.set(xscale="log", yscale="log", xlabel="suspension stiffness k [N/m]")
     ax.set_xlim(kd[0], kd[-1])
     ax.set_ylim(cd[0], cd[-1])
+    for axis in (ax.xaxis, ax.yaxis):  # numbers at 1, 2 and 5 per decade: a map within one decade has some too
+        axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
+        axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
     return mesh
 
 
