@@ -106,3 +106,13 @@ def test_libcosim_is_skipped_with_a_reason_when_libcosimpy_is_missing(monkeypatc
     methods, missing = cosimulation.available_methods()
     assert "libcosim" not in methods and "container" in methods
     assert "libcosimpy" in missing["libcosim"]
+
+
+def test_the_report_says_in_words_which_run_it_is_and_what_a_negative_slope_means(quick_results):
+    from double_pendulum.analysis.coupling.report import _run_kind
+
+    folder, _ = quick_scenario(quick_results, "cosimulation")
+    report = (folder / "report.md").read_text()
+    assert "This is a quick run" in report and "Quick run:" not in report and "False" not in report
+    assert "A negative slope" in report
+    assert _run_kind({"quick": False}) == "This is the default run."

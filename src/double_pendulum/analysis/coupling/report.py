@@ -33,7 +33,9 @@ def _order_note(summary: dict[str, Any]) -> list[str]:
     angles = [summary["order_angles"][k] for k in iterative if summary["order_angles"][k] is not None]
     others = [summary[q][k] for q in ("order_pivot", "order_energy") for k in iterative
               if summary[q][k] is not None and math.isfinite(summary[q][k])]
-    text = f"(no order): {summary['orders_unresolved_means']}."
+    text = (f"(no order): {summary['orders_unresolved_means']}. A negative slope (the error growing as h shrinks"
+            " over the steps tried) is no order of convergence either; the coupling-energy column is fitted like the"
+            " others but not checked for linearity.")
     if angles and others:
         text += (f" The iterative scheme's second order is its angles' ({min(angles):.2f} to {max(angles):.2f}):"
                  f" its pivot and energy slopes range from {min(others):.2f} to {max(others):.2f} and are not the"
@@ -42,6 +44,14 @@ def _order_note(summary: dict[str, Any]) -> list[str]:
                  " the monolithic reference's own error, and an error taken at one instant passing through zero"
                  " between two macro steps.")
     return [text]
+
+
+def _run_kind(summary: dict[str, Any]) -> str:
+    """Which run this is, in words."""
+    if summary["quick"]:
+        return ("This is a quick run: a smoke test with a short stop time and few step sizes, whose numbers are not"
+                " the default run's.")
+    return "This is the default run."
 
 
 def _remedy_table(rows: list[dict[str, Any]]) -> list[str]:
@@ -68,7 +78,7 @@ def report_text(summary: dict[str, Any], rows: list[dict[str, Any]]) -> str:
         "# Co-simulation of the pendulum on its suspension",
         "",
         f"Stop time {summary['stop_time_s']} s; reference: the monolithic model (suspension on). "
-        "Errors at the stop time. Quick run: " + str(summary["quick"]) + ".",
+        f"Errors at the stop time. {_run_kind(summary)}",
         "",
         "## Fitted order of convergence (slope of log error over log h, h <= 5 ms)",
         "",
