@@ -1,14 +1,11 @@
-"""Cost of coupling, measured side by side and printed as ratios (issue 11, benchmarks).
+"""Cost of coupling, measured side by side and printed as ratios (benchmarks).
 
-Usage: ``python benchmarks/coupling_performance.py [--repeats 3] [--steps 2000]``
+Usage: ``python benchmarks/coupling_performance.py [--repeats 3]``
 
-1. doStep of DoublePendulum.fmu with all eight inputs set before every step (a consistent
-   vertical shaker motion plus small torques, one fmi2SetReal call a step, 1 ms steps, through
-   fmpy's FMU2Slave) versus an empty pythonfmu FMU with the same eight inputs, driven the same
-   way. Target <= 2.
-2. The split system (PendulumOnSuspension.ssp: DoublePendulum + Suspension) on libcosim at a
-   1 ms macro step versus the monolithic FMU (``suspension`` on) on libcosim at the same step,
-   both for 1 s (report only).
+The split system (PendulumOnSuspension.ssp: DoublePendulum + Suspension) on libcosim at a 1 ms
+macro step versus the monolithic FMU (``suspension`` on) on libcosim at the same step, both for
+1 s (report only). The cost of one driven doStep against an empty FMU, with start-up excluded, is
+``benchmarks/stepping_cost.py``; ``shaker`` and ``build_empty_fmu`` here serve it.
 
 CPU times (``time.process_time``, median of the repeats). Compare the ratios, not the seconds:
 the machine is shared and noisy.
@@ -25,7 +22,6 @@ from collections.abc import Callable
 from pathlib import Path
 
 from double_pendulum.fmu.build import build_fmu
-from double_pendulum.fmu.coupling import FmuSlave
 from double_pendulum.fmu.hosts import simulate_ssp_with_libcosim, simulate_with_libcosim
 from double_pendulum.fmu.ssp import write_ssp
 from double_pendulum.model.inputs import INPUT_NAMES
@@ -79,35 +75,12 @@ def shaker(t: float) -> list[float]:
     return [values[n] for n in INPUT_NAMES]
 
 
-def drive(fmu_path: Path, steps: int, h: float = 1e-3) -> None:
-    """Instantiate, then set all inputs and doStep ``steps`` times."""
-    from fmpy import extract, read_model_description
-
-    md = read_model_description(str(fmu_path))
-    slave = FmuSlave(extract(str(fmu_path)), md)
-    refs = [slave.refs[n].valueReference for n in INPUT_NAMES]
-    try:
-        for n in range(steps):
-            slave.fmu.setReal(refs, shaker(n * h))
-            slave.do_step(n * h, h)
-    finally:
-        slave.close()
-
-
-def bench_do_step(pendulum: Path, empty: Path, steps: int, repeats: int) -> float:
-    t_fmu = median_cpu(lambda: drive(pendulum, steps), repeats)
-    t_empty = median_cpu(lambda: drive(empty, steps), repeats)
-    print(f"1. doStep with 8 inputs set every step ({steps} steps of 1 ms): FMU {t_fmu / steps * 1e6:.0f} us/step, "
-          f"empty pythonfmu FMU {t_empty / steps * 1e6:.0f} us/step -> ratio {t_fmu / t_empty:.2f} (target <= 2)")
-    return t_fmu / t_empty
-
-
 def bench_split_on_libcosim(pendulum: Path, suspension: Path, folder: Path, repeats: int) -> float:
     ssp = write_ssp(folder / "PendulumOnSuspension.ssp", pendulum, suspension, {}, macro_step=1e-3)
     t_split = median_cpu(lambda: simulate_ssp_with_libcosim(ssp, stop_time=1.0, macro_step=1e-3), repeats)
     t_mono = median_cpu(lambda: simulate_with_libcosim(pendulum, {"suspension": True}, ["phi1"], stop_time=1.0,
                                                        step_size=1e-3), repeats)
-    print(f"2. 1 s on libcosim at a 1 ms macro step: split system {t_split:.2f} s, monolithic FMU {t_mono:.2f} s "
+    print(f"1 s on libcosim at a 1 ms macro step: split system {t_split:.2f} s, monolithic FMU {t_mono:.2f} s "
           f"-> ratio {t_split / t_mono:.2f}")
     return t_split / t_mono
 
@@ -115,14 +88,11 @@ def bench_split_on_libcosim(pendulum: Path, suspension: Path, folder: Path, repe
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
-    parser.add_argument("--steps", type=int, default=2000)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory(prefix="dp_bench_coupling_") as tmp:
         folder = Path(tmp)
         pendulum = build_fmu(folder / "DoublePendulum.fmu")
         suspension = build_fmu(folder / "Suspension.fmu", "Suspension")
-        empty = build_empty_fmu(folder)
-        bench_do_step(pendulum, empty, args.steps, args.repeats)
         bench_split_on_libcosim(pendulum, suspension, folder, args.repeats)
 
 

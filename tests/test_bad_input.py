@@ -107,6 +107,22 @@ def test_setting_a_parameter_after_initialisation_is_an_error(runner):
     assert runner.simulate({"l1": 0.5}, stop_time=0.1)["time"][-1] == pytest.approx(0.1)
 
 
+def test_many_failed_calls_on_one_instance_leave_it_and_the_host_running(runner, monkeypatch):
+    """pythonfmu releases the slave's references once more for every exception that reaches it; the slave
+    balances them. Before, the fourth refused value on one instance crashed the host (segfault)."""
+    from fmpy.fmi1 import FMICallException
+
+    monkeypatch.setenv("DOUBLE_PENDULUM_FMU_STDERR", "0")
+    fmu, vrs = _slave(runner, "many")
+    for k in range(100):
+        with pytest.raises(FMICallException):
+            fmu.setReal([vrs["pivot_ay"] if k % 2 else 10**6], [math.nan])  # a bad value, an unknown reference
+    fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
+    assert fmu.getReal([vrs["phi1"]])[0] == pytest.approx(1.0, abs=1e-2)  # it swings on from phi1_0 = 1 rad
+    fmu.terminate()
+    fmu.freeInstance()
+
+
 def test_with_logging_off_the_message_still_reaches_the_user(fmu_path, tmp_path):
     """pythonfmu forwards messages only with logging on; the FMU also prints them to stderr."""
     script = textwrap.dedent(f"""

@@ -260,11 +260,14 @@ def test_without_a_c_compiler_the_build_says_so_once_and_keeps_pythonfmus_binary
     from pythonfmu.builder import HERE as PYTHONFMU_FOLDER
 
     from double_pendulum.fmu import build
+    from double_pendulum.fmu.build_fmi3 import build_fmu3
 
     monkeypatch.setenv("CC", "/nonexistent/cc")
     build._loader_binary.cache_clear()
+    build._note.cache_clear()
     try:
         fmus = [build.build_fmu(tmp_path / f"{name}.fmu", name) for name in ("DoublePendulum", "Suspension")]
+        fmi3 = build_fmu3(tmp_path / "fmi3" / "DoublePendulum.fmu")
     finally:
         build._loader_binary.cache_clear()
     said = capfd.readouterr().err.strip().splitlines()
@@ -275,3 +278,9 @@ def test_without_a_c_compiler_the_build_says_so_once_and_keeps_pythonfmus_binary
             binaries = [n for n in z.namelist() if n.startswith("binaries/linux64/")]
             assert binaries == [f"binaries/linux64/{fmu.stem}.so"] and z.read(binaries[0]) == plain
             assert "resources/python.cfg" not in z.namelist()
+    from pythonfmu3.builder import HERE as PYTHONFMU3_FOLDER
+
+    plain3 = (PYTHONFMU3_FOLDER / "resources" / "binaries" / "x86_64-linux" / "libpythonfmu-export.so").read_bytes()
+    with zipfile.ZipFile(fmi3) as z:  # the FMI 3 FMU alike, with pythonfmu3's binary
+        binaries = [n for n in z.namelist() if n.startswith("binaries/x86_64-linux/")]
+        assert binaries == ["binaries/x86_64-linux/DoublePendulum.so"] and z.read(binaries[0]) == plain3

@@ -183,3 +183,72 @@ def test_deferred_f_new_of_a_landed_step_is_evaluated_for_dense_output():
     mid = 0.5 * (it.t_prev + it.t)
     assert it.state_at(mid) == ref.state_at(mid)
     assert it.fy == F(it.t, it.y)
+
+
+@pytest.mark.parametrize(
+    ("a_rows", "c", "stages", "b"),
+    [(tb.DOPRI5_A, tb.DOPRI5_C, 6, tb.DOPRI5_B), (tb.DOP853_A, tb.DOP853_C, 12, tb.DOP853_B),
+     (tb.RK4_A, tb.RK4_C, 4, tb.RK4_B)],  # fmt: skip
+)
+def test_fused_stages_are_bit_identical_to_the_stage_by_stage_loop(a_rows, c, stages, b):
+    from double_pendulum.solvers.combinations import explicit_stages, sparse, step_combination
+
+    y, h, t = [2.0, -1.0, 0.7, 3.1, 0.25], 3e-3, 0.4
+    f = fixed_pivot_vector_field(P)
+
+    def field(t, y):  # a fifth state, as the driven pendulum's W_input
+        return [*f(t, y[:4]), y[2] * y[3]]
+
+    ks = [field(t, y)]
+    for i in range(1, stages):
+        ks.append(field(t + c[i] * h, step_combination(tuple(a_rows[i]), 5)(y, h, ks)))
+    loop = step_combination(sparse(b), 5)(y, h, ks)
+    fused, fused_ks = explicit_stages(a_rows, tuple(c), stages, sparse(b), 5)(field, t, y, ks[0], h)
+    assert fused == loop and fused_ks == ks
+
+
+@pytest.mark.parametrize("weights", [tb.DOPRI5_E, tb.DOP853_E5])
+def test_compiled_error_norm_equals_the_loop(weights):
+    from double_pendulum.solvers.combinations import scaled_error_norm, sparse, weighted_sum
+    from double_pendulum.solvers.runge_kutta import scaled_rms
+
+    rng = np.random.default_rng(3)
+    ks = [list(rng.normal(size=5)) for _ in weights]
+    y, y_new = list(rng.normal(size=5)), list(rng.normal(size=5))
+    h, rtol, atol = 2e-3, 1e-9, 1e-12
+    expected = scaled_rms([h * e for e in weighted_sum(sparse(weights), 5)(ks)], y, y_new, rtol, atol)
+    assert scaled_error_norm(sparse(weights), 5)(y, y_new, ks, h, rtol, atol) == expected
+
+
+def _restarted_landings(rtol: float, steps: int = 200, h_comm: float = 1e-3) -> Integrator:
+    """DOP853 on the regular case, restarted at every communication point and landing on the next."""
+    it = make_integrator("dop853", F, 0.0, Y0, rtol=rtol, atol=rtol * 1e-3, fixed_step=1.0)
+    it.advance_to(0.05)  # the controller's step grows well beyond 1 ms
+    t = 0.05
+    for _ in range(steps):
+        it.restart(t, it.state_at(t))
+        it.advance_to(t + h_comm, land=True)
+        t += h_comm
+    return it
+
+
+def test_a_short_landing_step_is_one_dopri5_step_within_the_tolerance_per_unit_step():
+    it = _restarted_landings(1e-9)
+    n0 = it.n_steps
+    assert it.landing_method.name == "dopri5" and it.last_method is it.landing_method
+    ref = make_integrator("dop853", F, 0.0, Y0, rtol=1e-13, atol=1e-15, fixed_step=1.0).advance_to(it.t)
+    assert max(abs(a - b) for a, b in zip(it.y, ref)) < 1e-9
+    before = it.nfev
+    it.restart(it.t, list(it.y))
+    it.advance_to(it.t + 1e-3, land=True)
+    assert it.nfev - before == 1 + 6  # f(t, y) at the restart, then Dopri5's six further stages
+    assert it.n_steps > n0 and it.h > 1e-3  # the controller's own step size is kept
+
+
+def test_a_landing_step_whose_error_per_unit_step_is_too_large_falls_back_to_dop853():
+    it = _restarted_landings(1e-14, steps=40)
+    assert it.n_rejected > 0 and it.landing_rest > 0  # Dopri5 failed err <= H / h, now rests
+    before = it.nfev
+    it.restart(it.t, list(it.y))
+    it.advance_to(it.t + 1e-3, land=True)
+    assert it.nfev - before >= 1 + 11 and it.last_method is it.method  # DOP853 took the step

@@ -72,19 +72,20 @@ static int own_folder(char *folder, size_t size) {
     return 1;
 }
 
-/* A file URI (file:///p, file://host/p, file:/p) or a plain path to a path, %XX decoded. */
+/* A file URI (file:///p, file://host/p, file:/p; FMI 2), %XX decoded, or a plain path (FMI 3), to a path. */
 static void uri_to_path(const char *uri, char *path, size_t size) {
     const char *p = uri;
+    int is_uri = strncmp(p, "file:", 5) == 0;
     if (strncmp(p, "file://", 7) == 0) {
         p += 7;
         if (*p != '/') p = strchr(p, '/') ? strchr(p, '/') : "";
-    } else if (strncmp(p, "file:", 5) == 0) {
+    } else if (is_uri) {
         p += 5;
     }
     size_t n = 0;
     for (; *p && n + 1 < size; p++) {
         unsigned int code;
-        if (p[0] == '%' && p[1] && p[2] && sscanf(p + 1, "%2x", &code) == 1) {
+        if (is_uri && p[0] == '%' && p[1] && p[2] && sscanf(p + 1, "%2x", &code) == 1) {
             path[n++] = (char)code;
             p += 2;
         } else {

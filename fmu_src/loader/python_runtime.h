@@ -1,9 +1,10 @@
-/* Find, load and start the CPython that runs a pythonfmu FMU, in any host process.
+/* Find, load and start the CPython that runs a pythonfmu FMU (FMI 2) or pythonfmu3 FMU (FMI 3), in
+ * any host process.
  *
- * pythonfmu's shared library calls the CPython C API but does not link libpython (on Linux it expects
- * the host to be a Python process).  The FMU's binary is this loader instead: before it loads
- * pythonfmu's library it makes sure the process has a CPython with global symbols, as described in
- * docs/fmu.md ("Use the FMU in other FMI tools"):
+ * pythonfmu's shared library (pythonfmu3's alike) calls the CPython C API but does not link
+ * libpython (on Linux it expects the host to be a Python process).  The FMU's binary is this loader
+ * instead: before it loads that library it makes sure the process has a CPython with global
+ * symbols, as described in docs/fmu.md ("Use the FMU in other FMI tools"):
  *
  *  1. a CPython already in the process (every Python host) is used as it is: nothing is loaded,
  *     nothing is changed;
@@ -23,11 +24,12 @@
 #define PYTHON_OVERRIDE_VARIABLE "DOUBLE_PENDULUM_FMU_PYTHON"
 #define PYTHON_MIN_MINOR 11 /* CPython 3.11 or newer */
 
-/* Load pythonfmu's library `backend_file` (a file name in the folder of this loader) after making
- * a CPython available (see above).  `resources_uri` is the FMU's resource location as passed to
- * fmi2Instantiate (file URI, may be NULL).  Returns the library's handle; the first call does the
- * work, later calls return the same handle.  On failure returns NULL and writes one line to
- * `error` saying what was looked for, where, and how to point the FMU at a Python. */
+/* Load the FMI library `backend_file` (pythonfmu's or pythonfmu3's; a file name in the folder of
+ * this loader) after making a CPython available (see above).  `resources_uri` is the FMU's resource
+ * location as passed to fmi2Instantiate (a file URI) or fmi3Instantiate* (a path), may be NULL.
+ * Returns the library's handle; the first call does the work, later calls return the same handle.
+ * On failure returns NULL and writes one line to `error` saying what was looked for, where, and
+ * how to point the FMU at a Python. */
 void *python_runtime_load_backend(const char *resources_uri, const char *backend_file, char *error,
                                   size_t error_size);
 

@@ -112,10 +112,11 @@ def default_fmu_path(out: Path) -> Path:
 
 
 def fmu_set(fmu: Path) -> list[Path]:
-    """The files ``build`` writes with the DoublePendulum FMU ``fmu``: the other FMUs next to it and the
-    coupled system (SSP and container FMU)."""
+    """The files ``build`` writes with the DoublePendulum FMU ``fmu``: the other FMUs next to it, the coupled
+    system (SSP and container FMU) and the FMI 3.0 FMU in ``fmi3/``."""
     others = [fmu.parent / f"{name}.fmu" for name in INTERFACES if f"{name}.fmu" != fmu.name]
-    return [fmu, *others, fmu.parent / "PendulumOnSuspension.ssp", fmu.parent / "PendulumOnSuspension.fmu"]
+    systems = [fmu.parent / "PendulumOnSuspension.ssp", fmu.parent / "PendulumOnSuspension.fmu"]
+    return [fmu, *others, *systems, fmu.parent / "fmi3" / fmu.name]
 
 
 def fmu_set_is_current(fmu: Path) -> bool:
@@ -129,7 +130,7 @@ def fmu_set_is_current(fmu: Path) -> bool:
         return True
     built = fmu.stat().st_mtime
     others = fmu_set(fmu)[1:]
-    interfaces = [path for path in others if path.stem in INTERFACES]
+    interfaces = [path for path in others if path.stem in INTERFACES and path.parent == fmu.parent]
     return all(fmu_is_current(path, path.stem) for path in interfaces) and all(
         path.is_file() and path.stat().st_mtime >= built for path in others if path not in interfaces)
 
@@ -348,16 +349,18 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser: plain-text help, the scenarios listed under ``run --help``."""
     parser = argparse.ArgumentParser(
         prog=PROG,
-        description="A planar double pendulum as an FMI 2.0 co-simulation FMU: build it, run the "
-        "scenarios through fmpy, print its variables.",
+        description="A planar double pendulum as an FMI 2.0 co-simulation FMU (and an FMI 3.0 Model Exchange "
+        "and Co-Simulation FMU): build them, run the scenarios through fmpy, print the variables.",
     )
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    p_build = sub.add_parser("build", help="build DoublePendulum.fmu, Suspension.fmu and the coupled system",
+    p_build = sub.add_parser("build", help="build DoublePendulum.fmu, Suspension.fmu, the coupled system and "
+                             "fmi3/DoublePendulum.fmu",
                              description="Build DoublePendulum.fmu and, next to it, Suspension.fmu, "
-                             "PendulumOnSuspension.ssp (SSP, for libcosim) and PendulumOnSuspension.fmu "
-                             "(fmpy's container FMU).")
+                             "PendulumOnSuspension.ssp (SSP, for libcosim), PendulumOnSuspension.fmu "
+                             "(fmpy's container FMU) and fmi3/DoublePendulum.fmu (FMI 3.0, Model Exchange and "
+                             "Co-Simulation).")
     p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="DoublePendulum FMU path or folder")
     p_build.set_defaults(func=cmd_build)
 

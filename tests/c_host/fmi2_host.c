@@ -22,34 +22,7 @@
 #include <time.h>
 
 #include "fmi2Functions.h"
-
-#define MAX_ARGS 128
-
-extern char **environ;
-static const int SIGNALS[] = {SIGINT, SIGTERM, SIGPIPE, SIGCHLD, SIGXFSZ, SIGSEGV};
-#define N_SIGNALS (sizeof SIGNALS / sizeof SIGNALS[0])
-
-/* The environment and the handlers of SIGNALS, as one comparable record. */
-typedef struct {
-    char environment[65536];
-    struct sigaction actions[N_SIGNALS];
-} host_state;
-
-static void snapshot(host_state *state) {
-    memset(state, 0, sizeof *state);
-    for (char **e = environ; *e; e++) {
-        strncat(state->environment, *e, sizeof state->environment - strlen(state->environment) - 2);
-        strcat(state->environment, "\n");
-    }
-    for (size_t k = 0; k < N_SIGNALS; k++) sigaction(SIGNALS[k], NULL, &state->actions[k]);
-}
-
-static int unchanged(const host_state *before, const host_state *after) {
-    if (strcmp(before->environment, after->environment) != 0) return 0;
-    for (size_t k = 0; k < N_SIGNALS; k++)
-        if (before->actions[k].sa_handler != after->actions[k].sa_handler) return 0;
-    return 1;
-}
+#include "host_common.h"
 
 static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status, fmi2String category,
                    fmi2String message, ...) {
@@ -63,24 +36,6 @@ static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status
     va_end(args);
     fflush(stdout);
 }
-
-static void *symbol(void *library, const char *name) {
-    void *f = dlsym(library, name);
-    if (!f) {
-        fprintf(stderr, "missing %s\n", name);
-        exit(3);
-    }
-    return f;
-}
-
-#define CHECK(call)                                                                                               \
-    do {                                                                                                          \
-        fmi2Status status_ = (call);                                                                             \
-        if (status_ > fmi2Warning) {                                                                              \
-            fprintf(stderr, "%s failed with status %d\n", #call, (int)status_);                                   \
-            return 5;                                                                                             \
-        }                                                                                                         \
-    } while (0)
 
 int main(int argc, char **argv) {
     if (argc < 6) {
@@ -127,27 +82,18 @@ int main(int argc, char **argv) {
     fmi2Real input_values[MAX_ARGS];
     size_t n_inputs = 0, n_outputs = 0;
     for (int k = 6; k < argc && n_inputs < MAX_ARGS && n_outputs < MAX_ARGS; k++) {
-        char kind = argv[k][0];
-        const char *value = strchr(argv[k], '=');
-        fmi2ValueReference vr = (fmi2ValueReference)strtoul(argv[k] + 2, NULL, 10);
-        if (kind == 'o') {
-            outputs[n_outputs++] = vr;
-        } else if (!value || argv[k][1] != ':') {
+        host_argument a;
+        if (!parse_argument(argv[k], &a) || a.kind == 'j') {
             fprintf(stderr, "bad argument %s\n", argv[k]);
             return 2;
-        } else if (kind == 'r') {
-            fmi2Real real = atof(value + 1);
-            CHECK(set_real(c, &vr, 1, &real));
-        } else if (kind == 'b') {
-            fmi2Boolean boolean = atoi(value + 1) ? fmi2True : fmi2False;
-            CHECK(set_boolean(c, &vr, 1, &boolean));
-        } else if (kind == 's') {
-            fmi2String string = value + 1;
-            CHECK(set_string(c, &vr, 1, &string));
-        } else if (kind == 'i') {
-            inputs[n_inputs] = vr;
-            input_values[n_inputs++] = atof(value + 1);
         }
+        fmi2ValueReference vr = a.vr;
+        fmi2Boolean boolean = atoi(a.text) ? fmi2True : fmi2False;
+        if (a.kind == 'o') outputs[n_outputs++] = vr;
+        else if (a.kind == 'r') CHECK(set_real(c, &vr, 1, &a.real));
+        else if (a.kind == 'b') CHECK(set_boolean(c, &vr, 1, &boolean));
+        else if (a.kind == 's') CHECK(set_string(c, &vr, 1, &a.text));
+        else inputs[n_inputs] = vr, input_values[n_inputs++] = a.real;
     }
 
     CHECK(setup(c, fmi2False, 0.0, 0.0, fmi2True, steps * step_size));

@@ -29,12 +29,13 @@ jump, so ``energy_residual`` keeps measuring only the integration error.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import fields
 from typing import Any
 
+from ..model.energy import pivot_motion_energy, relative_momentum
 from ..model.inputs import INPUT_NAMES, INPUT_UNITS, ZERO_INPUTS, InputHold, InputValues
-from ..model.links import link_coefficients
+from ..model.links import LinkCoefficients, link_coefficients
 from ..model.outputs import GROUP_OF, OUTPUT_GROUPS, OUTPUT_NAMES
 from ..model.parameters import (
     AirDragParameters,
@@ -47,7 +48,8 @@ from ..model.parameters import (
 )
 from ..model.vector_field import Model, ModelConfig, ModelError, build_model, build_vector_field, energies
 from ..solvers import Integrator, SolverError, make_integrator
-from .settings import SolverSettings
+from .pivot_motion import PositionOnlyWatch, PositionSamples
+from .settings import InputSettings, SolverSettings
 
 PARAMETER_GROUPS: tuple[type, ...] = (
     PendulumParameters,
@@ -56,7 +58,10 @@ PARAMETER_GROUPS: tuple[type, ...] = (
     BearingParameters,
     SuspensionParameters,
     SolverSettings,
+    InputSettings,
 )
+STRING_PARAMETER_GROUPS: dict[str, type] = {"solver": SolverSettings, "pivot_input": InputSettings}
+"""String parameters, by name, and the group whose checks a value must pass (names, not just strings)."""
 ENERGY_BLOWUP_FACTOR = 1e3
 
 
@@ -94,8 +99,8 @@ def checked_parameter(rules: Mapping[str, tuple[str, str]], name: str, value: An
     if rule != "str" and rule != "bool" and isinstance(value, int) and not isinstance(value, bool):
         value = float(value)
     check_value(name, value, unit, rule)
-    if name == "solver":
-        SolverSettings(solver=value)  # checks the name
+    if name in STRING_PARAMETER_GROUPS:
+        STRING_PARAMETER_GROUPS[name](**{name: value})  # checks the name
     return value
 
 
@@ -145,6 +150,10 @@ class LazyOutputs(Mapping[str, float]):
         return len(OUTPUT_NAMES)
 
 
+INPUT_INDEX: dict[str, int] = {name: k for k, name in enumerate(INPUT_NAMES)}
+STATE_OUTPUT_INDEX: dict[str, int] = {"phi1": 0, "phi2": 1, "omega1": 2, "omega2": 3}
+
+
 class DoublePendulumCoSimulation:
     """One instance of the double pendulum as a co-simulation slave."""
 
@@ -156,12 +165,17 @@ class DoublePendulumCoSimulation:
         self.initialised = False
         self.integrator: Integrator | None = None
         self.model: Model = build_model(ModelConfig())
-        self._outputs: Mapping[str, float] = {}
-        self._outputs_stale = False
+        self._coefficients: LinkCoefficients = link_coefficients(self.model.config.pendulum)
+        self._outputs: Mapping[str, float] | None = None  # None: computed when read
+        self._inputs_set = False  # inputs set since the last communication point
         self.initial_energy: float | None = None
-        self.inputs: dict[str, float] = dict.fromkeys(INPUT_NAMES, 0.0)
+        self._u: list[float] = [0.0] * len(INPUT_NAMES)  # the inputs as set, in INPUT_NAMES order
         self.driven = False  # the model with inputs is running (from the first non-zero input on)
-        self._hold: InputHold | None = None  # the hold the integrator is integrating
+        self._hold: InputHold | None = None  # the hold the integrator is integrating (reset in place)
+        self._fixed_step = False  # the solver is a fixed-step one (its blow-up is checked per step)
+        self._pivot_samples: PositionSamples | None = None  # pivot_input = position: the last positions
+        self._position_watch: PositionOnlyWatch | None = None  # pivot_input = acceleration: position-only wiring
+        self.notices: list[str] = []  # warnings for the host's log, taken by the FMU adapter
         self._y: list[float] = self.model.initial_state(*InitialState().as_list())  # state at self.time
         self._update_outputs(self._y)
 
@@ -172,13 +186,22 @@ class DoublePendulumCoSimulation:
 
     def get(self, name: str) -> Any:
         """Return a parameter, input or output value by name."""
+        index = STATE_OUTPUT_INDEX.get(name)
+        if index is not None:
+            return self._y[index]
         if name in self.values:
             return self.values[name]
-        if name in self.inputs:
-            return self.inputs[name]
+        index = INPUT_INDEX.get(name)
+        if index is not None:
+            return self._u[index]
         return self.outputs[name]
 
     # ------------------------------------------------------------------ inputs
+    @property
+    def inputs(self) -> dict[str, float]:
+        """The inputs as set now, by name (a copy)."""
+        return dict(zip(INPUT_NAMES, self._u))
+
     def set_input(self, name: str, value: float) -> None:
         """Set input ``name`` [its unit] for the next ``do_step``; any time, any number of times.
 
@@ -186,45 +209,88 @@ class DoublePendulumCoSimulation:
         (the input keeps its previous value). Outputs read afterwards see the new inputs (the
         pivot force depends on them directly).
         """
-        if name not in self.inputs:
+        index = INPUT_INDEX.get(name)
+        if index is None:
             raise ParameterError(f"unknown input {name!r}")
+        self.set_input_at(index, value)
+
+    def set_input_at(self, index: int, value: float) -> None:
+        """:meth:`set_input` by position in :data:`~double_pendulum.model.inputs.INPUT_NAMES`."""
+        self.set_inputs_at((index,), (value,))
+
+    def set_inputs_at(self, indices: Sequence[int], values: Sequence[float]) -> None:
+        """Set several inputs by position (the hot path of a co-simulation master's fmi2SetReal).
+
+        A finite float costs one check and a store; the right-hand side learns of the new values
+        at the next ``do_step``. A bad value raises :class:`ParameterError` naming the input; the
+        values before it are set, it and those after it are not.
+        """
+        u = self._u
+        changed = False
+        for index, value in zip(indices, values):
+            if type(value) is not float or value - value != 0.0:  # not a float, or inf or nan
+                value = self._checked_input(index, value)
+            if value != u[index]:
+                u[index] = value
+                changed = True
+        if changed:
+            self._outputs = None  # recomputed when read: a host sets several inputs per step
+            self._inputs_set = True
+            if self.initialised and not self.driven:
+                self._start_driving()
+
+    def _checked_input(self, index: int, value: Any) -> float:
+        """``value`` as a float, or :class:`ParameterError` naming the input and value."""
+        name = INPUT_NAMES[index]
         if isinstance(value, int) and not isinstance(value, bool):
             value = float(value)
         check_value(f"input {name}", value, INPUT_UNITS[name], "finite")
-        if value == self.inputs[name]:
-            return
-        self.inputs[name] = value
-        if self.initialised:
-            if not self.driven:
-                self._start_driving()
-            self._outputs_stale = True  # recomputed when read: a host sets several inputs per step
+        return value
 
     @property
     def outputs(self) -> Mapping[str, float]:
         """The outputs at the current communication point, with the inputs as now set."""
-        if self._outputs_stale:
-            self._outputs_stale = False
-            new = self._input_values()
-            y = self._with_jump_work(self._y, self._hold.at(self.time), new)  # as it will be booked
-            self._outputs = self._outputs_at(y, new)
+        if self._outputs is None:
+            if self.driven and self._inputs_set:
+                new = self._input_values()
+                y = self.with_jump_work(self._y, self._hold.held(self.time), new)  # as it will be booked
+                self._outputs = self._outputs_at(y, new)
+            else:
+                self._outputs = self._outputs_at(self._y, self._hold.at(self.time) if self.driven else None)
         return self._outputs
 
     @outputs.setter
     def outputs(self, values: Mapping[str, float]) -> None:
         self._outputs = values
-        self._outputs_stale = False
+
+    def state_values(self) -> dict[str, float]:
+        """The model's state at the current communication point, by state name (``model.layout``)."""
+        return dict(zip(self.model.layout.names, self._y))
 
     def _input_values(self) -> InputValues:
-        return InputValues(**self.inputs)
+        return InputValues(*self._u)
 
-    def _with_jump_work(self, y: list[float], old: InputValues, new: InputValues) -> list[float]:
+    def with_jump_work(self, y: list[float], old: Sequence[float], new: Sequence[float]) -> list[float]:
         """Return ``y`` with the energy jump [J] of switching the inputs ``old -> new`` added to ``W_input``.
 
-        Only the pivot (base) position and velocity change the energy at once; a consistent hold
-        makes the jump vanish with the communication step.
+        ``old`` and ``new`` are the eight input values in :data:`INPUT_NAMES` order. Only the pivot
+        (base) position and velocity change the energy at once; a consistent hold makes the jump
+        vanish with the communication step. Without a suspension only the pivot's velocity counts
+        (:func:`~double_pendulum.model.energy.pivot_motion_energy`: the potential energy is relative
+        to the pivot).
         """
         config, layout = self.model.config, self.model.layout
-        jump = sum(energies(config, y, layout, new)) - sum(energies(config, y, layout, old))
+        if config.suspension.suspension:
+            jump = sum(energies(config, y, layout, InputValues(*new))) - sum(
+                energies(config, y, layout, InputValues(*old))
+            )
+        elif old[2] == new[2] and old[3] == new[3]:
+            return y
+        else:
+            c = self._coefficients
+            px, py = relative_momentum(y[0], y[1], y[2], y[3], c)
+            before = pivot_motion_energy(px, py, old[2], old[3], c.mass)
+            jump = pivot_motion_energy(px, py, new[2], new[3], c.mass) - before
         if jump == 0.0:
             return y
         booked = list(y)
@@ -234,17 +300,18 @@ class DoublePendulumCoSimulation:
     def _start_driving(self) -> None:
         """Switch to the model with inputs at the current point: add ``W_input = 0``, restart."""
         self.driven = True
-        self.model = build_model(self._config())
+        self.model = build_model(self.model_config())
         self._y = self._y + [0.0]  # W_input is the last state
+        self._hold = InputHold(self.time, ZERO_INPUTS)
+        self.integrator.f = build_vector_field(self.model.config, self.model.evaluate, self._hold)
         self._restart(self.time)
 
     def _restart(self, t: float) -> None:
-        """Restart the integrator at ``t`` from the current state with the inputs set now."""
-        new = self._input_values()
-        self._y = self._with_jump_work(self._y, self._hold.at(t) if self._hold else ZERO_INPUTS, new)
-        self._hold = InputHold(t, new)
-        f = build_vector_field(self.model.config, self.model.evaluate, self._hold)
-        self.integrator.restart(t, self._y, f)
+        """Restart the integrator at ``t`` with the inputs set now: the hold and the right-hand side
+        (which reads the hold) change in place; the step size carries over."""
+        self._y = self.with_jump_work(self._y, self._hold.held(t), self._u)
+        self._hold.reset(t, self._u)
+        self.integrator.restart(t, self._y)
 
     def _group(self, cls: type) -> Any:
         return cls(**{f.name: self.values[f.name] for f in fields(cls)})
@@ -256,23 +323,25 @@ class DoublePendulumCoSimulation:
             raise CoSimulationError(f"invalid start time {start_time!r} s: must be finite")
         self.time = float(start_time)
 
-    def _config(self) -> ModelConfig:
+    def model_config(self, inputs: bool | None = None) -> ModelConfig:
+        """The scene of the parameters set so far, with inputs if ``inputs`` (default: if driven)."""
         return ModelConfig(
             pendulum=self._group(PendulumParameters),
             air=self._group(AirDragParameters),
             bearing=self._group(BearingParameters),
             suspension=self._group(SuspensionParameters),
-            inputs=self.driven,
+            inputs=self.driven if inputs is None else inputs,
         )
 
     def initialise(self) -> None:
         """Validate all parameters together and start the integrator at the start time."""
-        self.driven = self.driven or any(self.inputs.values())
+        self.driven = self.driven or any(self._u)
         initial = self._group(InitialState)
         settings = self._group(SolverSettings)
-        self.model = build_model(self._config())
+        self.model = build_model(self.model_config())
+        self._coefficients = link_coefficients(self.model.config.pendulum)
         y0 = self.model.initial_state(*initial.as_list())
-        self._hold = InputHold(self.time, self._input_values()) if self.driven else None
+        self._hold = InputHold(self.time, self._u) if self.driven else None
         self.integrator = make_integrator(
             settings.solver,
             build_vector_field(self.model.config, self.model.evaluate, self._hold),
@@ -283,39 +352,70 @@ class DoublePendulumCoSimulation:
             fixed_step=settings.fixed_step,
             max_steps_per_call=max(1, int(settings.max_steps)),
         )
+        self._fixed_step = not self.integrator.method.adaptive
+        self._start_pivot_input()
         self.initial_energy = None
         self._y = y0
+        self._inputs_set = False
         self._update_outputs(y0)
         self.initial_energy = self.outputs["E_total"]
         self.initialised = True
+
+    def _start_pivot_input(self, samples: list | None = None, watch: dict | None = None) -> None:
+        """Set up the reading of the pivot inputs (:mod:`~double_pendulum.component.pivot_motion`)."""
+        layout = self.model.layout
+        if self._group(InputSettings).pivot_input == "position":
+            self._pivot_samples, self._position_watch = PositionSamples(samples or ()), None
+        else:
+            self._pivot_samples = None
+            self._position_watch = PositionOnlyWatch(layout.index("xs") is None, layout.index("ys") is None)
+            if watch:
+                self._position_watch.last = tuple(watch["last"]) if watch["last"] is not None else None
+                self._position_watch.warned = watch["warned"]
+
+    def _read_pivot_input(self) -> None:
+        """At a communication point: derive the pivot's velocity and acceleration from its positions
+        (``pivot_input = position``), or look out for position-only wiring (``acceleration``)."""
+        u = self._u
+        if self._pivot_samples is not None:
+            u[2], u[3], u[4], u[5] = self._pivot_samples.rates_at(self.time, u[0], u[1])
+        elif not self._position_watch.warned and self.driven:
+            notice = self._position_watch.check(u)
+            if notice:
+                self.notices.append(notice)
 
     def do_step(self, current_time: float, step_size: float) -> None:
         """Advance from ``current_time`` [s] to ``current_time + step_size`` [s].
 
         Raises :class:`CoSimulationError` for a call out of order or a non-positive step and
         :class:`SolverError` when the integrator gives up; the state is then left at the last
-        successful communication point.
+        successful communication point. The outputs are computed when read.
         """
-        check_step_call(self.initialised and self.integrator is not None, self.time, current_time, step_size)
+        if not (current_time == self.time and 0.0 < step_size < math.inf and self.initialised):
+            check_step_call(self.initialised and self.integrator is not None, self.time, current_time, step_size)
         t_end = current_time + step_size
+        land = False
+        if self.driven or self._pivot_samples is not None:
+            self._read_pivot_input()
         try:
-            jump = self.driven and not self._hold.continued_by(self.time, self._input_values())
-            if jump:
-                self._restart(self.time)  # the inputs jump here: integrate nothing across it
-            # After a jump, land on t_end: the next step likely restarts too, so a step past it
-            # and its dense output would be wasted.
-            y = self.integrator.advance_to(t_end, land=jump)
+            if self.driven:
+                if not self._hold.continued_by(self.time, self._u):
+                    self._restart(self.time)  # the inputs jump here: integrate nothing across it
+                    # Land on t_end: the next step likely restarts too, so a step past it and its
+                    # dense output would be wasted.
+                    land = True
+                self._inputs_set = False
+            y = self.integrator.advance_to(t_end, land=land)
         except ModelError as error:
             raise SolverError(str(error)) from error
-        outputs = self._outputs_at(y, self._hold.at(t_end) if self.driven else None)
-        if not self.integrator.method.adaptive:  # adaptive methods reject non-finite or inaccurate steps
-            self._check_bounded(y, outputs, t_end)
+        if self._fixed_step:  # adaptive methods reject non-finite or inaccurate steps
+            self._check_bounded(y, self._outputs_at(y, self._hold.at(t_end) if self.driven else None), t_end)
         self.time = t_end
-        self._y = list(y)
-        self.outputs = outputs
+        self._y = y
+        self._outputs = None
 
     # ------------------------------------------------------------------ FMU state
-    STATE_VERSION = 2
+    STATE_VERSION = 3
 
     def get_state(self) -> dict[str, Any]:
         """Return the complete state (parameters, time, integrator) as JSON-serialisable data.
@@ -331,10 +431,15 @@ class DoublePendulumCoSimulation:
             "initial_energy": self.initial_energy,
             "outputs": dict(self.outputs),
             "integrator": self.integrator.get_state() if self.integrator is not None else None,
-            "inputs": dict(self.inputs),
+            "inputs": self.inputs,
             "driven": self.driven,
-            "hold": [self._hold.t0, list(self._hold.values)] if self._hold is not None else None,
+            "hold": [self._hold.t0, list(self._hold.u)] if self._hold is not None else None,
             "y": list(self._y),
+            "pivot_samples": [list(s) for s in self._pivot_samples.samples] if self._pivot_samples else None,
+            "position_watch": (
+                {"last": self._position_watch.last, "warned": self._position_watch.warned}
+                if self._position_watch else None
+            ),
         }
 
     def set_state(self, state: dict[str, Any]) -> None:
@@ -352,26 +457,28 @@ class DoublePendulumCoSimulation:
         self.initialised = False
         self.integrator = None
         self.time = float(state["time"])
-        self.inputs = {name: float(state["inputs"][name]) for name in INPUT_NAMES}
+        self._u = [float(state["inputs"][name]) for name in INPUT_NAMES]
         self.driven = bool(state["driven"])
         if state["initialised"]:
-            driven = self.driven or any(self.inputs.values())
+            driven = self.driven or any(self._u)
             if same_model and model.config.inputs == driven:
                 self.driven, self.model, self.integrator, self.initialised = driven, model, integrator, True
-                self._hold = InputHold(self.time, self._input_values()) if driven else None
+                self._hold = InputHold(self.time, self._u) if driven else None
                 if driven:
                     self.integrator.f = build_vector_field(model.config, model.evaluate, self._hold)
             else:
                 self.initialise()  # rebuilds model and integrator from the restored parameters
             hold = state["hold"]
             if hold is not None:
-                self._hold = InputHold(float(hold[0]), InputValues(*hold[1]))
+                self._hold = InputHold(float(hold[0]), hold[1])
                 self.integrator.f = build_vector_field(self.model.config, self.model.evaluate, self._hold)
             self.integrator.set_state(state["integrator"])
             self.time = float(state["time"])
             self._y = list(state["y"])
+            self._start_pivot_input(state["pivot_samples"], state["position_watch"])
         self.initial_energy = state["initial_energy"]
         self.outputs = LazyOutputs(None, None, None, {}, values=state["outputs"])
+        self._inputs_set = False
 
     def _check_bounded(self, y: list[float], outputs: Mapping[str, float], t_end: float) -> None:
         """Raise :class:`SolverError` if the motion has blown up numerically.

@@ -1,14 +1,15 @@
-"""Solver settings: the component's choice of integrator and its accuracy, as FMU parameters.
+"""The component's settings, as FMU parameters: its integrator and accuracy, and how it reads its inputs.
 
 They live with the component, not the model: the model is the physics, the component decides
-how to integrate it (see :mod:`double_pendulum.solvers`).
+how to integrate it (see :mod:`double_pendulum.solvers`) and how the host's input samples become
+the model's inputs.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..model.parameters import Validated, spec
+from ..model.parameters import ParameterError, Validated, spec
 from ..solvers.registry import check_solver_name
 
 
@@ -31,3 +32,27 @@ class SolverSettings(Validated):
     def __post_init__(self) -> None:
         super().__post_init__()
         check_solver_name(self.solver)
+
+
+PIVOT_INPUT_MODES: tuple[str, ...] = ("acceleration", "position")
+
+
+@dataclass(frozen=True)
+class InputSettings(Validated):
+    """How the pivot inputs drive the pendulum (see :mod:`double_pendulum.component.pivot_motion`)."""
+
+    pivot_input: str = spec(
+        "acceleration",
+        "",
+        "how the pivot inputs drive the pendulum: acceleration (pivot_ax, pivot_ay drive the angles; send "
+        "position, velocity and acceleration) or position (velocity and acceleration derived from the "
+        "pivot_x, pivot_y samples: a parabola through the last three, one step of lag in the acceleration)",
+        rule="str",
+    )
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.pivot_input not in PIVOT_INPUT_MODES:
+            raise ParameterError(
+                f"invalid pivot_input = {self.pivot_input!r}: must be one of {', '.join(PIVOT_INPUT_MODES)}"
+            )

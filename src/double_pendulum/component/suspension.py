@@ -47,6 +47,7 @@ class SuspensionCoSimulation:
         self._y = [0.0] * len(STATE_NAMES)
         self._held = self._load()  # the load the integrator integrates with
         self.initial_energy: float | None = None
+        self.notices: list[str] = []  # warnings for the host's log (none so far), as the pendulum's component
         self.outputs: dict[str, float] = self.model.outputs(self._y, *self._held)
 
     # ------------------------------------------------------------------ variables

@@ -19,10 +19,15 @@ from .cosimulation import PARAMETER_GROUPS
 from .suspension import INPUT_START, PARAMETER_FIELDS
 
 MODEL_IDENTIFIER = "DoublePendulum"
-MODEL_DESCRIPTION = (
+MODEL_PHYSICS = (
     "Planar double pendulum (bobs on rods that may carry mass; fixed, moving or suspended pivot; air "
     "drag and bearing friction), equations of motion from the Lagrangian; inputs: pivot motion and "
-    "joint torques; FMI 2.0 co-simulation with an integrator that persists across doStep."
+    "joint torques"
+)
+MODEL_DESCRIPTION = MODEL_PHYSICS + "; FMI 2.0 co-simulation with an integrator that persists across doStep."
+MODEL_DESCRIPTION_FMI3 = (
+    MODEL_PHYSICS + "; FMI 3.0 Model Exchange (the host integrates the continuous states) and Co-Simulation "
+    "(an integrator that persists across doStep)."
 )
 DEFAULT_EXPERIMENT = {"start_time": 0.0, "stop_time": 10.0, "step_size": 0.01}
 

@@ -28,14 +28,17 @@ Every FMU written is checked to hold a binary for this platform.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
 import importlib.util
 import json
+import os
 import shutil
 import sys
 import tempfile
 import zipfile
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
@@ -46,9 +49,10 @@ PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
 RUNTIME_SUBPACKAGES = ("model", "solvers", "component")
 DEFAULT_FMU_PATH = Path("build") / f"{MODEL_IDENTIFIER}.fmu"
-SHARED_ADAPTER = "double_pendulum_slave.py"  # the FMI-to-component mapping every adapter uses
+# The FMI-to-component mapping every FMI 2 adapter uses, and what it shares with the FMI 3 adapter.
+SHARED_ADAPTERS = ("double_pendulum_slave.py", "slave_common.py")
 
-# SI base-unit exponents of every unit the interface uses (FMI 2.0 section 2.2.2).
+# SI base-unit exponents of every unit the interfaces use (FMI 2.0 section 2.2.2, FMI 3.0 2.4.3).
 UNIT_EXPONENTS: dict[str, dict[str, int]] = {
     "s": {"s": 1},
     "m": {"m": 1},
@@ -87,9 +91,28 @@ def adapter_script(model_identifier: str = MODEL_IDENTIFIER) -> Path:
     return _adapters_dir() / f"{model_identifier}.py"
 
 
-def shared_adapter() -> Path:
-    """Return the path of the slave class all adapters share (bundled into every FMU)."""
-    return _adapters_dir() / SHARED_ADAPTER
+def shared_adapters() -> list[Path]:
+    """Return the paths of the modules all FMI 2 adapters share (bundled into every FMI 2 FMU)."""
+    return [_adapters_dir() / name for name in SHARED_ADAPTERS]
+
+
+@contextlib.contextmanager
+def builder_imports_forgotten() -> Iterator[None]:
+    """Forget the modules an FMI library's builder imports from its temporary copy of the adapter.
+
+    pythonfmu's and pythonfmu3's builders instantiate the adapter to write the modelDescription; the
+    modules it imports (the shared slave modules, from a folder deleted right after) would stay in
+    ``sys.modules`` under their public names, and an FMU instantiated later in this process would
+    pick them up instead of its own bundled copies.
+    """
+    before = set(sys.modules)
+    try:
+        yield
+    finally:
+        for name in set(sys.modules) - before:
+            origin = getattr(sys.modules[name], "__file__", None)
+            if origin and not os.path.exists(origin):
+                del sys.modules[name]
 
 
 def runtime_sources() -> list[Path]:
@@ -110,22 +133,26 @@ def _copy_runtime(dest: Path) -> Path:
     return target
 
 
+def unit_definitions(units: Iterable[str]) -> ET.Element:
+    """``UnitDefinitions`` for ``units`` (FMI 2 and 3 alike): each one's SI base-unit exponents."""
+    used = sorted(set(units))
+    unknown = [u for u in used if u not in UNIT_EXPONENTS]
+    if unknown:
+        raise ValueError(f"no SI definition for unit(s) {unknown}: add them to UNIT_EXPONENTS")
+    definitions = ET.Element("UnitDefinitions")
+    for unit in used:
+        element = ET.SubElement(definitions, "Unit", name=unit)
+        ET.SubElement(element, "BaseUnit", {k: str(v) for k, v in UNIT_EXPONENTS[unit].items()})
+    return definitions
+
+
 def complete_model_description(xml_text: bytes, model_identifier: str = MODEL_IDENTIFIER) -> bytes:
     """Add units, output dependencies and InitialUnknowns to a pythonfmu modelDescription."""
     interface = INTERFACES[model_identifier]
     root = ET.fromstring(xml_text)
     units = {v.name: v.unit for v in interface.variables() if v.fmi_type == "Real" and v.unit not in ("", "1")}
-    used = sorted(set(units.values()))
-    unknown = [u for u in used if u not in UNIT_EXPONENTS]
-    if unknown:
-        raise ValueError(f"no SI definition for unit(s) {unknown}: add them to UNIT_EXPONENTS")
-
-    unit_defs = ET.Element("UnitDefinitions")
-    for unit in used:
-        unit_el = ET.SubElement(unit_defs, "Unit", name=unit)
-        ET.SubElement(unit_el, "BaseUnit", {k: str(v) for k, v in UNIT_EXPONENTS[unit].items()})
     position = list(root).index(root.find("CoSimulation")) + 1
-    root.insert(position, unit_defs)
+    root.insert(position, unit_definitions(units.values()))
 
     outputs_index = []
     index_of: dict[str, int] = {}
@@ -179,13 +206,19 @@ def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
 
 
 @functools.cache
-def _loader_binary() -> bytes | None:
+def _loader_binary(fmi_version: int = 2) -> bytes | None:
     """The compiled loader, or None (said once on stderr) where it cannot be built."""
     try:
-        return loader.compiled_loader()
+        return loader.compiled_loader(fmi_version)
     except loader.LoaderUnavailable as why:
-        print(f"note: {why}", file=sys.stderr, flush=True)
+        _note(str(why))
         return None
+
+
+@functools.cache
+def _note(message: str) -> None:
+    """Say ``message`` on stderr, once per process (both FMI versions' builds meet the same missing compiler)."""
+    print(f"note: {message}", file=sys.stderr, flush=True)
 
 
 def bundle_id(files: dict[str, bytes], model_identifier: str) -> str:
@@ -199,25 +232,29 @@ def bundle_id(files: dict[str, bytes], model_identifier: str) -> str:
     return digest.hexdigest()[:16]
 
 
-def _rewrite_fmu(fmu: Path, model_identifier: str) -> None:
+def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], bytes], fmi_version: int = 2,
+                adapter: str | None = None) -> None:
     """Rewrite the zip with the completed modelDescription, bytecode, the loader and the bundle's id.
 
-    Precompiled bytecode spares every fresh extraction (fmpy extracts the FMU anew for each
-    ``simulate_fmu`` call) the compilation of the bundled sources at start-up.
+    ``complete`` completes the modelDescription; ``adapter`` is the adapter's file name in
+    ``resources/`` (default ``<model_identifier>.py``). Precompiled bytecode spares every fresh
+    extraction (fmpy extracts the FMU anew for each ``simulate_fmu`` call) the compilation of the
+    bundled sources at start-up.
     """
     with zipfile.ZipFile(fmu) as src:
         items = [(item, src.read(item.filename)) for item in src.infolist()]
-    binary = f"binaries/{loader.PLATFORM}/{model_identifier}.so"
-    loader_binary = _loader_binary() if any(item.filename == binary for item, _ in items) else None
-    backend = f"binaries/{loader.PLATFORM}/{loader.BACKEND_NAME}"
-    identity = bundle_id({item.filename: data for item, data in items}, model_identifier)
+    platform = loader.PLATFORMS[fmi_version]
+    binary = f"binaries/{platform}/{model_identifier}.so"
+    loader_binary = _loader_binary(fmi_version) if any(item.filename == binary for item, _ in items) else None
+    backend = f"binaries/{platform}/{loader.BACKEND_NAMES[fmi_version]}"
+    identity = bundle_id({item.filename: data for item, data in items}, Path(adapter or model_identifier).stem)
     tmp = fmu.with_suffix(".fmu.tmp")
     with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
         for item, data in items:
             if item.filename == "modelDescription.xml":
-                data = complete_model_description(data, model_identifier)
+                data = complete(data)
             if item.filename == binary and loader_binary is not None:
-                dst.writestr(backend, data, compress_type=zipfile.ZIP_DEFLATED)  # pythonfmu's, behind the loader
+                dst.writestr(backend, data, compress_type=zipfile.ZIP_DEFLATED)  # the library's, behind the loader
                 data = loader_binary
             dst.writestr(item, data, compress_type=zipfile.ZIP_DEFLATED)
             if item.filename.startswith("resources/") and item.filename.endswith(".py"):
@@ -229,15 +266,16 @@ def _rewrite_fmu(fmu: Path, model_identifier: str) -> None:
     tmp.replace(fmu)
 
 
-def check_platform_binary(fmu: Path, model_identifier: str) -> None:
+def check_platform_binary(fmu: Path, model_identifier: str, fmi_version: int = 2) -> None:
     """Raise if ``fmu`` holds no binary for this platform (it could not run here)."""
-    from fmpy import platform, sharedLibraryExtension
+    from fmpy import platform, platform_tuple, sharedLibraryExtension
 
-    binary = f"binaries/{platform}/{model_identifier}{sharedLibraryExtension}"
+    binary = f"binaries/{platform if fmi_version == 2 else platform_tuple}/{model_identifier}{sharedLibraryExtension}"
     with zipfile.ZipFile(fmu) as z:
         if binary not in z.namelist():
-            raise RuntimeError(f"{fmu} holds no binary for this platform ({binary} missing): is pythonfmu's "
-                               f"binary for {platform} installed (pythonfmu.builder.FmuBuilder.has_binary())?")
+            library = "pythonfmu" if fmi_version == 2 else "pythonfmu3"
+            raise RuntimeError(f"{fmu} holds no binary for this platform ({binary} missing): is {library}'s "
+                               f"binary for this platform installed ({library}.builder.FmuBuilder.has_binary())?")
 
 
 def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL_IDENTIFIER) -> Path:
@@ -256,14 +294,16 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
     with tempfile.TemporaryDirectory(prefix="dp_fmu_build_") as tmp:
         tmp_dir = Path(tmp)
         package_copy = _copy_runtime(tmp_dir)
-        built = FmuBuilder.build_FMU(
-            adapter_script(model_identifier),
-            dest=tmp_dir / f"{model_identifier}.fmu",
-            project_files=[package_copy, shared_adapter()],
-            canGetAndSetFMUstate=True,
-            canSerializeFMUstate=True,
-        )
-        _rewrite_fmu(Path(built), model_identifier)
+        with builder_imports_forgotten():
+            built = FmuBuilder.build_FMU(
+                adapter_script(model_identifier),
+                dest=tmp_dir / f"{model_identifier}.fmu",
+                project_files=[package_copy, *shared_adapters()],
+                canGetAndSetFMUstate=True,
+                canSerializeFMUstate=True,
+            )
+        rewrite_fmu(Path(built), model_identifier, functools.partial(complete_model_description,
+                                                                     model_identifier=model_identifier))
         check_platform_binary(Path(built), model_identifier)
         shutil.move(str(built), fmu_path)
     return fmu_path
@@ -271,11 +311,15 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
 
 def build_all(dest: str | Path = DEFAULT_FMU_PATH) -> list[Path]:
     """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it,
-    then the coupled system (:func:`build_systems`)."""
+    then the coupled system (:func:`build_systems`), then the FMI 3.0 ``DoublePendulum`` in the
+    subfolder ``fmi3/`` (:func:`double_pendulum.fmu.build_fmi3.build_fmu3`)."""
+    from .build_fmi3 import build_fmu3
+
     dest = Path(dest)
     first = build_fmu(dest, MODEL_IDENTIFIER)
     others = [build_fmu(first.parent / f"{name}.fmu", name) for name in INTERFACES if name != MODEL_IDENTIFIER]
-    return [first, *others, *build_systems(first)]
+    fmi3 = build_fmu3(first.parent / "fmi3" / f"{MODEL_IDENTIFIER}.fmu")
+    return [first, *others, *build_systems(first), fmi3]
 
 
 def build_systems(
@@ -303,5 +347,5 @@ def fmu_is_current(fmu_path: str | Path, model_identifier: str = MODEL_IDENTIFIE
     if not fmu_path.is_file():
         return False
     built = fmu_path.stat().st_mtime
-    sources = [adapter_script(model_identifier), shared_adapter(), *runtime_sources(), *loader.loader_sources()]
+    sources = [adapter_script(model_identifier), *shared_adapters(), *runtime_sources(), *loader.loader_sources()]
     return all(src.stat().st_mtime <= built for src in sources)

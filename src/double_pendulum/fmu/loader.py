@@ -1,16 +1,17 @@
 """The FMU's binary on Linux: a small C loader, compiled from source when the FMU is built.
 
-pythonfmu's Linux library calls the CPython C API without linking libpython, so on its own it runs
-only inside a Python process. The loader (``fmu_src/loader/``: ``python_runtime.c`` finds, loads
-and starts a CPython, ``fmi2_loader.c`` forwards the FMI 2 functions) becomes the FMU's
-``binaries/linux64/<model identifier>.so``; pythonfmu's library lies beside it as
-``libpythonfmu-export.so``. In a Python host the loader uses the host's interpreter and changes
+pythonfmu's Linux library (and pythonfmu3's, for FMI 3) calls the CPython C API without linking
+libpython, so on its own it runs only inside a Python process. The loader (``fmu_src/loader/``:
+``python_runtime.c`` finds, loads and starts a CPython, ``fmi2_loader.c`` forwards the FMI 2
+functions, ``fmi3_loader.c`` the FMI 3 ones) becomes the FMU's
+``binaries/<platform>/<model identifier>.so``; the FMI library's own lies beside it
+(:data:`BACKEND_NAMES`). In a Python host the loader uses the host's interpreter and changes
 nothing; in any other host it finds a CPython >= 3.11 with a shared libpython: the one named by
 ``DOUBLE_PENDULUM_FMU_PYTHON``, else the one the FMU was built with (``resources/python.cfg``,
 :func:`python_record`), else ``python3`` on PATH (docs/fmu.md, "Use the FMU in other FMI tools").
 
 The loader is compiled with the system C compiler (``$CC``, else ``cc``, ``gcc`` or ``clang``)
-against the FMI 2 headers fmpy ships (``fmpy/c-code``); nothing compiled is committed. Without a
+against the FMI 2 and FMI 3 headers fmpy ships (``fmpy/c-code``); nothing compiled is committed. Without a
 compiler the FMU keeps pythonfmu's plain library (Python hosts only) and the build says so once.
 """
 
@@ -28,10 +29,13 @@ import tempfile
 from pathlib import Path
 
 LOADER_FOLDER = "loader"  # in fmu_src/ (installed as double_pendulum.adapters)
-LOADER_SOURCES = ("python_runtime.c", "fmi2_loader.c")
+LOADER_SOURCES = {2: ("python_runtime.c", "fmi2_loader.c"), 3: ("python_runtime.c", "fmi3_loader.c")}
 LOADER_HEADERS = ("python_runtime.h",)
-BACKEND_NAME = "libpythonfmu-export.so"  # pythonfmu's library in the FMU, beside the loader
-PLATFORM = "linux64"  # the one platform whose pythonfmu library needs the loader
+# The FMI library's own binary in the FMU, beside the loader: pythonfmu's (FMI 2), pythonfmu3's (FMI 3).
+BACKEND_NAMES = {2: "libpythonfmu-export.so", 3: "libpythonfmu3-export.so"}
+# The one platform whose library needs the loader, as each FMI version names its binaries folder.
+PLATFORMS = {2: "linux64", 3: "x86_64-linux"}
+BACKEND_NAME, PLATFORM = BACKEND_NAMES[2], PLATFORMS[2]
 CONFIG_NAME = "python.cfg"  # in resources/: the CPython the FMU was built with
 OVERRIDE_VARIABLE = "DOUBLE_PENDULUM_FMU_PYTHON"
 CFLAGS = ("-shared", "-fPIC", "-O2", "-fvisibility=hidden")
@@ -42,13 +46,13 @@ class LoaderUnavailable(RuntimeError):
     """The loader cannot be built here (no C compiler, or not Linux); the message says why in one line."""
 
 
-def loader_sources() -> list[Path]:
-    """The loader's C sources and headers (in the installed ``double_pendulum.adapters``)."""
+def loader_sources(fmi_version: int = 2) -> list[Path]:
+    """The C sources and headers of the FMI ``fmi_version`` loader (in the installed ``double_pendulum.adapters``)."""
     spec = importlib.util.find_spec("double_pendulum.adapters")
     if spec is None or not spec.submodule_search_locations:
         raise FileNotFoundError("cannot find double_pendulum.adapters: is double-pendulum-fmu installed?")
     folder = Path(next(iter(spec.submodule_search_locations))) / LOADER_FOLDER
-    return [folder / name for name in (*LOADER_SOURCES, *LOADER_HEADERS)]
+    return [folder / name for name in (*LOADER_SOURCES[fmi_version], *LOADER_HEADERS)]
 
 
 def fmi_headers() -> Path:
@@ -79,8 +83,9 @@ def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tupl
         return output.read_bytes()
 
 
-def compiled_loader() -> bytes:
-    """The loader's shared library for this machine (compiled once per process, compiler and source version).
+def compiled_loader(fmi_version: int = 2) -> bytes:
+    """The FMI ``fmi_version`` loader's shared library for this machine (compiled once per process,
+    compiler and source version).
 
     Raises :class:`LoaderUnavailable` where it cannot be built (no C compiler; not Linux), and
     ``RuntimeError`` with the compiler's output if compiling fails.
@@ -90,10 +95,10 @@ def compiled_loader() -> bytes:
     compiler = c_compiler()
     if compiler is None:
         raise LoaderUnavailable(
-            "no C compiler found ($CC, cc, gcc or clang): the FMUs keep pythonfmu's plain binary, "
+            "no C compiler found ($CC, cc, gcc or clang): the FMUs keep the FMI library's plain binary, "
             "which runs only in Python hosts (docs/fmu.md)"
         )
-    sources = tuple(loader_sources())
+    sources = tuple(loader_sources(fmi_version))
     return _compiled(tuple(compiler), sources, tuple(path.stat().st_mtime for path in sources))
 
 

@@ -34,40 +34,42 @@ import math
 from collections.abc import Callable
 from typing import Any
 
+from .codegen import compile_function
 from .links import link_coefficients
 from .parameters import PendulumParameters
 
+LINK_ACCELERATIONS = """
+delta = phi1 - phi2
+s_d = sin(delta)
+c_d = cos(delta)
+a12 = k * c_d
+b1 = -k * omega2 * omega2 * s_d - gs1 * sin(phi1) + q1
+b2 = k * omega1 * omega1 * s_d - gs2 * sin(phi2) + q2
+det = j1 * j2 - a12 * a12
+alpha1 = (b1 * j2 - a12 * b2) / det
+alpha2 = (j1 * b2 - a12 * b1) / det
+"""
+"""The equations above solved for :math:`(\\ddot\\varphi_1, \\ddot\\varphi_2)` = ``(alpha1, alpha2)``
+[rad/s^2] by Cramer's rule, as a snippet (:mod:`double_pendulum.model.codegen`): from ``phi1, phi2``
+[rad], ``omega1, omega2`` [rad/s], ``q1, q2`` [N m] and the coefficients ``j1, j2, k`` [kg m^2],
+``gs1, gs2`` [N m]. The one copy of these equations: :func:`link_accelerations` and the fast
+vector fields are compiled from it."""
 
-def link_accelerations(
-    phi1: Any,
-    phi2: Any,
-    omega1: Any,
-    omega2: Any,
-    j1: float,
-    j2: float,
-    k: float,
-    gs1: float,
-    gs2: float,
-    q1: Any = 0.0,
-    q2: Any = 0.0,
-    sin: Callable[[Any], Any] = math.sin,
-    cos: Callable[[Any], Any] = math.cos,
-) -> tuple[Any, Any]:
-    r"""Return :math:`(\ddot\varphi_1, \ddot\varphi_2)` [rad/s^2] from the equations above.
+link_accelerations: Callable[..., tuple[Any, Any]] = compile_function(
+    "link_accelerations",
+    "phi1, phi2, omega1, omega2, j1, j2, k, gs1, gs2, q1, q2, sin, cos",
+    [LINK_ACCELERATIONS],
+    "alpha1, alpha2",
+    {},
+    defaults=(0.0, 0.0, math.sin, math.cos),
+    doc=r"""Return :math:`(\ddot\varphi_1, \ddot\varphi_2)` [rad/s^2] from the equations above.
 
     Arguments are angles [rad], angular velocities [rad/s], the coefficients :math:`J_1, J_2, K`
-    [kg m^2] and :math:`g S_1, g S_2` [N m] (:class:`~double_pendulum.model.links.LinkCoefficients`)
-    and the generalised forces ``q1, q2`` [N m].
-    """
-    delta = phi1 - phi2
-    s_d = sin(delta)
-    c_d = cos(delta)
-    # Mass matrix [[j1, a12], [a12, j2]] and right-hand side (b1, b2).
-    a12 = k * c_d
-    b1 = -k * omega2 * omega2 * s_d - gs1 * sin(phi1) + q1
-    b2 = k * omega1 * omega1 * s_d - gs2 * sin(phi2) + q2
-    det = j1 * j2 - a12 * a12
-    return (b1 * j2 - a12 * b2) / det, (j1 * b2 - a12 * b1) / det
+    [kg m^2] and :math:`g S_1, g S_2` [N m] (:class:`~double_pendulum.model.links.LinkCoefficients`),
+    the generalised forces ``q1, q2`` [N m] (default 0) and ``sin``/``cos`` (default ``math``'s)
+    (:data:`LINK_ACCELERATIONS`).
+    """,
+)
 
 
 def angular_accelerations(
@@ -102,18 +104,16 @@ def fixed_pivot_vector_field(params: PendulumParameters) -> Callable[[float, lis
     """Return ``f(t, y) -> dy/dt`` for ``y = [phi1, phi2, omega1, omega2]`` (frictionless).
 
     Units: y in (rad, rad, rad/s, rad/s), dy/dt in (rad/s, rad/s, rad/s^2, rad/s^2).
-    The coefficients (bobs and rods) are bound once so each call does no attribute look-ups.
+    Straight-line code from :data:`LINK_ACCELERATIONS` with the coefficients (bobs and rods) bound
+    once, so each call is one frame of float arithmetic.
     """
     c = link_coefficients(params)
-    j1, j2, k, gs1, gs2 = c.j1, c.j2, c.k, c.gs1, c.gs2
-    accel = link_accelerations
-
-    def vector_field(t: float, y: list[float]) -> list[float]:
-        phi1, phi2, omega1, omega2 = y
-        alpha1, alpha2 = accel(phi1, phi2, omega1, omega2, j1, j2, k, gs1, gs2)
-        return [omega1, omega2, alpha1, alpha2]
-
-    return vector_field
+    constants = {"j1": c.j1, "j2": c.j2, "k": c.k, "gs1": c.gs1, "gs2": c.gs2, "q1": 0.0, "q2": 0.0,
+                 "sin": math.sin, "cos": math.cos}  # fmt: skip
+    return compile_function(
+        "fixed_pivot_vector_field", "t, y", ["phi1, phi2, omega1, omega2 = y", LINK_ACCELERATIONS],
+        "[omega1, omega2, alpha1, alpha2]", constants,
+    )  # fmt: skip
 
 
 def linearised_normal_modes(

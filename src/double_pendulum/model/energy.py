@@ -20,7 +20,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from .links import link_coefficients
+from .links import LinkCoefficients, link_coefficients
 from .parameters import PendulumParameters
 
 
@@ -57,6 +57,24 @@ def total_energy(
     return kinetic_energy(phi1, phi2, omega1, omega2, params, cos) + potential_energy(phi1, phi2, params, cos)
 
 
+def relative_momentum(
+    phi1: float, phi2: float, omega1: float, omega2: float, c: LinkCoefficients
+) -> tuple[float, float]:
+    r"""Return the momentum [kg m/s] of bobs and rods relative to the pivot,
+    :math:`\vec P = S_1 \dot\varphi_1 \vec n_1 + S_2 \dot\varphi_2 \vec n_2`,
+    :math:`\vec n_i = (\cos\varphi_i, \sin\varphi_i)` (``c``: the link coefficients)."""
+    px = c.s1 * omega1 * math.cos(phi1) + c.s2 * omega2 * math.cos(phi2)
+    py = c.s1 * omega1 * math.sin(phi1) + c.s2 * omega2 * math.sin(phi2)
+    return px, py
+
+
+def pivot_motion_energy(px: float, py: float, vxs: float, vys: float, mass: float, plus: float = 0.0) -> float:
+    r"""Return ``plus`` + the part of the kinetic energy [J] that the pivot's velocity :math:`\vec v_s` [m/s]
+    adds, :math:`\tfrac12 M|\vec v_s|^2 + \vec v_s\cdot\vec P` (``(px, py)``: :func:`relative_momentum`,
+    ``mass``: M, bobs and rods [kg]), added term by term to ``plus`` [J]."""
+    return plus + 0.5 * mass * (vxs * vxs + vys * vys) + vxs * px + vys * py
+
+
 def kinetic_energy_moving_pivot(
     phi1: float,
     phi2: float,
@@ -71,21 +89,13 @@ def kinetic_energy_moving_pivot(
     :math:`T = T_{rel} + \tfrac12 M|\vec v_s|^2
     + \vec v_s\cdot(S_1 \dot\varphi_1 \vec n_1 + S_2 \dot\varphi_2 \vec n_2)`,
     :math:`\vec n_i = (\cos\varphi_i, \sin\varphi_i)`, M the total mass (bobs and rods), the last
-    term the pivot velocity times the momentum relative to the pivot; exactly :func:`kinetic_energy`
-    for a pivot at rest.
+    two terms :func:`pivot_motion_energy`; exactly :func:`kinetic_energy` for a pivot at rest.
     """
     if vxs == 0.0 and vys == 0.0:
         return kinetic_energy(phi1, phi2, omega1, omega2, params)
     c = link_coefficients(params)
-    # momentum of bobs and rods relative to the pivot
-    px = c.s1 * omega1 * math.cos(phi1) + c.s2 * omega2 * math.cos(phi2)
-    py = c.s1 * omega1 * math.sin(phi1) + c.s2 * omega2 * math.sin(phi2)
-    return (
-        kinetic_energy(phi1, phi2, omega1, omega2, params)
-        + 0.5 * c.mass * (vxs * vxs + vys * vys)
-        + vxs * px
-        + vys * py
-    )
+    px, py = relative_momentum(phi1, phi2, omega1, omega2, c)
+    return pivot_motion_energy(px, py, vxs, vys, c.mass, plus=kinetic_energy(phi1, phi2, omega1, omega2, params))
 
 
 def suspension_energy(

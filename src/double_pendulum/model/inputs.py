@@ -42,18 +42,48 @@ still measures only the integration error.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Sequence
 from typing import NamedTuple
 
 from .outputs import Quantity
 
 INPUTS: tuple[Quantity, ...] = (
-    Quantity("pivot_x", "m", "horizontal position of the pivot (suspension on: of its base)"),
-    Quantity("pivot_y", "m", "vertical position of the pivot (suspension on: of its base), up positive"),
-    Quantity("pivot_vx", "m/s", "horizontal velocity of the pivot (suspension on: of its base)"),
-    Quantity("pivot_vy", "m/s", "vertical velocity of the pivot (suspension on: of its base)"),
-    Quantity("pivot_ax", "m/s2", "horizontal acceleration of the pivot (drives the angles)"),
-    Quantity("pivot_ay", "m/s2", "vertical acceleration of the pivot (drives the angles)"),
+    Quantity(
+        "pivot_x",
+        "m",
+        "horizontal position of the pivot (suspension on: of its base)"
+        "; without suspension it moves the angles only with pivot_input = position",
+    ),
+    Quantity(
+        "pivot_y",
+        "m",
+        "vertical position of the pivot (suspension on: of its base), up positive"
+        "; without suspension it moves the angles only with pivot_input = position",
+    ),
+    Quantity(
+        "pivot_vx",
+        "m/s",
+        "horizontal velocity of the pivot (suspension on: of its base)"
+        "; ignored with pivot_input = position",
+    ),
+    Quantity(
+        "pivot_vy",
+        "m/s",
+        "vertical velocity of the pivot (suspension on: of its base)"
+        "; ignored with pivot_input = position",
+    ),
+    Quantity(
+        "pivot_ax",
+        "m/s2",
+        "horizontal acceleration of the pivot (drives the angles)"
+        "; ignored with pivot_input = position",
+    ),
+    Quantity(
+        "pivot_ay",
+        "m/s2",
+        "vertical acceleration of the pivot (drives the angles)"
+        "; ignored with pivot_input = position",
+    ),
     Quantity("tau1", "N.m", "torque on the upper rod at the pivot (motor), along omega1"),
     Quantity("tau2", "N.m", "torque of the upper rod on the lower rod at the elbow, along omega2 - omega1"),
 )
@@ -88,43 +118,65 @@ def _same(a: float, b: float) -> bool:
     return a == b or abs(a - b) <= HOLD_MATCH_RTOL * max(abs(a), abs(b))
 
 
-@dataclass(frozen=True)
 class InputHold:
-    """The second-order hold of one communication step: the values set at ``t0`` [s]."""
+    """The second-order hold of the current communication step: the input values set at ``t0`` [s].
 
-    t0: float
-    values: InputValues
+    One object per driven component, **reset in place** at each communication point where the
+    inputs jump (:meth:`reset`): the vector fields built on it read its values on every call, so
+    an input change gives them a new right-hand side without building anything.
+    ``u`` holds the eight values in :data:`INPUT_NAMES` order.
+    """
+
+    __slots__ = ("t0", "u")
+
+    def __init__(self, t0: float, values: Sequence[float]) -> None:
+        self.t0 = float(t0)
+        self.u = [float(v) for v in values]
+
+    @property
+    def values(self) -> InputValues:
+        """The values set at ``t0``."""
+        return InputValues(*self.u)
+
+    def reset(self, t0: float, values: Sequence[float]) -> None:
+        """Start a new hold at ``t0`` [s] with ``values`` (eight floats in :data:`INPUT_NAMES` order)."""
+        self.t0 = t0
+        self.u[:] = values
+
+    def held(self, t: float) -> Sequence[float]:
+        """The eight held values at time ``t`` [s] (quadratic position, linear velocity)."""
+        u = self.u
+        x, y, vx, vy, ax, ay, tau1, tau2 = u
+        tau = t - self.t0
+        if tau == 0.0 or not (vx or vy or ax or ay):
+            return u
+        return (
+            x + tau * (vx + 0.5 * tau * ax),
+            y + tau * (vy + 0.5 * tau * ay),
+            vx + tau * ax,
+            vy + tau * ay,
+            ax,
+            ay,
+            tau1,
+            tau2,
+        )
 
     def at(self, t: float) -> InputValues:
         """Return the held inputs at time ``t`` [s] (quadratic position, linear velocity)."""
-        v = self.values
-        tau = t - self.t0
-        if tau == 0.0 or not (v.pivot_vx or v.pivot_vy or v.pivot_ax or v.pivot_ay):
-            return v
-        return InputValues(
-            v.pivot_x + tau * (v.pivot_vx + 0.5 * tau * v.pivot_ax),
-            v.pivot_y + tau * (v.pivot_vy + 0.5 * tau * v.pivot_ay),
-            v.pivot_vx + tau * v.pivot_ax,
-            v.pivot_vy + tau * v.pivot_ay,
-            v.pivot_ax,
-            v.pivot_ay,
-            v.tau1,
-            v.tau2,
-        )
+        return InputValues(*self.held(t))
 
     def velocity_at(self, t: float) -> tuple[float, float]:
         """Return the held pivot velocity ``(vx, vy)`` [m/s] at time ``t`` [s], as in :meth:`at`."""
-        v = self.values
+        u = self.u
         tau = t - self.t0
         if tau == 0.0:
-            return v.pivot_vx, v.pivot_vy
-        return v.pivot_vx + tau * v.pivot_ax, v.pivot_vy + tau * v.pivot_ay
+            return u[2], u[3]
+        return u[2] + tau * u[4], u[3] + tau * u[5]
 
-    def continued_by(self, t0: float, values: InputValues) -> bool:
+    def continued_by(self, t0: float, values: Sequence[float]) -> bool:
         """True if ``values`` set at ``t0`` describe this same hold (no discontinuity at ``t0``).
 
         Then the integrator may go on with this hold; otherwise the right-hand side jumps at
         ``t0`` and the integration must restart there.
         """
-        held = self.at(t0)
-        return all(_same(a, b) for a, b in zip(held, values))
+        return all(map(_same, self.held(t0), values))

@@ -70,7 +70,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, NamedTuple
 
-from .dynamics import fixed_pivot_vector_field, link_accelerations
+from .codegen import compile_function
+from .dynamics import LINK_ACCELERATIONS, fixed_pivot_vector_field
 from .energy import kinetic_energy_moving_pivot, potential_energy, suspension_energy
 from .forces import bearing_drag_torque, bearing_torque, quadratic_drag, rod_drag_integrals
 from .links import link_coefficients, plate_lengths
@@ -365,6 +366,21 @@ def build_evaluator(config: ModelConfig) -> Callable[..., Evaluation]:
 
 MomentumRate = Callable[..., tuple[float, float, float, float, float, float]]
 
+MOMENTUM_RATE = """
+acc1x = axs + l1 * (c1 * alpha1 - s1 * omega1 * omega1)
+acc1y = ays + l1 * (s1 * alpha1 + c1 * omega1 * omega1)
+acc2x = acc1x + l2 * (c2 * alpha2 - s2 * omega2 * omega2)
+acc2y = acc1y + l2 * (s2 * alpha2 + c2 * omega2 * omega2)
+ma_x = m1 * acc1x + m2 * acc2x + hr1 * (axs + acc1x) + hr2 * (acc1x + acc2x)
+ma_y = m1 * acc1y + m2 * acc2y + hr1 * (ays + acc1y) + hr2 * (acc1y + acc2y)
+"""
+"""Bob accelerations and the rate of change of the pendulum's momentum, as a snippet
+(:mod:`~double_pendulum.model.codegen`; see :func:`_momentum_rate_function`)."""
+
+
+def _momentum_constants(p: PendulumParameters) -> dict[str, float]:
+    return {"m1": p.m1, "m2": p.m2, "l1": p.l1, "l2": p.l2, "hr1": 0.5 * p.m_rod1, "hr2": 0.5 * p.m_rod2}
+
 
 def _momentum_rate_function(p: PendulumParameters) -> MomentumRate:
     r"""Return ``rate(a_x, a_y, c1, s1, c2, s2, w1, w2, alpha1, alpha2)`` for the pendulum ``p``.
@@ -382,24 +398,31 @@ def _momentum_rate_function(p: PendulumParameters) -> MomentumRate:
     :math:`m_1\vec a_1 + m_2\vec a_2 + \tfrac12 m_{r1}(\vec a_p + \vec a_1)
     + \tfrac12 m_{r2}(\vec a_1 + \vec a_2)` (each rod's centre moves as the mean of its joints):
     ``(a1x, a1y, a2x, a2y, ma_x, ma_y)``. The pivot force on the pendulum is this minus gravity and
-    the external forces. One copy for the general evaluator and the fast driven core.
+    the external forces. Compiled from :data:`MOMENTUM_RATE`, which the fast driven core inlines.
     """
-    m1, m2, l1, l2 = p.m1, p.m2, p.l1, p.l2
-    hr1, hr2 = 0.5 * p.m_rod1, 0.5 * p.m_rod2
+    return compile_function(
+        "rate", "axs, ays, c1, s1, c2, s2, omega1, omega2, alpha1, alpha2", [MOMENTUM_RATE],
+        "acc1x, acc1y, acc2x, acc2y, ma_x, ma_y", _momentum_constants(p),
+    )  # fmt: skip
 
-    def rate(
-        axs: float, ays: float, c1: float, s1: float, c2: float, s2: float,
-        w1: float, w2: float, alpha1: float, alpha2: float,
-    ) -> tuple[float, float, float, float, float, float]:  # fmt: skip
-        acc1x = axs + l1 * (c1 * alpha1 - s1 * w1 * w1)
-        acc1y = ays + l1 * (s1 * alpha1 + c1 * w1 * w1)
-        acc2x = acc1x + l2 * (c2 * alpha2 - s2 * w2 * w2)
-        acc2y = acc1y + l2 * (s2 * alpha2 + c2 * w2 * w2)
-        ma_x = m1 * acc1x + m2 * acc2x + hr1 * (axs + acc1x) + hr2 * (acc1x + acc2x)
-        ma_y = m1 * acc1y + m2 * acc2y + hr1 * (ays + acc1y) + hr2 * (acc1y + acc2y)
-        return acc1x, acc1y, acc2x, acc2y, ma_x, ma_y
 
-    return rate
+DRIVEN_CORE = """
+phi1, phi2, omega1, omega2 = y[0], y[1], y[2], y[3]
+axs, ays, tau1, tau2 = u[4], u[5], u[6], u[7]
+s1 = sin(phi1)
+c1 = cos(phi1)
+s2 = sin(phi2)
+c2 = cos(phi2)
+q1 = tau1 - tau2 - fm1 * (c1 * axs + s1 * ays)
+q2 = tau2 - fm2 * (c2 * axs + s2 * ays)
+""", """
+fp_y = ma_y + weight
+tau = t - hold.t0
+p_input = tau1 * omega1 + tau2 * (omega2 - omega1) + ma_x * (u[2] + tau * axs) + (fp_y - weight) * (u[3] + tau * ays)
+"""
+"""The driven core around :data:`~double_pendulum.model.dynamics.LINK_ACCELERATIONS` and
+:data:`MOMENTUM_RATE`: the forcing (joint torques, fictitious forces of the pivot acceleration) and
+the input power (:func:`_input_powers` with both directions prescribed)."""
 
 
 def driven_core_vector_field(
@@ -408,7 +431,7 @@ def driven_core_vector_field(
     r"""Return ``f(t, y) -> dy/dt`` for ``y = [phi1, phi2, omega1, omega2, W_input]`` (fast path).
 
     The frictionless pendulum on a prescribed pivot, inputs ``hold.at(t)``: the angle equations of
-    :func:`~double_pendulum.model.dynamics.link_accelerations` with the generalised forces [N m]
+    :data:`~double_pendulum.model.dynamics.LINK_ACCELERATIONS` with the generalised forces [N m]
 
     .. math::
 
@@ -416,34 +439,24 @@ def driven_core_vector_field(
         Q_2 = \tau_2 - S_2(\cos\varphi_2 a_x + \sin\varphi_2 a_y)
 
     (joint torques and the fictitious forces of the pivot acceleration :math:`(a_x, a_y)` [m/s^2]),
-    and :math:`\dot W_{input}` [W] as in :func:`_input_powers` (:func:`_pivot_power` per direction):
-    the torques' power :math:`\tau_1\omega_1 + \tau_2(\omega_2 - \omega_1)` plus the pivot force
-    on the pendulum about its static value times the pivot velocity
-    :math:`(v_x, v_y)(t)` [m/s] (:meth:`InputHold.velocity_at`). The same equations as
-    :func:`build_evaluator` without mechanisms, to rounding, at a fraction of its cost.
+    and :math:`\dot W_{input}` [W] as in :func:`_input_powers`: the torques' power
+    :math:`\tau_1\omega_1 + \tau_2(\omega_2 - \omega_1)` plus the pivot force on the pendulum about
+    its static value (:data:`MOMENTUM_RATE`) times the pivot velocity :math:`(v_x, v_y)(t)` [m/s]
+    (:meth:`InputHold.velocity_at`). The same equations as :func:`build_evaluator` without
+    mechanisms, to rounding, as one frame of straight-line code (:data:`DRIVEN_CORE`). Built once
+    per scene: it reads the hold's values on every call, so :meth:`InputHold.reset` changes it.
     """
     lc = link_coefficients(params)
-    j1, j2, k, fm1, fm2, gs1, gs2 = lc.j1, lc.j2, lc.k, lc.s1, lc.s2, lc.gs1, lc.gs2
-    weight = lc.mass * params.g  # N, static pivot force
-    rate = _momentum_rate_function(params)
-    accel, sin, cos, power, velocity = link_accelerations, math.sin, math.cos, _pivot_power, hold.velocity_at
-    u = hold.values  # accelerations and torques are constant over the hold
-    apx, apy, tau1, tau2 = u.pivot_ax, u.pivot_ay, u.tau1, u.tau2
-    tau12 = tau1 - tau2
-
-    def vector_field(t: float, y: list[float]) -> list[float]:
-        phi1, phi2, w1, w2 = y[0], y[1], y[2], y[3]
-        s1, c1, s2, c2 = sin(phi1), cos(phi1), sin(phi2), cos(phi2)
-        q1 = tau12 - fm1 * (c1 * apx + s1 * apy)
-        q2 = tau2 - fm2 * (c2 * apx + s2 * apy)
-        alpha1, alpha2 = accel(phi1, phi2, w1, w2, j1, j2, k, gs1, gs2, q1, q2)
-        ma_x, ma_y = rate(apx, apy, c1, s1, c2, s2, w1, w2, alpha1, alpha2)[4:]
-        fp_y = ma_y + weight
-        vx, vy = velocity(t)
-        p_input = power(power(tau1 * w1 + tau2 * (w2 - w1), ma_x, vx), fp_y - weight, vy)
-        return [w1, w2, alpha1, alpha2, p_input]
-
-    return vector_field
+    constants = {
+        "j1": lc.j1, "j2": lc.j2, "k": lc.k, "gs1": lc.gs1, "gs2": lc.gs2, "fm1": lc.s1, "fm2": lc.s2,
+        "weight": lc.mass * params.g, "hold": hold, "u": hold.u, "sin": math.sin, "cos": math.cos,
+        **_momentum_constants(params),
+    }  # fmt: skip
+    forcing, power = DRIVEN_CORE
+    return compile_function(
+        "driven_core_vector_field", "t, y", [forcing, LINK_ACCELERATIONS, MOMENTUM_RATE, power],
+        "[omega1, omega2, alpha1, alpha2, p_input]", constants,
+    )  # fmt: skip
 
 
 def _input_powers(

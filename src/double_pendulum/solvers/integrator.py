@@ -14,6 +14,17 @@ order of the error estimate, never growing right after a rejection.
 A jump of the right-hand side (an FMU input changing at a communication point) is handled by
 :meth:`Integrator.restart`: the last step and its dense output are forgotten, the integration
 goes on from the given state with the new right-hand side and the current step size.
+
+**Short landing steps.** After such a jump the integrator must land on the next communication
+point (:meth:`Integrator.advance_to` with ``land=True``). When that point lies within the
+controller's next step, the step is short for the method (a 1 ms communication step against
+DOP853's 10 ms or so), and a method of lower order meets the same tolerance with fewer stages.
+A method may name such a ``landing_method`` (DOP853: the Dormand-Prince 5(4) pair, 7 evaluations
+instead of 12): the short step ``H`` is tried with it and accepted if its own error estimate meets
+``rtol``/``atol`` per unit step, ``err <= H / h`` with ``h`` the controller's step (so landing steps
+add no more error per second than the method's own steps would); otherwise it is taken with the
+method itself, and the landing method rests for the next :data:`LANDING_REST` short steps. The
+controller's step size is left as the method's own.
 """
 
 from __future__ import annotations
@@ -29,6 +40,8 @@ MAX_FACTOR = 10.0
 DEFAULT_MAX_STEPS_PER_CALL = 1_000_000
 # A step landing on a stop time may be stretched by this factor rather than leave a sliver.
 LANDING_SLACK = 1.01
+# Short landing steps the landing method skips after its error estimate failed once.
+LANDING_REST = 16
 
 
 class SolverError(RuntimeError):
@@ -36,7 +49,9 @@ class SolverError(RuntimeError):
 
 
 def _all_finite(values: list[float]) -> bool:
-    return all(math.isfinite(v) for v in values)
+    """True if every value is finite (a NaN or infinity anywhere makes the sum non-finite; a sum that
+    overflows from finite values, beyond 1e308, is taken as blown up too)."""
+    return math.isfinite(sum(values))
 
 
 class Integrator:
@@ -83,6 +98,9 @@ class Integrator:
         self.fy_prev = list(self.fy)
         self.stages: list[list[float]] = []
         self._interp = None
+        self.landing_method = getattr(method, "landing_method", None)
+        self.last_method = method  # the method of the last step (its dense output)
+        self.landing_rest = 0
         if method.adaptive:
             self.h = self._initial_step()
         else:
@@ -111,8 +129,34 @@ class Integrator:
         self.t_prev, self.y_prev, self.fy_prev = self.t, self.y, self.fy
         self.stages = stages
         self._interp = None
+        self.last_method = self.method
         self.y, self.fy = y_new, f_new
         self.n_steps += 1
+
+    def _short_landing(self, t_stop: float) -> bool:
+        """Try to reach ``t_stop`` [s] in one step of the landing method; True if accepted.
+
+        Only for a stop within the controller's next step (see the module docstring); the step size
+        ``self.h`` stays the method's own.
+        """
+        method, h = self.landing_method, t_stop - self.t
+        if method is None or h > self.h or h <= 0.0:
+            return False
+        if self.landing_rest > 0:
+            self.landing_rest -= 1
+            return False
+        self._complete_fy()
+        y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h)
+        self.nfev += method.evals_per_step
+        # error per unit step: no more error per second than the method's own steps of self.h would make
+        if not (method.error_norm(self.y, y_new, stages, h, self.rtol, self.atol) <= h / self.h and _all_finite(y_new)):
+            self.n_rejected += 1
+            self.landing_rest = LANDING_REST
+            return False
+        self._accept(h, y_new, f_new, stages)
+        self.last_method = method
+        self.t = t_stop
+        return True
 
     def _fixed_step(self) -> None:
         n = self.n_steps - self.grid_start + 1
@@ -194,18 +238,18 @@ class Integrator:
         evaluated anew. The step size (adaptive) and the counters carry over; the fixed-step grid
         restarts at ``t``.
         """
-        y = [float(v) for v in y]
+        y = list(map(float, y))
         if not _all_finite(y):
             raise SolverError(f"non-finite state {y} at t = {t:.6g} s")
         if f is not None:
             self.f = f
         self.t0 = self.t = self.t_prev = float(t)
-        self.y, self.y_prev = y, list(y)
-        self.fy = self.f(self.t, y)
-        self.fy_prev = list(self.fy)
+        self.y = self.y_prev = y  # states and derivatives are never changed in place
+        self.fy = self.fy_prev = self.f(self.t, y)
         self.nfev += 1
         self.stages = []
         self._interp = None
+        self.last_method = self.method
         self.grid_start = self.n_steps
 
     # ------------------------------------------------------------------ output
@@ -218,8 +262,12 @@ class Integrator:
         side evaluations (DOP853: 3). Otherwise stepping past ``t_out`` keeps the step sequence
         independent of the communication points.
         """
+        if self.t_prev < t_out < self.t and self._interp is not None:  # within the last step (as state_at)
+            return self._interp((t_out - self.t_prev) / (self.t - self.t_prev))
         if t_out < self.t_prev:
             raise SolverError(f"cannot return to t = {t_out:.9g} s: the integrator is at t = {self.t:.9g} s")
+        if land and self.t < t_out and self._short_landing(t_out):
+            return list(self.y)
         budget = self.max_steps_per_call
         while self.t < t_out:
             if budget == 0:
@@ -245,10 +293,10 @@ class Integrator:
         if self._interp is None:
             self._complete_fy()
             h = self.t - self.t_prev
-            self._interp = self.method.interpolant(
+            self._interp = self.last_method.interpolant(
                 self.f, self.t_prev, self.y_prev, self.y, self.fy_prev, self.fy, h, self.stages
             )
-            self.nfev += self.method.dense_evals
+            self.nfev += self.last_method.dense_evals
         return self._interp((t_out - self.t_prev) / (self.t - self.t_prev))
 
     # ------------------------------------------------------------------ state
@@ -266,11 +314,12 @@ class Integrator:
         "n_steps",
         "n_rejected",
         "grid_start",
+        "landing_rest",
     )
 
     def get_state(self) -> dict[str, Any]:
         """Return everything that determines the future steps, as JSON-serialisable data."""
-        return {
+        state = {
             name: (
                 [list(s) for s in value]
                 if name == "stages"
@@ -279,6 +328,8 @@ class Integrator:
             for name in self._STATE_FIELDS
             for value in [getattr(self, name)]
         }
+        state["landed"] = self.last_method is not self.method  # the last step was the landing method's
+        return state
 
     def set_state(self, state: dict[str, Any]) -> None:
         """Restore a state from :meth:`get_state`; later steps are bit-identical."""
@@ -289,4 +340,5 @@ class Integrator:
             elif isinstance(value, list):
                 value = list(value)
             setattr(self, name, value)
+        self.last_method = self.landing_method if state["landed"] else self.method
         self._interp = None

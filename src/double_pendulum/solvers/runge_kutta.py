@@ -26,9 +26,19 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from functools import partial
 
 from . import tableaus as tb
-from .combinations import alternating_horner, sparse, step_combination, weighted_sum
+from .combinations import (
+    alternating_horner,
+    dense_columns,
+    explicit_stages,
+    scaled_error_norm,
+    sparse,
+    step_combination,
+    two_estimate_error_norm,
+    weighted_sum,
+)
 
 VectorField = Callable[[float, list[float]], list[float]]
 SparseRows = Sequence[Sequence[tuple[int, float]]]
@@ -62,38 +72,33 @@ def _weighted_sum(ks: list[list[float]], weights: Sequence[float]) -> list[float
     return weighted_sum(sparse(weights), len(ks[0]))(ks)
 
 
-def _run_stages(
-    f: VectorField,
-    t: float,
-    y: list[float],
-    fy: list[float],
-    h: float,
-    a: SparseRows,
-    c: Sequence[float],
-    n_stages: int,
-) -> list[list[float]]:
-    """Evaluate the first ``n_stages`` stage derivatives ``k_0 = fy, k_1, ...``."""
-    stages = _stage_kernels(a, len(y))  # a is a module-level tableau
-    ks = [fy]
-    for i in range(1, n_stages):
-        ks.append(f(t + c[i] * h, stages[i](y, h, ks)))
-    return ks
+_TABLEAU_KERNELS: dict[tuple[int, int], Callable] = {}
 
 
-_KERNELS: dict[tuple[int, int], list] = {}
+def _tableau_kernel(key: object, n: int, build: Callable[[], Callable]) -> Callable:
+    """The compiled kernel of a *module-level constant* tableau ``key`` for state size ``n``, built once.
+
+    Cached by the constant's identity (a tableau lives as long as the module), so finding it costs
+    one small dict look-up, not the hash of a whole tableau.
+    """
+    kernel = _TABLEAU_KERNELS.get((id(key), n))
+    if kernel is None:
+        kernel = _TABLEAU_KERNELS[(id(key), n)] = build()
+    return kernel
 
 
-def _stage_kernels(a: SparseRows, n: int) -> list:
-    """Compiled ``y + h sum_j a_ij k_j`` for every row of tableau ``a`` and state size ``n`` (cached)."""
-    key = (id(a), n)
-    kernels = _KERNELS.get(key)
-    if kernels is None:
-        kernels = _KERNELS[key] = [step_combination(tuple(row), n) for row in a]
-    return kernels
+def _stages(a: SparseRows, c: Sequence[float], n_stages: int, b: SparseRows, n: int) -> Callable:
+    """:func:`~double_pendulum.solvers.combinations.explicit_stages` of a module-level tableau."""
+    return _tableau_kernel(a, n, lambda: explicit_stages(a, tuple(c), n_stages, b, n))
 
 
 _DOPRI5_B_ROW = sparse(tb.DOPRI5_B)
+_DOPRI5_E_ROW = sparse(tb.DOPRI5_E)
 _DOP853_B_ROW = sparse(tb.DOP853_B)
+_DOP853_E5_ROW = sparse(tb.DOP853_E5)
+_DOP853_E3_ROW = sparse(tb.DOP853_E3)
+_DOP853_EXTRA_STAGES = tuple((i, tuple(tb.DOP853_A[i]), tb.DOP853_C[i]) for i in (13, 14, 15))
+_DOP853_D_ROWS = tuple(sparse(row) for row in tb.DOP853_D)
 _RK4_B_ROW = sparse(tb.RK4_B)
 _DOPRI5_P_COLUMNS = tuple(tuple(row[k] for row in tb.DOPRI5_P) for k in range(len(tb.DOPRI5_P[0])))
 
@@ -119,15 +124,14 @@ class Dopri5:
     dense_evals = 0
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
-        ks = _run_stages(f, t, y, fy, h, tb.DOPRI5_A, tb.DOPRI5_C, 6)
-        y_new = _constant_kernel(_DOPRI5_B_ROW, len(y))(y, h, ks)
+        y_new, ks = _stages(tb.DOPRI5_A, tb.DOPRI5_C, 6, _DOPRI5_B_ROW, len(y))(f, t, y, fy, h)
         f_new = f(t + h, y_new)
         ks.append(f_new)
         return y_new, f_new, ks
 
     def error_norm(self, y, y_new, ks, h, rtol, atol) -> float:
-        err = _constant_kernel(tb.DOPRI5_E, len(y), dense_weights=True)(ks)
-        return scaled_rms([h * e for e in err], y, y_new, rtol, atol)
+        norm = _tableau_kernel(_DOPRI5_E_ROW, len(y), lambda: scaled_error_norm(_DOPRI5_E_ROW, len(y)))
+        return norm(y, y_new, ks, h, rtol, atol)
 
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):
         # y(t + theta h) = y + h * sum_k Q[:, k] theta^(k+1), Q = K^T P
@@ -151,6 +155,7 @@ class Dop853:
     evals_per_step = 12
     dense_evals = 3
     deferrable_f_new = True  # the error estimate does not use f(t + h, y_new)
+    landing_method = Dopri5()  # short landing steps (see double_pendulum.solvers.integrator)
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float, *, with_f_new: bool = True):
         """One step; ``with_f_new=False`` skips ``f(t + h, y_new)`` (returned as ``None``, not in the stages).
@@ -158,8 +163,7 @@ class Dop853:
         The caller then evaluates it when needed (next step, dense output) and appends it to the
         stages, or never, if the right-hand side changes at ``t + h`` (a restart).
         """
-        ks = _run_stages(f, t, y, fy, h, tb.DOP853_A, tb.DOP853_C, 12)
-        y_new = _constant_kernel(_DOP853_B_ROW, len(y))(y, h, ks)
+        y_new, ks = _stages(tb.DOP853_A, tb.DOP853_C, 12, _DOP853_B_ROW, len(y))(f, t, y, fy, h)
         if not with_f_new:
             return y_new, None, ks
         f_new = f(t + h, y_new)
@@ -167,38 +171,16 @@ class Dop853:
         return y_new, f_new, ks
 
     def error_norm(self, y, y_new, ks, h, rtol, atol) -> float:
-        err5 = _constant_kernel(tb.DOP853_E5, len(y), dense_weights=True)(ks)
-        err3 = _constant_kernel(tb.DOP853_E3, len(y), dense_weights=True)(ks)
-        n5 = n3 = 0.0
-        for e5, e3, u, v in zip(err5, err3, y, y_new):
-            s = atol + rtol * max(abs(u), abs(v))
-            n5 += (e5 / s) ** 2
-            n3 += (e3 / s) ** 2
-        if n5 == 0.0 and n3 == 0.0:
-            return 0.0
-        return abs(h) * n5 / math.sqrt((n5 + 0.01 * n3) * len(y))
+        n = len(y)
+        norm = _tableau_kernel(tb.DOP853_E5, n, lambda: two_estimate_error_norm(_DOP853_E5_ROW, _DOP853_E3_ROW, n))
+        return norm(y, y_new, ks, h, rtol, atol)
 
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):
-        ks = list(ks)
-        for i in (13, 14, 15):
-            ks.append(f(t + tb.DOP853_C[i] * h, _constant_kernel(tb.DOP853_A[i], len(y))(y, h, ks)))
-        dy = [v - u for u, v in zip(y, y_new)]
-        coeffs = [
-            dy,
-            [h * a - d for a, d in zip(fy, dy)],
-            [2.0 * d - h * (a + b) for d, a, b in zip(dy, fy, f_new)],
-        ]
-        for row in tb.DOP853_D:
-            coeffs.append([h * v for v in _constant_kernel(row, len(y), dense_weights=True)(ks)])
-        coeffs.reverse()
-        columns = list(zip(*coeffs))  # per component: its 7 coefficients, highest first
-        horner = alternating_horner(len(y), len(coeffs))
-
-        def evaluate(theta: float) -> list[float]:
-            # y + F0 x + F1 x(1-x) + F2 x^2(1-x) + ..., Horner-like with factors alternating x and 1-x
-            return horner(theta, columns, y)
-
-        return evaluate
+        n = len(y)
+        dense = _tableau_kernel(tb.DOP853_D, n, lambda: dense_columns(_DOP853_EXTRA_STAGES, _DOP853_D_ROWS, n))
+        columns = dense(f, t, y, y_new, fy, f_new, h, ks)  # per component: its 7 coefficients, highest first
+        # y + F0 x + F1 x(1-x) + F2 x^2(1-x) + ..., Horner-like with factors alternating x and 1-x
+        return partial(alternating_horner(n, 7), columns, y)
 
 
 class ClassicRK4:
@@ -213,8 +195,7 @@ class ClassicRK4:
     dense_evals = 0
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
-        ks = _run_stages(f, t, y, fy, h, tb.RK4_A, tb.RK4_C, 4)
-        y_new = _constant_kernel(_RK4_B_ROW, len(y))(y, h, ks)
+        y_new, ks = _stages(tb.RK4_A, tb.RK4_C, 4, _RK4_B_ROW, len(y))(f, t, y, fy, h)
         return y_new, f(t + h, y_new), ks
 
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):

@@ -1,0 +1,107 @@
+"""Build the FMI 3.0 ``DoublePendulum.fmu`` (Model Exchange and Co-Simulation) with pythonfmu3.
+
+The adapter ``fmu_src/DoublePendulumFmi3.py`` maps the FMI 3 calls onto the same component as the
+FMI 2 FMU (Co-Simulation) and onto the runtime's vector field (Model Exchange,
+``double_pendulum.component.model_exchange``); the runtime is bundled as for FMI 2
+(:mod:`double_pendulum.fmu.build`), with pythonfmu3's Python part imported under a private name.
+The build then
+
+* adds ``UnitDefinitions`` for the units the adapter gives its Float64 variables;
+* writes ``ModelStructure`` anew: every output (its direct dependencies on the inputs and, for
+  Model Exchange, on the continuous states), every state derivative, and as initial unknowns the
+  outputs, the derivatives and the states computed at initialisation, so that
+  ``fmpy.validation.validate_fmu`` reports no problems;
+* on Linux makes the FMU's binary the FMI 3 loader (``fmu_src/loader/fmi3_loader.c``), with
+  pythonfmu3's library beside it, records the building CPython, and writes ``resources/bundle.json``.
+"""
+
+from __future__ import annotations
+
+import shutil
+import tempfile
+from pathlib import Path
+from xml.etree import ElementTree as ET
+
+from ..component.variables import INTERFACES, MODEL_IDENTIFIER
+from .build import (
+    _adapters_dir,
+    _copy_runtime,
+    builder_imports_forgotten,
+    check_platform_binary,
+    rewrite_fmu,
+    unit_definitions,
+)
+
+DEFAULT_FMU3_PATH = Path("build") / "fmi3" / f"{MODEL_IDENTIFIER}.fmu"
+ADAPTER = "DoublePendulumFmi3.py"  # the pythonfmu3 class DoublePendulum
+SHARED = ("slave_common.py",)  # bundled beside it
+
+
+def adapter_sources() -> list[Path]:
+    """The FMI 3 adapter and the modules it shares (in the installed ``double_pendulum.adapters``)."""
+    folder = _adapters_dir()
+    return [folder / ADAPTER, *(folder / name for name in SHARED)]
+
+
+def complete_model_description_fmi3(xml_text: bytes) -> bytes:
+    """Add unit definitions and write the ModelStructure of a pythonfmu3 modelDescription."""
+    interface = INTERFACES[MODEL_IDENTIFIER]
+    root = ET.fromstring(xml_text)
+    variables = list(root.find("ModelVariables"))
+    units = [v.get("unit") for v in variables if v.get("unit")]
+    last_interface = max(i for i, e in enumerate(root) if e.tag in ("ModelExchange", "CoSimulation"))
+    for old in root.findall("UnitDefinitions"):
+        root.remove(old)
+    root.insert(last_interface + 1, unit_definitions(units))
+
+    reference = {v.get("name"): v.get("valueReference") for v in variables}
+    states = [v.get("derivative") for v in variables if v.get("derivative") is not None]
+    structure = root.find("ModelStructure")
+    for old in list(structure):
+        structure.remove(old)
+    for v in variables:
+        if v.get("causality") != "output":
+            continue
+        own = reference[v.get("name")]
+        inputs = [reference[name] for name in interface.output_dependencies.get(v.get("name"), ())]
+        knowns = [own] if own in states else states  # a state output is its state
+        ET.SubElement(structure, "Output", valueReference=own,
+                      dependencies=" ".join(sorted(set(inputs + knowns), key=int)))
+    for v in variables:
+        if v.get("derivative") is not None:
+            ET.SubElement(structure, "ContinuousStateDerivative", valueReference=v.get("valueReference"))
+    for v in variables:
+        if v.get("initial") in ("approx", "calculated") and v.get("causality") in ("output", "local"):
+            ET.SubElement(structure, "InitialUnknown", valueReference=v.get("valueReference"))
+    ET.indent(root, space="  ")
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH) -> Path:
+    """Build the FMI 3.0 ``DoublePendulum`` FMU at ``dest`` (a ``.fmu`` path or a folder); return its path.
+
+    Written to a temporary folder first and moved into place at the end, so a failed build never
+    leaves a broken FMU behind.
+    """
+    from pythonfmu3.builder import FmuBuilder
+
+    dest = Path(dest)
+    fmu_path = dest if dest.suffix == ".fmu" else dest / f"{MODEL_IDENTIFIER}.fmu"
+    fmu_path.parent.mkdir(parents=True, exist_ok=True)
+    adapter, *shared = adapter_sources()
+    with tempfile.TemporaryDirectory(prefix="dp_fmu3_build_") as tmp:
+        tmp_dir = Path(tmp)
+        with builder_imports_forgotten():
+            built = Path(FmuBuilder.build_FMU(
+                adapter,
+                dest=tmp_dir / "out",
+                project_files=[_copy_runtime(tmp_dir), *shared],
+                canGetAndSetFMUState=True,
+                canSerializeFMUState=True,
+                canHandleVariableCommunicationStepSize=True,
+                needsCompletedIntegratorStep=False,
+            ))
+        rewrite_fmu(built, MODEL_IDENTIFIER, complete_model_description_fmi3, fmi_version=3, adapter=ADAPTER)
+        check_platform_binary(built, MODEL_IDENTIFIER, fmi_version=3)
+        shutil.move(str(built), fmu_path)
+    return fmu_path

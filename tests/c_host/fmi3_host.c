@@ -1,0 +1,251 @@
+/* A minimal FMI 3.0 host in C, for the tests (tests/test_fmi3_c_host.py): no Python in it.
+ *
+ *   fmi3_host DIR IDENTIFIER TOKEN METHOD STEPS STEP_SIZE [ARG ...]
+ *
+ * DIR is an extracted FMU; the host dlopens DIR/binaries/x86_64-linux/IDENTIFIER.so and runs it from
+ * t = 0 over STEPS steps of STEP_SIZE, then reads the outputs, terminates, frees the instance and
+ * unloads the library. METHOD:
+ *   euler, rk4  Model Exchange, integrated by the host with explicit Euler or classical RK4, with
+ *               event handling as the FMI 3.0 standard describes it (section 3.2): after every step
+ *               fmi3CompletedIntegratorStep; Event Mode on its request, on a time event
+ *               (nextEventTime), on a sign change of an event indicator (located to the step's end)
+ *               or on an input jump (ARG j:); there fmi3UpdateDiscreteStates until it needs no
+ *               further update, the states read again if it changed them; every derivative is
+ *               evaluated after fmi3SetTime, the inputs and fmi3SetContinuousStates;
+ *   cs          Co-Simulation: fmi3DoStep every step.
+ * Like a strict host it initialises every out-argument to a value that would make it go wrong if
+ * the FMU did not write it: discreteStatesNeedUpdate = true and nextEventTime = +inf in Event
+ * Mode (an unwritten flag iterates until the host gives up after MAX_ITERATIONS), earlyReturn =
+ * true and lastSuccessfulTime = NaN in fmi3DoStep.
+ * ARGs: r:VR=VALUE (Float64 start value), b:VR=0|1 (Boolean), s:VR=TEXT (String), i:VR=VALUE (input,
+ * continuous: set before every evaluation), j:VR=VALUE@T (that input jumps to VALUE at the step end
+ * nearest T, in Event Mode), o:VR (Float64 read at the end, printed as "VR VALUE" with 17 digits).
+ * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE". At the end it prints "events N",
+ * "event-iterations N", "derivative-evaluations N" and "host-unchanged 1" if its environment and
+ * signal handlers are as before it loaded the FMU. Exit status: 0 on success, 2 bad usage, 3 library
+ * not loaded, 4 instantiation failed, 5 a call failed, 6 an event iteration did not end, 7 the FMU
+ * asked to terminate. */
+#include <dlfcn.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fmi3Functions.h"
+#include "host_common.h"
+
+#define MAX_STATES 64
+#define MAX_ITERATIONS 100
+
+static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String category, fmi3String message) {
+    (void)env;
+    printf("log %d %s: %s\n", (int)status, category ? category : "", message ? message : "");
+    fflush(stdout);
+}
+
+static void *library;
+
+#define FUNCTION(name) name##TYPE *name = (name##TYPE *)symbol(library, #name)
+
+/* The host's inputs: continuous values, and jumps in Event Mode. */
+static fmi3ValueReference inputs[MAX_ARGS], jumps[MAX_ARGS];
+static fmi3Float64 input_values[MAX_ARGS], jump_values[MAX_ARGS], jump_times[MAX_ARGS];
+static size_t n_inputs, n_jumps;
+static long evaluations;
+
+/* der(x) at (t, x): fmi3SetTime, inputs, fmi3SetContinuousStates, fmi3GetContinuousStateDerivatives
+ * (dx NULL: only set time, inputs and states). */
+static fmi3Status derivatives(fmi3Instance c, fmi3Float64 t, const fmi3Float64 x[], fmi3Float64 dx[], size_t n) {
+    FUNCTION(fmi3SetTime);
+    FUNCTION(fmi3SetFloat64);
+    FUNCTION(fmi3SetContinuousStates);
+    FUNCTION(fmi3GetContinuousStateDerivatives);
+    fmi3Status status = fmi3SetTime(c, t);
+    if (status <= fmi3Warning && n_inputs) status = fmi3SetFloat64(c, inputs, n_inputs, input_values, n_inputs);
+    if (status <= fmi3Warning) status = fmi3SetContinuousStates(c, x, n);
+    if (status <= fmi3Warning && dx) {
+        status = fmi3GetContinuousStateDerivatives(c, dx, n);
+        evaluations++;
+    }
+    return status;
+}
+
+/* Event Mode at the current instant: fmi3UpdateDiscreteStates until no further update is needed. */
+static int event_iteration(fmi3Instance c, fmi3Float64 x[], size_t n, long *iterations, int *next_defined,
+                           double *next_time) {
+    FUNCTION(fmi3UpdateDiscreteStates);
+    FUNCTION(fmi3GetContinuousStates);
+    for (int k = 0; k < MAX_ITERATIONS; k++) {
+        fmi3Boolean need = fmi3True, terminate = fmi3False, nominals = fmi3False, values = fmi3False;
+        fmi3Boolean defined = fmi3False;
+        fmi3Float64 next = INFINITY;
+        CHECK(fmi3UpdateDiscreteStates(c, &need, &terminate, &nominals, &values, &defined, &next));
+        (*iterations)++;
+        if (values && n) CHECK(fmi3GetContinuousStates(c, x, n));
+        *next_defined = defined;
+        *next_time = next;
+        if (terminate) return 7;
+        if (!need) return 0;
+    }
+    fprintf(stderr, "the event iteration did not end after %d fmi3UpdateDiscreteStates\n", MAX_ITERATIONS);
+    return 6;
+}
+
+static int run_model_exchange(fmi3Instance c, int rk4, long steps, double h, long *events, long *iterations) {
+    FUNCTION(fmi3EnterEventMode);
+    FUNCTION(fmi3EnterContinuousTimeMode);
+    FUNCTION(fmi3GetContinuousStates);
+    FUNCTION(fmi3GetNumberOfContinuousStates);
+    FUNCTION(fmi3GetNumberOfEventIndicators);
+    FUNCTION(fmi3GetEventIndicators);
+    FUNCTION(fmi3CompletedIntegratorStep);
+    FUNCTION(fmi3SetFloat64);
+    size_t n = 0, nz = 0;
+    CHECK(fmi3GetNumberOfContinuousStates(c, &n));
+    CHECK(fmi3GetNumberOfEventIndicators(c, &nz));
+    if (n > MAX_STATES || nz > MAX_STATES) return 5;
+    fmi3Float64 x[MAX_STATES], k1[MAX_STATES], k2[MAX_STATES], k3[MAX_STATES], k4[MAX_STATES], y[MAX_STATES];
+    fmi3Float64 z[MAX_STATES], z_new[MAX_STATES];
+    int next_defined = 0, status;
+    double next_time = INFINITY;
+    /* after fmi3ExitInitializationMode the instance is in Event Mode */
+    if ((status = event_iteration(c, x, 0, iterations, &next_defined, &next_time))) return status;
+    CHECK(fmi3EnterContinuousTimeMode(c));
+    CHECK(fmi3GetContinuousStates(c, x, n));
+    if (nz) CHECK(fmi3GetEventIndicators(c, z, nz));
+    for (long step = 0; step < steps; step++) {
+        double t = step * h, t_end = (step + 1) * h;
+        CHECK(derivatives(c, t, x, k1, n));
+        if (rk4) {
+            for (size_t i = 0; i < n; i++) y[i] = x[i] + 0.5 * h * k1[i];
+            CHECK(derivatives(c, t + 0.5 * h, y, k2, n));
+            for (size_t i = 0; i < n; i++) y[i] = x[i] + 0.5 * h * k2[i];
+            CHECK(derivatives(c, t + 0.5 * h, y, k3, n));
+            for (size_t i = 0; i < n; i++) y[i] = x[i] + h * k3[i];
+            CHECK(derivatives(c, t_end, y, k4, n));
+            for (size_t i = 0; i < n; i++) x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        } else {
+            for (size_t i = 0; i < n; i++) x[i] += h * k1[i];
+        }
+        /* the step's end: time, inputs (left limit) and states set, then the step completed */
+        CHECK(derivatives(c, t_end, x, NULL, n));
+        fmi3Boolean step_event = fmi3True, terminate = fmi3True;
+        CHECK(fmi3CompletedIntegratorStep(c, fmi3True, &step_event, &terminate));
+        if (terminate) break;
+        int state_event = 0;
+        if (nz) {
+            CHECK(fmi3GetEventIndicators(c, z_new, nz));
+            for (size_t i = 0; i < nz; i++) state_event |= (z[i] > 0) != (z_new[i] > 0);
+        }
+        int input_event = 0;
+        for (size_t k = 0; k < n_jumps; k++) input_event |= fabs(jump_times[k] - t_end) < 0.5 * h;
+        int time_event = next_defined && next_time <= t_end + 1e-12 * (1.0 + fabs(t_end));
+        if (step_event || state_event || input_event || time_event) {
+            (*events)++;
+            CHECK(fmi3EnterEventMode(c));
+            for (size_t k = 0; k < n_jumps; k++) /* the right limit of a jump, set in Event Mode */
+                if (fabs(jump_times[k] - t_end) < 0.5 * h) {
+                    for (size_t i = 0; i < n_inputs; i++)
+                        if (inputs[i] == jumps[k]) input_values[i] = jump_values[k];
+                    CHECK(fmi3SetFloat64(c, &jumps[k], 1, &jump_values[k], 1));
+                }
+            if ((status = event_iteration(c, x, n, iterations, &next_defined, &next_time))) return status;
+            CHECK(fmi3EnterContinuousTimeMode(c));
+        }
+        if (nz) CHECK(fmi3GetEventIndicators(c, z, nz));
+    }
+    return 0;
+}
+
+static int run_co_simulation(fmi3Instance c, long steps, double h) {
+    FUNCTION(fmi3DoStep);
+    FUNCTION(fmi3SetFloat64);
+    for (long step = 0; step < steps; step++) {
+        if (n_inputs) CHECK(fmi3SetFloat64(c, inputs, n_inputs, input_values, n_inputs));
+        fmi3Boolean event = fmi3True, terminate = fmi3True, early = fmi3True;
+        fmi3Float64 reached = NAN;
+        CHECK(fmi3DoStep(c, step * h, (step + 1) * h - step * h, fmi3True, &event, &terminate, &early, &reached));
+        if (early || terminate || reached != (step + 1) * h) {
+            fprintf(stderr, "fmi3DoStep at t = %g: earlyReturn %d, terminateSimulation %d, lastSuccessfulTime %g\n",
+                    step * h, (int)early, (int)terminate, reached);
+            return 5;
+        }
+    }
+    return 0;
+}
+
+int main(int argc, char **argv) {
+    if (argc < 7) {
+        fprintf(stderr, "usage: %s DIR IDENTIFIER TOKEN euler|rk4|cs STEPS STEP_SIZE [ARG ...]\n", argv[0]);
+        return 2;
+    }
+    const char *dir = argv[1], *identifier = argv[2], *token = argv[3], *method = argv[4];
+    long steps = atol(argv[5]);
+    double h = atof(argv[6]);
+    int cs = strcmp(method, "cs") == 0, rk4 = strcmp(method, "rk4") == 0;
+    if (!cs && !rk4 && strcmp(method, "euler") != 0) return 2;
+    char path[4096], resources[4200];
+    snprintf(path, sizeof path, "%s/binaries/x86_64-linux/%s.so", dir, identifier);
+    snprintf(resources, sizeof resources, "%s/resources/", dir);
+
+    static host_state before, after;
+    snapshot(&before);
+    library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!library) {
+        fprintf(stderr, "cannot load %s: %s\n", path, dlerror());
+        return 3;
+    }
+    FUNCTION(fmi3InstantiateModelExchange);
+    FUNCTION(fmi3InstantiateCoSimulation);
+    FUNCTION(fmi3FreeInstance);
+    FUNCTION(fmi3EnterInitializationMode);
+    FUNCTION(fmi3ExitInitializationMode);
+    FUNCTION(fmi3SetFloat64);
+    FUNCTION(fmi3SetBoolean);
+    FUNCTION(fmi3SetString);
+    FUNCTION(fmi3GetFloat64);
+    FUNCTION(fmi3Terminate);
+    fmi3Instance c = cs ? fmi3InstantiateCoSimulation("host", token, resources, fmi3False, fmi3False, fmi3False,
+                                                      fmi3False, NULL, 0, NULL, logger, NULL)
+                        : fmi3InstantiateModelExchange("host", token, resources, fmi3False, fmi3False, NULL, logger);
+    if (!c) {
+        fprintf(stderr, "fmi3Instantiate%s returned NULL\n", cs ? "CoSimulation" : "ModelExchange");
+        return 4;
+    }
+
+    fmi3ValueReference outputs[MAX_ARGS];
+    size_t n_outputs = 0;
+    for (int k = 7; k < argc && n_inputs < MAX_ARGS && n_jumps < MAX_ARGS && n_outputs < MAX_ARGS; k++) {
+        host_argument a;
+        if (!parse_argument(argv[k], &a)) {
+            fprintf(stderr, "bad argument %s\n", argv[k]);
+            return 2;
+        }
+        fmi3ValueReference vr = a.vr;
+        fmi3Boolean boolean = atoi(a.text) ? fmi3True : fmi3False;
+        if (a.kind == 'o') outputs[n_outputs++] = vr;
+        else if (a.kind == 'r') CHECK(fmi3SetFloat64(c, &vr, 1, &a.real, 1));
+        else if (a.kind == 'b') CHECK(fmi3SetBoolean(c, &vr, 1, &boolean, 1));
+        else if (a.kind == 's') CHECK(fmi3SetString(c, &vr, 1, &a.text, 1));
+        else if (a.kind == 'i') inputs[n_inputs] = vr, input_values[n_inputs++] = a.real;
+        else jumps[n_jumps] = vr, jump_values[n_jumps] = a.real, jump_times[n_jumps++] = a.at;
+    }
+
+    CHECK(fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3True, steps * h));
+    if (n_inputs) CHECK(fmi3SetFloat64(c, inputs, n_inputs, input_values, n_inputs));
+    CHECK(fmi3ExitInitializationMode(c));
+    long events = 0, iterations = 0;
+    int status = cs ? run_co_simulation(c, steps, h) : run_model_exchange(c, rk4, steps, h, &events, &iterations);
+    if (status) return status;
+    fmi3Float64 values[MAX_ARGS];
+    if (n_outputs) CHECK(fmi3GetFloat64(c, outputs, n_outputs, values, n_outputs));
+    for (size_t k = 0; k < n_outputs; k++) printf("%u %.17g\n", outputs[k], values[k]);
+    CHECK(fmi3Terminate(c));
+    fmi3FreeInstance(c);
+    dlclose(library);
+    snapshot(&after);
+    printf("events %ld\nevent-iterations %ld\nderivative-evaluations %ld\n", events, iterations, evaluations);
+    printf("host-unchanged %d\n", unchanged(&before, &after));
+    return 0;
+}

@@ -1,0 +1,81 @@
+/* What the tests' C hosts (fmi2_host.c, fmi3_host.c) share: a record of the host's environment and
+ * signal handlers, to show that the FMU left them as it found them; symbol lookup; the check of an
+ * FMI call's status (fmi2Warning and fmi3Warning are both 1). */
+#ifndef HOST_COMMON_H
+#define HOST_COMMON_H
+
+#include <dlfcn.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_ARGS 128
+
+extern char **environ;
+static const int SIGNALS[] = {SIGINT, SIGTERM, SIGPIPE, SIGCHLD, SIGXFSZ, SIGSEGV};
+#define N_SIGNALS (sizeof SIGNALS / sizeof SIGNALS[0])
+
+/* The environment and the handlers of SIGNALS, as one comparable record. */
+typedef struct {
+    char environment[65536];
+    struct sigaction actions[N_SIGNALS];
+} host_state;
+
+static void snapshot(host_state *state) {
+    memset(state, 0, sizeof *state);
+    for (char **e = environ; *e; e++) {
+        strncat(state->environment, *e, sizeof state->environment - strlen(state->environment) - 2);
+        strcat(state->environment, "\n");
+    }
+    for (size_t k = 0; k < N_SIGNALS; k++) sigaction(SIGNALS[k], NULL, &state->actions[k]);
+}
+
+static int unchanged(const host_state *before, const host_state *after) {
+    if (strcmp(before->environment, after->environment) != 0) return 0;
+    for (size_t k = 0; k < N_SIGNALS; k++)
+        if (before->actions[k].sa_handler != after->actions[k].sa_handler) return 0;
+    return 1;
+}
+
+/* A function of the FMU's library; a missing one ends the host with exit status 3. */
+static void *symbol(void *library, const char *name) {
+    void *f = dlsym(library, name);
+    if (!f) {
+        fprintf(stderr, "missing %s\n", name);
+        exit(3);
+    }
+    return f;
+}
+
+/* One argument of a host: K:VR=VALUE (K: r Float64/Real start value, b Boolean 0|1, s String, i input),
+ * j:VR=VALUE@T (an input's jump at T, FMI 3 host only) or o:VR (an output to print). */
+typedef struct {
+    char kind;
+    unsigned int vr;
+    double real; /* VALUE as a number */
+    const char *text; /* VALUE as text */
+    double at;   /* T of a jump */
+} host_argument;
+
+/* Parse `text` into `a`; 0 if it is malformed. */
+static int parse_argument(const char *text, host_argument *a) {
+    const char *value = strchr(text, '='), *at = value ? strchr(value, '@') : NULL;
+    *a = (host_argument){text[0], (unsigned int)strtoul(text + 2, NULL, 10), value ? atof(value + 1) : 0.0,
+                         value ? value + 1 : "", at ? atof(at + 1) : 0.0};
+    if (text[1] != ':') return 0;
+    if (a->kind == 'o') return 1;
+    return value && strchr("rbsij", a->kind) && (a->kind != 'j' || at);
+}
+
+/* Return 5 from the calling function if an FMI call fails (a status above Warning). */
+#define CHECK(call)                                                                                               \
+    do {                                                                                                          \
+        int status_ = (int)(call);                                                                                \
+        if (status_ > 1) {                                                                                        \
+            fprintf(stderr, "%s failed with status %d\n", #call, status_);                                       \
+            return 5;                                                                                             \
+        }                                                                                                         \
+    } while (0)
+
+#endif
