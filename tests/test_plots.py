@@ -6,7 +6,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pytest
 
-from double_pendulum.plots import decay, style, suspension, trajectories
+from double_pendulum.plots import chaos, decay, style, suspension, trajectories
 
 
 @pytest.fixture
@@ -16,6 +16,7 @@ def captured(monkeypatch):
     monkeypatch.setattr(decay, "save", lambda fig, path: figures.append(fig) or path)
     monkeypatch.setattr(suspension, "save", lambda fig, path: figures.append(fig) or path)
     monkeypatch.setattr(trajectories, "save", lambda fig, path: figures.append(fig) or path)
+    monkeypatch.setattr(chaos, "save", lambda fig, path: figures.append(fig) or path)
     yield figures
     plt.close("all")
 
@@ -130,3 +131,38 @@ def test_figures_ask_for_no_font_the_machine_lacks(tmp_path, monkeypatch, caplog
         font_manager.FontManager._findfont_cached.cache_clear()
     assert [r.getMessage() for r in caplog.records if "findfont" in r.getMessage()] == []
     assert (tmp_path / "math.png").stat().st_size > 1000
+
+
+def test_a_decay_rate_map_within_one_decade_of_k_still_numbers_its_k_axis(captured):
+    k, c = np.array([2e4, 8e4]), np.array([5.0, 200.0])  # the quick run's map: no power of ten inside
+    panel = {"k": k, "c": c, "b": -0.02 - 1e-3 * np.outer(np.ones(2), np.log(c)), "m_s": 2.0}
+    suspension.plot_decay_rate_map({"M_s = 2 kg": panel}, {"measured": -0.023}, "unused.png")
+    ax = next(ax for ax in captured[0].axes if ax.get_title().startswith("M_s"))
+    captured[0].canvas.draw()
+    labels = [tick.get_text() for tick in ax.get_xticklabels() if k[0] <= tick.get_position()[0] <= k[-1]]
+    assert "20000" in labels and "50000" in labels
+
+
+def test_the_lyapunov_convergence_puts_its_long_labels_below_the_axes(captured):
+    t = np.linspace(0.5, 100.0, 50)
+    label = "integration {}, mean of 32 starts within 5 mm of the default start"
+    curves = {label.format(i): (t, 1.0 + i / t) for i in range(3)}
+    chaos.plot_lyapunov_convergence(curves, "unused.png", title="default start")
+    fig = captured[0]
+    assert fig.axes[0].get_legend() is None and len(fig.legends) == 1  # not beside the axes, taking their room
+    fig.canvas.draw()
+    legend, axes = fig.legends[0].get_window_extent(), fig.axes[0].get_window_extent()
+    assert legend.y1 <= axes.y0  # below the axes, over no data
+
+
+def test_angles_say_they_are_unwrapped(captured):
+    t = np.linspace(0.0, 1.0, 11)
+    run = np.zeros(11, dtype=[("time", float), ("phi1", float), ("phi2", float)])
+    run["time"], run["phi2"] = t, 20.0 * t  # a lower rod turning over
+    trajectories.plot_angles({"chaotic": run}, "unused.png")
+    ax = captured[0].axes[0]
+    assert "unwrapped" in ax.get_title() and "unwrapped" in ax.get_ylabel() and "[rad]" in ax.get_ylabel()
+
+
+def test_quick_figures_are_drawn_at_a_readable_resolution():
+    assert style.DRAFT_DPI >= 100  # at 60 dpi their text was a few pixels high
