@@ -4,7 +4,8 @@ Usage: ``python benchmarks/batch_vs_c.py [--batch 10000] [--steps 500] [--repeat
 
 Both integrate the same batch (seeded random release angles in (-pi, pi)^2 from rest, the seed
 pendulum, h = 1 ms) with the classic RK4 in the same stage order: the batch integrator
-(:func:`double_pendulum.analysis.ensemble.rk4_step` on :func:`double_pendulum.analysis.ensemble.pendulum_field`,
+(:func:`double_pendulum.analysis.chaos.ensemble.rk4_step` on
+:func:`~double_pendulum.analysis.chaos.ensemble.pendulum_field`,
 vectorised over the batch) and a plain C loop over trajectories and steps, compiled at run time
 with the system ``cc -O2`` into a temporary folder and called through ctypes. The C source
 restates the equations of :mod:`double_pendulum.model.dynamics` only for this comparison; the script
@@ -27,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from double_pendulum.analysis.chaos import flip_time_map
-from double_pendulum.analysis.ensemble import initial_states, pendulum_field, rk4_step
+from double_pendulum.analysis.chaos.ensemble import initial_states, pendulum_field, rk4_step
+from double_pendulum.analysis.chaos.flips import flip_time_map
 from double_pendulum.model.parameters import PendulumParameters
 
 C_SOURCE = r"""

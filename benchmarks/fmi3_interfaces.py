@@ -6,7 +6,7 @@ Usage: ``python benchmarks/fmi3_interfaces.py [--repeats 3]``
    phi1 = phi2 = 2 rad for 2 s, output every 10 ms, both through fmpy: Model Exchange integrated by
    fmpy's CVode (BDF, relative tolerance r, absolute r x the nominal 1) and Co-Simulation (the
    FMU's own dop853, rtol r, atol r / 1000). Error: the larger angle error at t = 2 s against the
-   cached reference (``double_pendulum.analysis.reference``). For each target error the loosest
+   cached reference (``double_pendulum.analysis.solvers.reference``). For each target error the loosest
    tolerance that reaches it, its CPU time, and the cost ratio ME / CS.
 2. **The pendulum on its suspension: monolithic ME against split CS.** The default suspension
    (M_s = 2 kg, k = 2e4 N/m, c = 20 N s/m) with phi1 = phi2 = 1 rad for 1 s: the FMI 3 FMU with
@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
 
-from double_pendulum.analysis.reference import reference_solution
+from double_pendulum.analysis.solvers.reference import reference_solution
 from double_pendulum.fmu.build import build_fmu
 from double_pendulum.fmu.build_fmi3 import build_fmu3
 from double_pendulum.fmu.coupling import FmuSlave, run_coupled, split_values

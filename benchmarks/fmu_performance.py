@@ -32,7 +32,7 @@ from pathlib import Path
 
 import numpy as np
 
-from double_pendulum.analysis.reference import STATE_OUTPUTS, reference_solution
+from double_pendulum.analysis.solvers.reference import STATE_OUTPUTS, reference_solution
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.fmu.runner import FmuRunner, ensure_fmu
 

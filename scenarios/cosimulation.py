@@ -4,8 +4,8 @@ Runs the monolith (reference) and the split system (in-process Jacobi, linear ex
 iterative coupling with rollback; libcosim on the SSP file; fmpy's container FMU) over macro steps
 from 1e-4 s to 2e-2 s for a regular and a chaotic start and two suspensions, and maps where Jacobi
 coupling stays bounded over mass ratio and h omega against the derived added-mass limit
-(analysis: :mod:`~double_pendulum.analysis.cosimulation`,
-:mod:`~double_pendulum.analysis.coupling_stability`; figures: :mod:`~double_pendulum.plots.coupling`).
+(analysis: :mod:`~double_pendulum.analysis.coupling.cosimulation`,
+:mod:`~double_pendulum.analysis.coupling.stability`; figures: :mod:`~double_pendulum.plots.coupling`).
 
 Outputs in ``results/cosimulation/``: ``runs.csv``, ``stability_map.csv``, ``error_vs_macro_step.png``,
 ``error_vs_cpu_time.png``, ``coupling_energy.png``, ``stability_map.png``, ``summary.json``, ``report.md``.
@@ -28,9 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from double_pendulum.analysis import cosimulation as study
-from double_pendulum.analysis.cosimulation_report import report_text
-from double_pendulum.analysis.coupling_stability import critical_mass_ratio
+from double_pendulum.analysis.coupling import cosimulation as study
+from double_pendulum.analysis.coupling.report import report_text
+from double_pendulum.analysis.coupling.stability import critical_mass_ratio
 from double_pendulum.analysis.sweep import parallel_map
 from double_pendulum.fmu.build import build_fmu
 from double_pendulum.fmu.runner import FmuRunner

@@ -10,7 +10,7 @@ section 4.2, with the package's own energy function. Outputs in ``results/energy
 - ``summary.json``: pivot, rod lengths, the exponential fit ``a_J``, ``b_per_s`` with errors, the
   model comparison (AIC/BIC), the same fit with other weights, the seed's numbers, and the error
   budget of a and b (``error_budget``: statistical and systematic rows, totals ``total_a_J``,
-  ``total_b_per_s``; :mod:`double_pendulum.analysis.decay_error_budget`);
+  ``total_b_per_s``; :mod:`double_pendulum.analysis.decay.error_budget`);
 - ``report.md``: the figures and why they differ from the seed's a = 0.813 J, b = -0.024 1/s.
 
 The runner argument of :func:`run` is not used, nor is ``quick`` (the analysis takes about a second).
@@ -24,10 +24,10 @@ from typing import Any
 import numpy as np
 
 from double_pendulum import plots
-from double_pendulum.analysis.decay_error_budget import error_budget
-from double_pendulum.analysis.decay_fit import SEED_FIT, FitResult, calibrate_error_model, comparison_table, fit_all
-from double_pendulum.analysis.decay_report import report_text
-from double_pendulum.analysis.decay_summary import (
+from double_pendulum.analysis.decay.error_budget import error_budget
+from double_pendulum.analysis.decay.fit import SEED_FIT, FitResult, calibrate_error_model, comparison_table, fit_all
+from double_pendulum.analysis.decay.report import report_text
+from double_pendulum.analysis.decay.summary import (
     TRACK_CSV_UNITS,
     decay_curves,
     error_model_summary,
@@ -40,7 +40,7 @@ from double_pendulum.analysis.decay_summary import (
     track_table,
     weighting_variants,
 )
-from double_pendulum.analysis.measurement import SEED_TOTAL_MASS_KG, Reconstruction, load_track, reconstruct
+from double_pendulum.analysis.track.measurement import SEED_TOTAL_MASS_KG, Reconstruction, load_track, reconstruct
 from double_pendulum.results_io import write_json, write_results_csv, write_text
 
 __all__ = ["DESCRIPTION", "SEED_FIT", "SEED_TOTAL_MASS_KG", "report_text", "run"]

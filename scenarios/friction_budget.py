@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from double_pendulum import plots
-from double_pendulum.analysis.decay_fit import fit_model
+from double_pendulum.analysis.decay.fit import fit_model
 from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.sweep import runner_map, timed_simulate
 from double_pendulum.fmu.runner import FmuRunner

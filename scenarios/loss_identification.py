@@ -4,7 +4,7 @@ Fits the simulated energy of the seed's pendulum (rigid links, start state from 
 measured energy over the whole 21 s record for combinations of air drag (free factor),
 load-proportional bearing friction, bearing drag torque, viscous joint damping and a damped
 suspension, and compares them by AIC/BIC with the residuals' correlation accounted for
-(:mod:`double_pendulum.analysis.loss_identification`). Outputs in ``results/loss_identification/``:
+(:mod:`double_pendulum.analysis.losses.identification`). Outputs in ``results/loss_identification/``:
 
 - ``energy.csv``: per fitted frame the measured energy, its error, the top model's simulated energy
   (FMU run) and its dissipated work per mechanism;
@@ -15,7 +15,7 @@ suspension, and compares them by AIC/BIC with the residuals' correlation account
 - ``report.md``.
 
 Default: the one- and two-mechanism models but air+drag2
-(:data:`~double_pendulum.analysis.loss_identification.FULL_MODELS`), about 80 s of CPU on one worker
+(:data:`~double_pendulum.analysis.losses.identification.FULL_MODELS`), about 80 s of CPU on one worker
 process per core (the worker pool is started once for every fitting round). ``thorough``
 (``--thorough``) adds air+drag2 (one drag torque per joint), the three-mechanism models
 air+drag+bearing, air+drag+viscous and air+drag+suspension, with 30 runs for every fit, and the top
@@ -32,8 +32,9 @@ from pathlib import Path
 from typing import Any
 
 from double_pendulum import plots
-from double_pendulum.analysis.loss_identification import identify_losses, parameters_of
-from double_pendulum.analysis.loss_report import report_text
+from double_pendulum.analysis.losses.identification import identify_losses
+from double_pendulum.analysis.losses.mechanisms import parameters_of
+from double_pendulum.analysis.losses.report import report_text
 from double_pendulum.results_io import table_from_columns, write_json, write_results_csv, write_text
 
 DESCRIPTION = "loss mechanisms of the real pendulum identified from its measured energy (AIC/BIC, shares)"

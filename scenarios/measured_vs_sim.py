@@ -6,7 +6,7 @@ coordinates agreeing with the camera track until about 2 s, i.e. about 1.2 s aft
 pendulum with its acrylic rods (:data:`~double_pendulum.model.parameters.SEED_RIGID_LINKS`) and the
 losses of the ``loss_identification`` scenario's best model, air drag with a free factor on rho_air
 plus a bearing drag torque at both joints, fitted to the measured energy decay exactly as that scenario's
-run in the same mode fits it (:func:`double_pendulum.analysis.track_comparison.identified_losses`: default,
+run in the same mode fits it (:func:`double_pendulum.analysis.prediction.comparison.identified_losses`: default,
 warm-started from the one-mechanism fits; quick, from the reference values; the whole record in both: the
 first 8 s alone leave the two losses unidentified). The fits are cached, so after ``loss_identification``
 they are read, not repeated (and the other way round). Four runs:
@@ -18,11 +18,11 @@ they are read, not repeated (and the other way round). Four runs:
   the first :data:`FIT_FRAMES` frames (1/3 s) through the FMU, identified model;
 - **least-squares start and geometry**: the state fitted together with the camera's rotation against
   gravity [rad], the pivot's offset (x, y) [m] from the measurement's circle-fit pivot and the lower
-  rod's length l2 [m] (:data:`~double_pendulum.analysis.track_comparison.FREE_GEOMETRY`) to the first
+  rod's length l2 [m] (:data:`~double_pendulum.analysis.prediction.comparison.FREE_GEOMETRY`) to the first
   :data:`GEOMETRY_FIT_FRAMES` frames (1.5 s; quick: :data:`QUICK_GEOMETRY_FIT_FRAMES`) after t0, identified model;
   beside it, over the same frames, the state alone with the geometry fixed (circle-fit pivot, the track's
   l1 and l2, no rotation) and the state with the pivot offset and l2 but no rotation
-  (:data:`~double_pendulum.analysis.track_comparison.PIVOT_SHIFT_GEOMETRY`), the alternative the rotation
+  (:data:`~double_pendulum.analysis.prediction.comparison.PIVOT_SHIFT_GEOMETRY`), the alternative the rotation
   trades off against.
 
 The losses are fitted to the same record the predictions are compared with: every horizon here is in-sample.
@@ -67,12 +67,8 @@ from typing import Any
 import numpy as np
 
 from double_pendulum import plots
-from double_pendulum.analysis.loss_identification import seed_reconstruction
-from double_pendulum.analysis.measurement import FRAME_INTERVAL, Reconstruction
-from double_pendulum.analysis.prediction_report import report_text
-from double_pendulum.analysis.start_state import STATE_NAMES
-from double_pendulum.analysis.suspension_identification import START_FIT_FRAMES
-from double_pendulum.analysis.track_comparison import (
+from double_pendulum.analysis.losses.identification import seed_reconstruction
+from double_pendulum.analysis.prediction.comparison import (
     FREE_GEOMETRY,
     PIVOT_SHIFT_GEOMETRY,
     SMOOTHING_S,
@@ -83,6 +79,8 @@ from double_pendulum.analysis.track_comparison import (
     error_curves,
     errors_table,
     errors_units,
+    goal_entry,
+    headline_entries,
     headline_horizon,
     identified_losses,
     least_squares_start,
@@ -100,6 +98,10 @@ from double_pendulum.analysis.track_comparison import (
     start_fit_summary,
     window_sensitivity,
 )
+from double_pendulum.analysis.prediction.report import report_text
+from double_pendulum.analysis.suspension.identification import START_FIT_FRAMES
+from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, Reconstruction
+from double_pendulum.analysis.track.start_state import STATE_NAMES
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.results_io import write_json, write_results_csv, write_text
@@ -220,28 +222,11 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
             "least_squares_fixed_geometry": start_fit_summary(fixed, seed_state),
             "least_squares_pivot_shift": start_fit_summary(shift, seed_state),
         },
-        "horizon_5cm_s": headlines["lsq_geometry_identified"]["horizon_s"],
-        "horizon_5cm_censored": headlines["lsq_geometry_identified"]["censored"],
-        "horizon_5cm_s_fixed_geometry": headlines["lsq_fixed_geometry_identified"]["horizon_s"],
-        "horizon_5cm_censored_fixed_geometry": headlines["lsq_fixed_geometry_identified"]["censored"],
-        "horizon_5cm_s_pivot_shift": headlines["lsq_pivot_shift_identified"]["horizon_s"],
-        "horizon_5cm_censored_pivot_shift": headlines["lsq_pivot_shift_identified"]["censored"],
-        "horizon_5cm_details": headlines,
-        "horizon_statement": "lower bob, smoothed error, 5 cm; censored: never exceeded within the record, so the "
-                             "horizon is only known to exceed horizon_5cm_s. In-sample: the losses are fitted to "
-                             "the same record. The motion is regular, so a horizon measures how well frequencies "
-                             "and damping match, not predictability.",
+        **headline_entries(headlines),
         "smoothing": {"method": "centred moving median of the per-frame position error", "window_s": SMOOTHING_S},
         "horizons_smoothed_s": smoothed,
         "horizons_raw_s": {p.label: p.horizons() for p in predictions},
-        "goal": {
-            "statement": f"the lower bob's smoothed error stays below 5 cm for at least {GOAL_S:g} s after t0, "
-                         "least-squares start and geometry",
-            "required_s": GOAL_S,
-            "reached_s": prediction_s if reached is None else reached,
-            "reached_is_lower_bound": reached is None,
-            "met": bool(reached is None or reached >= GOAL_S),
-        },
+        "goal": goal_entry(reached, prediction_s, GOAL_S),
         "regime": regime(PendulumParameters(**{**losses.pendulum, **fitted_l2}), geo.state, lyapunov_s),
         "chaos_horizons_s": chaos_horizons(spread),
         "ensemble_size": ensemble_size,

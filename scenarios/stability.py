@@ -1,6 +1,6 @@
 """Scenario ``stability``: stiff and extreme cases through the FMU, each with a pass criterion.
 
-Every case (:mod:`double_pendulum.analysis.stability_cases`) runs through fmpy and is judged on:
+Every case (:mod:`double_pendulum.analysis.solvers.stability_cases`) runs through fmpy and is judged on:
 
 * the run finished (the solver did not give up) -- or, for a case marked ``expect_failure``,
   the failure was detected and reported with a message (status and text in the table);
@@ -31,7 +31,7 @@ from pathlib import Path
 
 from double_pendulum import plots
 from double_pendulum.analysis.progress import step
-from double_pendulum.analysis.stability_cases import (
+from double_pendulum.analysis.solvers.stability_cases import (
     case_cost,
     cases,
     report,

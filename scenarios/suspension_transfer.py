@@ -10,15 +10,15 @@ on; b is fitted to E_pendulum (the bobs, what the camera sees) on the measured f
 
 Steps: identify c at the default k and M_s from the measured energy, with its valley in
 (k, c, M_s) and the decay shape p of dE/dt = -k E^p
-(:mod:`~double_pendulum.analysis.suspension_identification`); sweep b over (k, c) at a few M_s and
+(:mod:`~double_pendulum.analysis.suspension.identification`); sweep b over (k, c) at a few M_s and
 check the map against the linear response to the fixed-pivot force spectrum (the default run maps
 M_s = 2 kg, the identified mass; ``--thorough`` adds coarser maps at 0.5 and 8 kg and the fits on the
 first 7 and 14 s)
-(:mod:`~double_pendulum.analysis.decay_map`, :mod:`~double_pendulum.analysis.suspension_response`);
+(:mod:`~double_pendulum.analysis.suspension.decay_map`, :mod:`~double_pendulum.analysis.suspension.response`);
 run the identified suspension (and the resonant one on the same iso-b curve) again and follow the
-energy into the suspension (:mod:`~double_pendulum.analysis.energy_flow`). Summary entries, tables
-and figure inputs: :mod:`~double_pendulum.analysis.suspension_transfer`; the report:
-:mod:`~double_pendulum.analysis.suspension_report`.
+energy into the suspension (:mod:`~double_pendulum.analysis.suspension.energy_flow`). Summary entries, tables
+and figure inputs: :mod:`~double_pendulum.analysis.suspension.transfer`; the report:
+:mod:`~double_pendulum.analysis.suspension.report`.
 
 Outputs in ``results/suspension_transfer/``: ``decay_rate_map.csv`` (the sweep), ``frames.csv``
 (measured and simulated energy per frame), ``identified.csv`` / ``resonant.csv`` (energy-flow runs),
@@ -33,17 +33,15 @@ the final runs, all independent once c is identified, run on parallel worker pro
 from __future__ import annotations
 
 import time
-from collections.abc import Sequence
-from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from double_pendulum.scenarios.energy_decay import SEED_FIT
 
 from double_pendulum import plots
-from double_pendulum.analysis import suspension_transfer as study
-from double_pendulum.analysis.decay_map import (
+from double_pendulum.analysis.progress import step
+from double_pendulum.analysis.suspension import transfer as study
+from double_pendulum.analysis.suspension.decay_map import (
     BASE_SETTINGS,
     MAP_SETTINGS,
     MAP_UNITS,
@@ -51,14 +49,10 @@ from double_pendulum.analysis.decay_map import (
     map_summary,
     trace_valley,
 )
-from double_pendulum.analysis.energy_flow import energy_flow_run, energy_flow_summary
-from double_pendulum.analysis.measurement import load_track, reconstruct
-from double_pendulum.analysis.progress import step
-from double_pendulum.analysis.suspension_identification import (
-    DEFAULT_SUSPENSION,
+from double_pendulum.analysis.suspension.energy_flow import energy_flow_run, energy_flow_summary
+from double_pendulum.analysis.suspension.identification import (
     FIT_SETTINGS,
     LOSSES,
-    QUICK_WINDOW_S,
     identify_suspension,
     pendulum_values,
     point_summary,
@@ -67,8 +61,10 @@ from double_pendulum.analysis.suspension_identification import (
     valley_fisher,
     window_check,
 )
-from double_pendulum.analysis.suspension_report import report_text
+from double_pendulum.analysis.suspension.plan import FULL, NULL_MEANS, QUICK, THOROUGH
+from double_pendulum.analysis.suspension.report import report_text
 from double_pendulum.analysis.sweep import runner_map
+from double_pendulum.analysis.track.measurement import load_track, reconstruct
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv, write_text
 
@@ -76,72 +72,6 @@ DESCRIPTION = "decay rate b over suspension stiffness and damping; suspension id
 
 SEED_B = SEED_FIT["b_per_s"]
 """The seed's measured decay rate [1/s]."""
-
-
-@dataclass(frozen=True)
-class Plan:
-    """Sizes of one run: sweep grids [N/m, N s/m], masses [kg], time window [s], extra fits."""
-
-    k_grid: tuple[float, ...]
-    c_grid: tuple[float, ...]
-    m_s_main: float
-    m_s_extra: tuple[float, ...]
-    extra_stride: int
-    window_s: float | None
-    valley_k_factors: tuple[float, ...]
-    resonant_end: bool
-    window_checks_s: tuple[float, ...]
-    max_workers: int | None
-
-
-NULL_MEANS = {
-    "resonant_end": "not traced: the quick run skips it, or the measured b is not crossed at the map's "
-                    "smallest c",
-    "k_range_within_N_per_m": "no map cell within the tolerance",
-    "c_range_within_N_s_per_m": "no map cell within the tolerance",
-    "largest_share_within_per_s": "no map cell within the tolerance",
-    "ratio_fmu_to_prediction": "the prediction is zero or undefined in that cell",
-    "stiffest_k_reaching_N_per_m": "no k on the map reaches the measured b",
-}
-"""What a null in ``summary.json`` means, by key (write_json writes non-finite numbers and None as null)."""
-
-
-def _k_grid(exponents: Sequence[int]) -> tuple[float, ...]:
-    """Stiffnesses 2e4 * 10^(n/5) N/m: the default k and steps of 1.585 around it."""
-    return tuple(DEFAULT_SUSPENSION.k_x * 10.0 ** (n / 5.0) for n in exponents)
-
-
-FULL = Plan(
-    k_grid=_k_grid(range(-3, 6)),
-    c_grid=tuple(float(c) for c in np.geomspace(1.0, 3000.0, 7)),
-    m_s_main=DEFAULT_SUSPENSION.M_s,
-    m_s_extra=(),
-    extra_stride=2,
-    window_s=None,
-    valley_k_factors=(),
-    resonant_end=True,
-    window_checks_s=(),
-    max_workers=None,
-)
-THOROUGH = replace(FULL, c_grid=tuple(float(c) for c in np.geomspace(1.0, 3000.0, 9)), m_s_extra=(0.5, 8.0),
-                   valley_k_factors=(1.25, 1.5), window_checks_s=(7.0, 14.0))
-"""``--thorough``: the main map on 9 x 9 cells (the default: 9 k x 7 c) and coarser ones (every second k and
-c) at M_s = 0.5 and 8 kg (50 more runs, the stiffest cells of the light suspension among them: about
-2.5 times the map's CPU time), c refitted along the valley at 1.25 k and 1.5 k (the default follows the
-valley by its Fisher matrix alone: a refit is a sequential fit of about 12 s of CPU) and c identified
-again on the first 7 and 14 s of the record (three more sequential fits)."""
-QUICK = Plan(
-    k_grid=_k_grid((0, 3)),
-    c_grid=(5.0, 200.0),
-    m_s_main=DEFAULT_SUSPENSION.M_s,
-    m_s_extra=(),
-    extra_stride=1,
-    window_s=QUICK_WINDOW_S,
-    valley_k_factors=(),
-    resonant_end=False,
-    window_checks_s=(),
-    max_workers=1,
-)
 
 
 def checks(runner: FmuRunner, task: tuple[str, Any, dict[str, Any]]) -> Any:

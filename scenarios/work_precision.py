@@ -5,8 +5,8 @@ diverges --, and a stiff light suspension over 2 s) and each solver, a sweep of 
 (adaptive methods) or step sizes (fixed-step methods) runs **through fmpy** at a 10 ms
 communication step, and one mid setting per solver also at 100 ms. Recorded per run:
 final-horizon error and maximum error over the horizon (max over phi1, phi2, omega1, omega2
-against the cached reference, :mod:`double_pendulum.analysis.reference`; the cases, errors and
-the choice per band are in :mod:`double_pendulum.analysis.work_precision`), energy drift (frictionless: max
+against the cached reference, :mod:`double_pendulum.analysis.solvers.reference`; the cases, errors and
+the choice per band are in :mod:`double_pendulum.analysis.solvers.work_precision`), energy drift (frictionless: max
 |E_total - E0| / E0; with dissipation: max |energy_residual| / E0), RHS evaluations and steps
 (FMU outputs), CPU time (process time of the run; the median of 1-3 repeats: runs are repeated while
 they took under 0.25 s CPU in all, so cheap runs, whose timing decides close races, are timed several
@@ -14,7 +14,7 @@ times and expensive ones once). Failed or unstable configurations are kept in th
 status and message.
 
 Cost: the configurations and the three references (cached, see
-:mod:`double_pendulum.analysis.reference`; their error floor from SciPy's DOP853 at rtol 1e-13, about
+:mod:`double_pendulum.analysis.solvers.reference`; their error floor from SciPy's DOP853 at rtol 1e-13, about
 15 s CPU for all three) run on parallel worker processes, one per core, about 70 s CPU in all on a first
 run. ``thorough=True`` (``--thorough``, about three times the CPU time) adds the settings that cost most
 and win no band -- Rodas4 at rtol 1e-10 and 1e-12 (40 s CPU on the stiff case alone), Dopri5 at rtol
@@ -32,9 +32,8 @@ from typing import Any
 
 from double_pendulum import plots
 from double_pendulum.analysis.progress import step
-from double_pendulum.analysis.reference import CROSS_CHECK, THOROUGH_CROSS_CHECK, Reference, cached_reference
-from double_pendulum.analysis.sweep import runner_map
-from double_pendulum.analysis.work_precision import (
+from double_pendulum.analysis.solvers.reference import CROSS_CHECK, THOROUGH_CROSS_CHECK, Reference, cached_reference
+from double_pendulum.analysis.solvers.work_precision import (
     BASE_COMM_STEP,
     CASES,
     COMM_STEPS,
@@ -50,6 +49,7 @@ from double_pendulum.analysis.work_precision import (
     run_task,
     settings_for,
 )
+from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_table_csv, write_text
 from double_pendulum.solvers import METHODS

@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
+import tempfile
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from double_pendulum.fmu.build import build_fmu
+from double_pendulum.fmu.build import build_all
 from double_pendulum.fmu.runner import FmuRunner
 
 REPO = Path(__file__).resolve().parents[1]
@@ -18,8 +21,9 @@ DATA = REPO / "data"
 
 @pytest.fixture(scope="session")
 def fmu_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A freshly built DoublePendulum.fmu (built once per session)."""
-    return build_fmu(tmp_path_factory.mktemp("fmu") / "DoublePendulum.fmu")
+    """A freshly built DoublePendulum.fmu, with the other FMUs and the coupled system next to it, as ``run``
+    wants them (built once per session)."""
+    return build_all(tmp_path_factory.mktemp("fmu") / "DoublePendulum.fmu")[0]
 
 
 @pytest.fixture(scope="session")
@@ -56,9 +60,34 @@ def quick_results(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory) -> P
         fcntl.flock(lock, fcntl.LOCK_EX)
         if not done.is_file():
             shutil.rmtree(out, ignore_errors=True)
-            assert main(["run", "all", "--quick", "--fmu", str(fmu_path), "--out", str(out)]) == 0
+            tmpdir = shared / "quick_results.tmp"  # the run's $TMPDIR: what it leaves there is recorded
+            shutil.rmtree(tmpdir, ignore_errors=True)
+            tmpdir.mkdir()
+            with temporary_folder(tmpdir):
+                assert main(["run", "all", "--quick", "--fmu", str(fmu_path), "--out", str(out)]) == 0
+            (shared / "quick_results.leftovers").write_text("".join(f"{p.name}\n" for p in tmpdir.iterdir()))
             done.write_text("")
     return out
+
+
+@contextlib.contextmanager
+def temporary_folder(folder: Path) -> Iterator[None]:
+    """``folder`` as $TMPDIR (and :mod:`tempfile`'s folder) of this process and those it starts, in the block."""
+    saved_env, saved = os.environ.get("TMPDIR"), tempfile.tempdir
+    os.environ["TMPDIR"], tempfile.tempdir = str(folder), str(folder)
+    try:
+        yield
+    finally:
+        if saved_env is None:
+            os.environ.pop("TMPDIR", None)
+        else:
+            os.environ["TMPDIR"] = saved_env
+        tempfile.tempdir = saved
+
+
+def quick_run_leftovers(results: Path) -> list[str]:
+    """What the run of :func:`quick_results` left in its $TMPDIR."""
+    return (results.parent / "quick_results.leftovers").read_text().split()
 
 
 def quick_scenario(results: Path, name: str) -> tuple[Path, dict]:

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis import excitation_study as study
-from double_pendulum.analysis.excitation import (
+from double_pendulum.analysis.excitation import study
+from double_pendulum.analysis.excitation.drive import (
     FloquetCase,
     bisect_threshold,
     drive_amplitude,
@@ -19,7 +19,7 @@ from double_pendulum.analysis.excitation import (
     torque_outcome,
     vertical_vibration,
 )
-from double_pendulum.analysis.excitation_theory import (
+from double_pendulum.analysis.excitation.theory import (
     averaging_matrix,
     damped_peak_frequency,
     equivalent_lengths,

@@ -9,11 +9,11 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import quick_scenario
+from conftest import quick_run_leftovers, quick_scenario
 from double_pendulum.scenarios import SCENARIOS
 
 import double_pendulum
-from double_pendulum.cli import main, run_scenario
+from double_pendulum.cli import default_fmu_path, fmu_set, fmu_set_is_current, main, run_scenario
 from double_pendulum.results_io import read_results_csv
 
 
@@ -107,6 +107,7 @@ def test_unusable_output_folder_is_one_clear_line(tmp_path, capsys, kind):
     assert main(["run", "free_swing", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "cannot write results to" in err and "Traceback" not in err
+    assert "--out" in err  # how to write elsewhere
 
 
 def test_corrupt_fmu_is_one_clear_line(tmp_path, capsys, monkeypatch):
@@ -196,3 +197,48 @@ def test_bad_scenario_lists_are_one_clear_line(tmp_path, capsys, names, message)
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and message in err
     assert list(tmp_path.iterdir()) == []  # nothing ran
+
+
+def test_a_finished_run_leaves_nothing_in_the_temporary_folder(quick_results):
+    # every scenario ran (in child processes, their sweeps on workers); the FMUs they extracted are gone
+    assert quick_run_leftovers(quick_results) == []
+
+
+@pytest.mark.parametrize("command", ["variables", "list"])
+def test_a_reader_that_stops_early_gets_no_traceback(command):
+    process = subprocess.Popen([sys.executable, "-m", "double_pendulum.cli", command], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE)  # fmt: skip
+    process.stdout.close()  # as `| head -1` does, before the command has written its lines
+    stderr = process.stderr.read().decode()
+    assert process.wait(timeout=60) == 141, stderr  # 128 + SIGPIPE, as a shell tool ended by the pipe
+    assert stderr == ""
+
+
+def test_run_from_another_folder_keeps_every_fmu_in_the_out_folder(tmp_path, monkeypatch, capsys):
+    elsewhere, out = tmp_path / "elsewhere", tmp_path / "results"
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    assert main(["run", "free_swing", "--quick", "--out", str(out)]) == 0
+    assert list(elsewhere.iterdir()) == []  # no build/ where the command was given
+    fmu = out / "fmu" / "DoublePendulum.fmu"
+    assert default_fmu_path(out) == fmu
+    names = sorted(str(path.relative_to(fmu.parent)) for path in fmu_set(fmu))
+    assert names == ["DoublePendulum.fmu", "PendulumOnSuspension.fmu", "PendulumOnSuspension.ssp", "Suspension.fmu",
+                     "fmi3/DoublePendulum.fmu"]  # fmt: skip
+    assert all(path.is_file() for path in fmu_set(fmu)) and fmu_set_is_current(fmu)
+    (out / "fmu" / "PendulumOnSuspension.ssp").unlink()  # one missing: the next run builds the set again
+    assert not fmu_set_is_current(fmu)
+
+
+def test_in_the_project_folder_the_fmus_stay_in_build(tmp_path, monkeypatch):
+    (tmp_path / "pyproject.toml").write_text('[project]\nname = "double-pendulum-fmu"\n')
+    monkeypatch.chdir(tmp_path)
+    assert default_fmu_path(Path("results")) == Path("build") / "DoublePendulum.fmu"
+
+
+def test_an_fmu_that_cannot_be_built_names_the_option_to_build_it_elsewhere(tmp_path, capsys):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("x")  # a file where the FMU's folder should be
+    assert main(["run", "free_swing", "--fmu", str(blocker / "DoublePendulum.fmu"), "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot build the FMU" in err and "--fmu" in err

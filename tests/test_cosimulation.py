@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis.cosimulation import fitted_order, stability_run
-from double_pendulum.analysis.coupling_stability import critical_mass_ratio, oscillator_step, spectral_radius
+from double_pendulum.analysis.coupling.cosimulation import fitted_order, stability_run
+from double_pendulum.analysis.coupling.stability import critical_mass_ratio, oscillator_step, spectral_radius
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.component.suspension import SuspensionCoSimulation
 from double_pendulum.fmu.coupling import CouplingError, run_coupled, split_values
@@ -99,10 +99,20 @@ def test_quick_scenario_writes_csv_plots_summary_and_report(quick_results):
 def test_libcosim_is_skipped_with_a_reason_when_libcosimpy_is_missing(monkeypatch):
     import importlib.util
 
-    from double_pendulum.analysis import cosimulation
+    from double_pendulum.analysis.coupling import cosimulation
 
     real = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "libcosimpy" else real(name, *a))
     methods, missing = cosimulation.available_methods()
     assert "libcosim" not in methods and "container" in methods
     assert "libcosimpy" in missing["libcosim"]
+
+
+def test_the_report_says_in_words_which_run_it_is_and_what_a_negative_slope_means(quick_results):
+    from double_pendulum.analysis.coupling.report import _run_kind
+
+    folder, _ = quick_scenario(quick_results, "cosimulation")
+    report = (folder / "report.md").read_text()
+    assert "This is a quick run" in report and "Quick run:" not in report and "False" not in report
+    assert "A negative slope" in report
+    assert _run_kind({"quick": False}) == "This is the default run."

@@ -6,9 +6,9 @@ import math
 
 import pytest
 
-from double_pendulum.analysis.decay_error_budget import budget_table, error_budget
-from double_pendulum.analysis.decay_fit import calibrate_error_model
-from double_pendulum.analysis.measurement import load_track, reconstruct
+from double_pendulum.analysis.decay.error_budget import budget_table, error_budget
+from double_pendulum.analysis.decay.fit import calibrate_error_model
+from double_pendulum.analysis.track.measurement import load_track, reconstruct
 
 
 @pytest.fixture(scope="module")

@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum.analysis import decay_fit as df
-from double_pendulum.analysis.measurement import load_track, reconstruct
+from double_pendulum.analysis.decay import fit as df
+from double_pendulum.analysis.track.measurement import load_track, reconstruct
 from double_pendulum.model.energy import total_energy
 from double_pendulum.results_io import read_results_csv
 

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum.analysis import decay_summary as ds
-from double_pendulum.analysis.decay_fit import SEED_FIT, fit_all
-from double_pendulum.analysis.decay_report import plus_minus, variant_rows
-from double_pendulum.analysis.measurement import FRAME_INTERVAL
+from double_pendulum.analysis.decay import summary as ds
+from double_pendulum.analysis.decay.fit import SEED_FIT, fit_all
+from double_pendulum.analysis.decay.report import plus_minus, variant_rows
+from double_pendulum.analysis.track.measurement import FRAME_INTERVAL
 
 
 def test_central_difference_gains_are_the_sinc_of_the_frame_step():

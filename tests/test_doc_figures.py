@@ -86,7 +86,11 @@ def test_every_marked_figure_matches_the_recorded_default_run(page: Path):
 def test_the_headline_figures_are_marked():
     """The pages this project's claims live on quote their headline figures with markers."""
     counts = {p.name: len(markers(p.read_text())) for p in PAGES}
-    assert counts["README.md"] >= 8 and counts["data-analysis.md"] >= 15 and counts["coupling.md"] >= 8
+    assert counts["README.md"] >= 3 and counts["data-analysis.md"] >= 15 and counts["coupling.md"] >= 8
+    # the README's findings are a short summary: every figure it quotes is quoted in docs/ too
+    keys = {page.name: {(m["scenario"], m["path"]) for m in markers(page.read_text())} for page in PAGES}
+    in_docs = set().union(*(found for name, found in keys.items() if name != "README.md"))
+    assert keys["README.md"] <= in_docs
     assert {m["scenario"] for p in PAGES for m in markers(p.read_text())} >= {
         "energy_decay", "loss_identification", "measured_vs_sim", "suspension_transfer", "base_excitation",
         "cosimulation"}

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from conftest import DATA
 
-from double_pendulum.analysis.ensemble import (
+from double_pendulum.analysis.chaos.ensemble import (
     batch_energy,
     columnwise_field,
     dop853_trajectory,

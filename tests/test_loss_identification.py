@@ -15,9 +15,9 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis import loss_claims
-from double_pendulum.analysis import loss_identification as li
-from double_pendulum.analysis import measurement as ms
+from double_pendulum.analysis.losses import claims as loss_claims
+from double_pendulum.analysis.losses import comparison, fitting, identification, mechanisms
+from double_pendulum.analysis.track import measurement as ms
 from double_pendulum.fmu.simulate import simulate
 from double_pendulum.model.parameters import SEED_RIGID_LINKS
 
@@ -29,9 +29,9 @@ SECONDS = 12.0
 
 def _synthetic_track(seed: int = 7) -> ms.Track:
     values = {
-        **li.SIM_SETTINGS, **SEED_RIGID_LINKS, "l1": 0.2964, "l2": 0.1971,
+        **mechanisms.SIM_SETTINGS, **SEED_RIGID_LINKS, "l1": 0.2964, "l2": 0.1971,
         "phi1_0": -0.34, "phi2_0": 0.89, "omega1_0": 3.97, "omega2_0": -6.31,
-        **li.model_values("air+drag", [TRUE["air_factor"], TRUE["tau_b"]]),
+        **mechanisms.model_values("air+drag", [TRUE["air_factor"], TRUE["tau_b"]]),
     }  # fmt: skip
     r = simulate(values, stop_time=SECONDS, output_interval=ms.FRAME_INTERVAL, outputs=("x1", "y1", "x2", "y2"))
     rng = np.random.default_rng(seed)
@@ -46,18 +46,18 @@ def _synthetic_track(seed: int = 7) -> ms.Track:
 
 
 @pytest.fixture(scope="module")
-def synthetic_problem() -> li.FitProblem:
+def synthetic_problem() -> fitting.FitProblem:
     rec = ms.reconstruct(_synthetic_track(), rods=SEED_RIGID_LINKS)
     # The synthetic track starts in free motion: begin at the first frame with a defined energy
     # (the seed's hand release ends later, where every derivative stencil fits).
     rec = dataclasses.replace(rec, release_frame=max(rec.release_frame, int(np.argmax(rec.energy_valid))))
-    return li.problem_from_track(rec, li.measured(rec))
+    return fitting.problem_from_track(rec, identification.measured(rec))
 
 
 @pytest.fixture(scope="module")
-def synthetic_fit(synthetic_problem) -> tuple[li.ModelFit, float]:
-    fit = li.fit_loss_model("air+drag", synthetic_problem)
-    return fit, li.common_factor([fit])
+def synthetic_fit(synthetic_problem) -> tuple[fitting.ModelFit, float]:
+    fit = fitting.fit_loss_model("air+drag", synthetic_problem)
+    return fit, comparison.common_factor([fit])
 
 
 def test_identification_recovers_the_true_losses_within_its_stated_uncertainty(synthetic_fit):
@@ -76,14 +76,14 @@ def test_shares_of_the_synthetic_fit_sum_to_one(synthetic_fit):
 
 
 def test_model_values_and_parameters_line_up():
-    assert [p.name for p in li.parameters_of("air+drag2+suspension")] == ["air_factor", "tau_b1", "tau_b2",
+    assert [p.name for p in mechanisms.parameters_of("air+drag2+suspension")] == ["air_factor", "tau_b1", "tau_b2",
                                                                           "c_suspension"]  # fmt: skip
-    v = li.model_values("air+viscous", [1.0, 2e-4])
+    v = mechanisms.model_values("air+viscous", [1.0, 2e-4])
     assert v["rho_air"] == pytest.approx(1.2) and v["b_v1"] == v["b_v2"] == 2e-4 and v["c_R1"] == 0.0
 
 
 def test_profile_interval_interpolates_the_crossings():
-    lo, hi = li._profile_interval([1.0, 2.0, 3.0, 4.0, 5.0], [4.0, 0.5, 0.0, 0.5, 4.0])
+    lo, hi = comparison._profile_interval([1.0, 2.0, 3.0, 4.0, 5.0], [4.0, 0.5, 0.0, 0.5, 4.0])
     assert lo == pytest.approx(2.0 - 0.5 / 3.5) and hi == pytest.approx(4.0 + 0.5 / 3.5)
 
 
@@ -91,7 +91,7 @@ def test_top_model_on_the_real_data_quick(quick_results):
     """Quick settings (air+drag alone, no profiles): the shares sum to 1; the suspension question is not
     answered without a suspension model."""
     _, s = quick_scenario(quick_results, "loss_identification")
-    assert s["top_model"] == "air+drag" and s["models_fitted"] == list(li.QUICK_MODELS)
+    assert s["top_model"] == "air+drag" and s["models_fitted"] == list(mechanisms.QUICK_MODELS)
     assert sum(s["top_model_shares"].values()) == pytest.approx(1.0, abs=1e-12)
     assert all(0.0 <= v <= 1.0 for v in s["top_model_shares"].values())
     # the fitted torque against the seed's rolling friction c_R r_b M g at the pivot
@@ -105,17 +105,17 @@ def test_top_model_on_the_real_data_quick(quick_results):
 
 
 def test_a_fit_above_its_nested_model_counts_as_not_converged():
-    def fake(model: str, chi2: float) -> li.ModelFit:
-        n = len(li.parameters_of(model))
-        return li.ModelFit(model, np.ones(n), chi2, 100, np.eye(100)[:, :n], np.zeros(100), 1.0, 1)
+    def fake(model: str, chi2: float) -> fitting.ModelFit:
+        n = len(mechanisms.parameters_of(model))
+        return fitting.ModelFit(model, np.ones(n), chi2, 100, np.eye(100)[:, :n], np.zeros(100), 1.0, 1)
 
     fits = [fake("air+drag", 100.0), fake("air+drag+viscous", 120.0), fake("air", 130.0)]
-    rows = li.comparison_rows(fits, 1.0)
+    rows = comparison.comparison_rows(fits, 1.0)
     assert [r["model"] for r in rows] == ["air+drag", "air", "air+drag+viscous"]
     assert not rows[-1]["converged"] and rows[-1]["akaike_weight"] == 0.0
     assert rows[-1]["not_ranked_because"].startswith("the fit stalled")
     assert "not_ranked_because" not in rows[0]
-    assert "c_suspension -> infinity" in li.not_ranked_because("air+suspension")
+    assert "c_suspension -> infinity" in comparison.not_ranked_because("air+suspension")
 
 
 
@@ -124,12 +124,12 @@ def test_a_nested_model_warm_started_from_its_parent_ends_no_worse(synthetic_pro
     Gauss-Newton only accepts steps that lower chi2, so the larger model cannot end above its parent
     (it would then count as not converged and drop out of the comparison)."""
     parent, _ = synthetic_fit
-    (start,) = li.fit_item_of("air+drag+bearing", [parent]).starts
+    (start,) = fitting.fit_item_of("air+drag+bearing", [parent]).starts
     assert start[:2] == pytest.approx(tuple(parent.theta))
-    assert start[2] == pytest.approx(li.WARM_START_FRACTION * li.MECHANISMS["bearing"].parameters[0].ref)
-    fit = li.fit_loss_model("air+drag+bearing", synthetic_problem, start=start, max_nfev=8)
+    assert start[2] == pytest.approx(fitting.WARM_START_FRACTION * mechanisms.MECHANISMS["bearing"].parameters[0].ref)
+    fit = fitting.fit_loss_model("air+drag+bearing", synthetic_problem, start=start, max_nfev=8)
     assert fit.chi2 <= parent.chi2 * (1.0 + 1e-3)
-    assert li.converged(fit, [parent, fit])
+    assert comparison.converged(fit, [parent, fit])
 
 
 def test_models_within_two_aic_are_reported_with_weights_and_the_range_of_the_air_share():
@@ -153,45 +153,46 @@ def test_models_within_two_aic_are_reported_with_weights_and_the_range_of_the_ai
 
 
 def test_the_suspension_joins_a_fitted_model_at_each_damping_of_its_scan():
-    parent = li.ModelFit("air", np.array([2.5]), 1.0, 100, np.zeros((100, 1)), np.zeros(100), 1.0, 1)
-    starts = li.fit_item_of("air+suspension", [parent]).starts
-    assert starts == tuple((2.5, c) for c in li.MECHANISMS["suspension"].parameters[0].warm_scan)
-    assert li.fit_item_of("air", [parent]).starts == ()
+    parent = fitting.ModelFit("air", np.array([2.5]), 1.0, 100, np.zeros((100, 1)), np.zeros(100), 1.0, 1)
+    starts = fitting.fit_item_of("air+suspension", [parent]).starts
+    assert starts == tuple((2.5, c) for c in mechanisms.MECHANISMS["suspension"].parameters[0].warm_scan)
+    assert fitting.fit_item_of("air", [parent]).starts == ()
 
 
 def test_drag_per_joint_nests_the_common_drag_torque_and_starts_at_its_optimum():
     """air+drag2 generalises air+drag (tau_b1 = tau_b2 = tau_b): it is fitted a round later, starts at the
     air+drag optimum with the short run budget, and counts as not converged if it ends above it."""
-    assert li.contains("air+drag2", "air+drag") and li.contains("air+drag2", "air")
-    assert not li.contains("air+drag", "air+drag2") and not li.contains("air+drag", "air+drag")
-    assert not li.contains("air+bearing", "air+drag")
-    assert li.model_rank("air+drag2") > li.model_rank("air+drag") > li.model_rank("air")
-    parent = li.ModelFit("air+drag", np.array([2.2, 1.1e-3]), 600.0, 100, np.zeros((100, 2)), np.zeros(100), 1.0, 1)
-    air = li.ModelFit("air", np.array([6.0]), 640.0, 100, np.zeros((100, 1)), np.zeros(100), 1.0, 1)
-    item = li.fit_item_of("air+drag2", [air, parent])
-    assert item.starts == ((2.2, 1.1e-3, 1.1e-3),) and item.max_nfev == li.SHORT_RUN_BUDGET
-    assert li.fit_item_of("air+drag2", [air, parent], short=False).max_nfev == 30
-    assert li.fit_item_of("air+bearing", [air, parent]).max_nfev == 30  # a rival, not a generalisation
-    worse = li.ModelFit("air+drag2", np.ones(3), 601.0, 100, np.zeros((100, 3)), np.zeros(100), 1.0, 1)
-    assert not li.converged(worse, [parent, worse])
+    assert mechanisms.contains("air+drag2", "air+drag") and mechanisms.contains("air+drag2", "air")
+    assert not mechanisms.contains("air+drag", "air+drag2") and not mechanisms.contains("air+drag", "air+drag")
+    assert not mechanisms.contains("air+bearing", "air+drag")
+    assert mechanisms.model_rank("air+drag2") > mechanisms.model_rank("air+drag") > mechanisms.model_rank("air")
+    parent = fitting.ModelFit("air+drag", np.array([2.2, 1.1e-3]), 600.0, 100, np.zeros((100, 2)), np.zeros(100),
+                              1.0, 1)
+    air = fitting.ModelFit("air", np.array([6.0]), 640.0, 100, np.zeros((100, 1)), np.zeros(100), 1.0, 1)
+    item = fitting.fit_item_of("air+drag2", [air, parent])
+    assert item.starts == ((2.2, 1.1e-3, 1.1e-3),) and item.max_nfev == fitting.SHORT_RUN_BUDGET
+    assert fitting.fit_item_of("air+drag2", [air, parent], short=False).max_nfev == 30
+    assert fitting.fit_item_of("air+bearing", [air, parent]).max_nfev == 30  # a rival, not a generalisation
+    worse = fitting.ModelFit("air+drag2", np.ones(3), 601.0, 100, np.zeros((100, 3)), np.zeros(100), 1.0, 1)
+    assert not comparison.converged(worse, [parent, worse])
 
 
 def test_the_default_models_leave_the_three_mechanism_ones_and_air_drag2_to_the_thorough_run():
-    assert set(li.FULL_MODELS) < set(li.THOROUGH_MODELS)
-    extra = set(li.THOROUGH_MODELS) - set(li.FULL_MODELS)
+    assert set(mechanisms.FULL_MODELS) < set(mechanisms.THOROUGH_MODELS)
+    extra = set(mechanisms.THOROUGH_MODELS) - set(mechanisms.FULL_MODELS)
     assert all(len(m.split("+")) == 3 for m in extra - {"air+drag2"}) and "air+drag2" in extra
     # the default identification takes two rounds: single mechanisms, then pairs (no sequential third round)
-    assert {li.model_rank(m) for m in li.FULL_MODELS} == {1, 2}
-    assert "air+drag" in li.FULL_MODELS and li.QUICK_MODELS == ("air+drag",)
+    assert {mechanisms.model_rank(m) for m in mechanisms.FULL_MODELS} == {1, 2}
+    assert "air+drag" in mechanisms.FULL_MODELS and mechanisms.QUICK_MODELS == ("air+drag",)
 
 
 def test_a_fit_reuses_the_run_at_its_optimum(synthetic_problem, synthetic_fit):
     """The shares come from the last accepted Gauss-Newton run: no run is repeated for them, and they are
     the ones a fresh run at the optimum gives."""
     fit, _ = synthetic_fit
-    works = sorted({m.work for m in li.mechanisms_of("air+drag")})
-    fresh = synthetic_problem.simulate(li.model_values("air+drag", fit.theta), outputs=("E_pendulum", *works))
-    assert fit.extra["shares"] == li.shares(fresh, "air+drag")
+    works = sorted({m.work for m in mechanisms.mechanisms_of("air+drag")})
+    fresh = synthetic_problem.simulate(mechanisms.model_values("air+drag", fit.theta), outputs=("E_pendulum", *works))
+    assert fit.extra["shares"] == mechanisms.shares(fresh, "air+drag")
     r, _ = synthetic_problem.scaled_residuals(np.asarray(fresh["E_pendulum"])[synthetic_problem.offsets])
     assert float(r @ r) == fit.chi2
 
@@ -203,35 +204,35 @@ def test_gauss_newton_says_why_it_stopped():
     def residuals(x: np.ndarray) -> np.ndarray:
         return a @ x - target
 
-    x, _, stop = li.gauss_newton(residuals, np.array([1.0, 1.0]))
+    x, _, stop = fitting.gauss_newton(residuals, np.array([1.0, 1.0]))
     assert stop == "converged" and x == pytest.approx([3.0, -1.0], abs=1e-4)
-    assert li.gauss_newton(residuals, np.array([1.0, 1.0]), max_runs=2)[2] == "run limit"
+    assert fitting.gauss_newton(residuals, np.array([1.0, 1.0]), max_runs=2)[2] == "run limit"
 
 
 @pytest.mark.parametrize("quick", [False, True])
 def test_identified_fit_fits_a_model_as_the_identification_of_its_mode_does(monkeypatch, quick):
-    """``measured_vs_sim`` takes its losses from :func:`li.identified_fit`: the fit items (model, start, run
+    """``measured_vs_sim`` takes its losses from :func:`fitting.identified_fit`: the fit items (model, start, run
     budget) it fits must be the identification's own, so the cached fits of one scenario serve the other."""
-    items: list[li.FitItem] = []
+    items: list[fitting.FitItem] = []
 
-    def fake_fit_item(item: li.FitItem, problem: object) -> li.ModelFit:
+    def fake_fit_item(item: fitting.FitItem, problem: object) -> fitting.ModelFit:
         items.append(item)
-        theta = np.array(item.starts[0] if item.starts else [p.ref for p in li.parameters_of(item.model)])
+        theta = np.array(item.starts[0] if item.starts else [p.ref for p in mechanisms.parameters_of(item.model)])
         chi2 = 1000.0 / (1 + len(item.model)) + 7.0 * len(items)  # differing chi2: the parent choice matters
-        return li.ModelFit(item.model, 1.1 * theta, chi2, 100, np.zeros((100, len(theta))), np.zeros(100), 1.0, 1)
+        return fitting.ModelFit(item.model, 1.1 * theta, chi2, 100, np.zeros((100, len(theta))), np.zeros(100), 1.0, 1)
 
-    monkeypatch.setattr(li, "fit_item", fake_fit_item)
-    models = li.QUICK_MODELS if quick else li.FULL_MODELS
+    monkeypatch.setattr(fitting, "fit_item", fake_fit_item)
+    models = mechanisms.QUICK_MODELS if quick else mechanisms.FULL_MODELS
     problem = object()  # never simulated: the fake fits only record their items
     # the identification's rounds (identify_losses: short=True, the mode's run budget)
-    li.fit_models(models, problem, max_workers=1, max_runs=li.run_budget(quick))
+    fitting.fit_models(models, problem, max_workers=1, max_runs=fitting.run_budget(quick))
     identification = {i.model: i for i in items}
     items.clear()
-    fit = li.identified_fit("air+drag", problem, quick=quick)
+    fit = fitting.identified_fit("air+drag", problem, quick=quick)
     assert fit.model == "air+drag"
     assert {i.model for i in items} == ({"air+drag"} if quick else {"air", "drag", "air+drag"})
     assert items[-1] == identification["air+drag"]
     assert bool(items[-1].starts) != quick  # default: warm-started from a one-mechanism fit; quick: references
-    assert items[-1].max_nfev == (li.QUICK_RUN_BUDGET if quick else 30)  # quick: one Gauss-Newton step
+    assert items[-1].max_nfev == (mechanisms.QUICK_RUN_BUDGET if quick else 30)  # quick: one Gauss-Newton step
     with pytest.raises(ValueError):
-        li.identified_fit("air+drag+bearing", problem)
+        fitting.identified_fit("air+drag+bearing", problem)

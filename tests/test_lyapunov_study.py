@@ -7,14 +7,15 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum.analysis import chaos, lyapunov_study
-from double_pendulum.analysis.ensemble import initial_states, model_field, pendulum_field, rod_field
+from double_pendulum.analysis.chaos import lyapunov, lyapunov_study, releases
+from double_pendulum.analysis.chaos.ensemble import initial_states, model_field, pendulum_field, rod_field
 from double_pendulum.model.parameters import AirDragParameters, BearingParameters, PendulumParameters
 from double_pendulum.model.vector_field import ModelConfig
 
 P = PendulumParameters()
 FIELD = pendulum_field(P)
-METHODS = {"dop853": chaos.Integration("dop853", rtol=1e-10, atol=1e-12), "rk4_h": chaos.Integration("rk4", h=1e-3)}
+METHODS = {"dop853": lyapunov.Integration("dop853", rtol=1e-10, atol=1e-12),
+           "rk4_h": lyapunov.Integration("rk4", h=1e-3)}
 
 
 def test_checkpoints_take_the_running_estimate_at_the_nearest_renormalisation_time():
@@ -30,7 +31,7 @@ def test_standard_error_is_the_sample_deviation_over_root_n():
 
 @pytest.fixture(scope="module")
 def comparison() -> lyapunov_study.IntegrationComparison:
-    starts = chaos.release_ensemble(2.0, 0.0, 0.005, 4, P, seed=41, include_nominal=True)
+    starts = releases.release_ensemble(2.0, 0.0, 0.005, 4, P, seed=41, include_nominal=True)
     return lyapunov_study.compare_integrations(FIELD, starts, 4.0, METHODS, renorm=0.5)
 
 
@@ -80,9 +81,9 @@ def test_single_trajectory_benettin_on_the_runtime_integrator_agrees_with_the_ba
     integrate the same equations with the same tangent: over 2 s, before the chaotic trajectory forgets
     the integrators' differences (rtol 1e-8), their log growths per 0.5 s agree to 1e-4 relative."""
     config = ModelConfig(P, AirDragParameters(air_drag=True), BearingParameters(bearing_friction=True))
-    single = chaos.lyapunov_single(rod_field(config), [2.0, 0.0, 0.0, 0.0], 2.0, renorm_interval=0.5, rtol=1e-8)
-    batch = chaos.lyapunov_benettin(model_field(config), initial_states(2.0, 0.0), 2.0, renorm_interval=0.5,
-                                    integration=chaos.Integration("dop853", rtol=1e-8, atol=1e-10), jvp="central")
+    single = lyapunov.lyapunov_single(rod_field(config), [2.0, 0.0, 0.0, 0.0], 2.0, renorm_interval=0.5, rtol=1e-8)
+    batch = lyapunov.lyapunov_benettin(model_field(config), initial_states(2.0, 0.0), 2.0, renorm_interval=0.5,
+                                    integration=lyapunov.Integration("dop853", rtol=1e-8, atol=1e-10), jvp="central")
     np.testing.assert_allclose(single.times, batch.times)
     np.testing.assert_allclose(single.log_growth, batch.log_growth, rtol=1e-4, atol=1e-5)
     np.testing.assert_allclose(single.states, batch.states, rtol=1e-5, atol=1e-5)

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis import track_comparison as tc
-from double_pendulum.analysis.loss_identification import ComponentRunner
-from double_pendulum.analysis.measurement import FRAME_INTERVAL, load_track, reconstruct
-from double_pendulum.analysis.prediction_report import cause_text, fmt_horizon, regime_text
-from double_pendulum.analysis.start_state import (
+from double_pendulum.analysis.losses.fitting import ComponentRunner
+from double_pendulum.analysis.prediction import comparison as tc
+from double_pendulum.analysis.prediction.report import cause_text, fmt_horizon, regime_text
+from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, load_track, reconstruct
+from double_pendulum.analysis.track.start_state import (
     ANGLE_OUTPUTS,
     FIT_SETTINGS,
     POSITION_OUTPUTS,

@@ -8,7 +8,7 @@ from conftest import DATA
 from scipy.integrate import solve_ivp
 from scipy.signal import savgol_filter
 
-from double_pendulum.analysis import measurement as ms
+from double_pendulum.analysis.track import measurement as ms
 from double_pendulum.model.dynamics import fixed_pivot_vector_field
 from double_pendulum.model.energy import total_energy
 from double_pendulum.model.kinematics import positions
@@ -192,7 +192,7 @@ def test_reconstruction_of_frictionless_motion_keeps_the_energy_better_than_cent
 
 def test_measured_energy_scatters_less_with_the_savgol_derivative():
     """The docstring's evidence for the filter choice: scatter of E about its exponential fit, Table 1."""
-    from double_pendulum.analysis.decay_fit import exponential, fit_model
+    from double_pendulum.analysis.decay.fit import exponential, fit_model
 
     rec = ms.reconstruct(ms.load_track())
     m = rec.free_motion

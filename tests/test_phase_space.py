@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum.analysis import chaos, phase_space
-from double_pendulum.analysis.ensemble import batch_potential_energy, pendulum_field
+from double_pendulum.analysis.chaos import flips, phase_space
+from double_pendulum.analysis.chaos.ensemble import batch_potential_energy, pendulum_field
 from double_pendulum.model.parameters import PendulumParameters
 
 P = PendulumParameters()
@@ -16,10 +16,10 @@ E_ROD1 = 2 * (P.m1 + P.m2) * P.g * P.l1  # J, V(pi, 0)
 E_ROD2 = 2 * P.m2 * P.g * P.l2  # J, V(0, pi)
 
 
-def _flip_map(rod: np.ndarray, energy: np.ndarray) -> chaos.FlipMap:
+def _flip_map(rod: np.ndarray, energy: np.ndarray) -> flips.FlipMap:
     axis = np.array([-1.0, 1.0])
     times = np.where(rod > 0, 1.0, np.nan)
-    return chaos.FlipMap(axis, axis, times, rod, energy, min(E_ROD1, E_ROD2), 2.0, 1e-3, 0.0, 1)
+    return flips.FlipMap(axis, axis, times, rod, energy, min(E_ROD1, E_ROD2), 2.0, 1e-3, 0.0, 1)
 
 
 def test_rest_energy_is_the_potential_energy_of_the_release():

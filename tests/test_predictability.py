@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from double_pendulum.analysis import chaos, predictability
-from double_pendulum.analysis.ensemble import dop853_trajectory, initial_states, pendulum_field
+from double_pendulum.analysis.chaos import predictability, releases
+from double_pendulum.analysis.chaos.ensemble import dop853_trajectory, initial_states, pendulum_field
 from double_pendulum.model.parameters import PendulumParameters
 
 P = PendulumParameters()
@@ -76,7 +76,7 @@ def test_release_predictability_starts_with_the_drawn_spread_and_keeps_the_chose
     assert res.snapshot_group == 1 and sorted(res.spread.snapshots) == [0.0, 0.2]  # 3 s is past the end
     # at release the hanging lower bob moves with the upper one: its spread is the RMS of the drawn arcs
     for j, sigma in enumerate(sigmas):
-        arcs = chaos.release_ensemble(2.0, 0.0, sigma, 30, P, seed=7 + j)[0] - 2.0
+        arcs = releases.release_ensemble(2.0, 0.0, sigma, 30, P, seed=7 + j)[0] - 2.0
         assert res.spread.spread[0, j] == pytest.approx(P.l1 * np.std(arcs), rel=1e-3)
     table, units = predictability.spread_table(res)
     assert table.dtype.names == ("time", "spread_sigma_0.1mm", "spread_sigma_1mm") and units["spread_sigma_1mm"] == "m"

@@ -318,7 +318,7 @@ def test_bearing_drag_loss_per_cycle_is_amplitude_independent_so_decay_is_linear
 
 def test_batch_field_for_ensembles_has_the_rods_too():
     """The NumPy ensemble field (chaos, maps) uses the same rigid-link accelerations as the FMU's core."""
-    from double_pendulum.analysis.ensemble import pendulum_field
+    from double_pendulum.analysis.chaos.ensemble import pendulum_field
 
     rng = np.random.default_rng(3)
     states = rng.uniform(-3, 3, size=(4, 20))

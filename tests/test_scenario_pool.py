@@ -158,10 +158,12 @@ class _Bar:
     """A stand-in progress bar that records its total and each update."""
 
     def __init__(self, total: int) -> None:
-        self.total, self.updates = total, []
+        self.total, self.updates, self.n = total, [], 0
 
     def update(self, n: int) -> None:
-        self.updates.append(n)
+        if n:
+            self.updates.append(n)
+        self.n += n
 
     def __enter__(self) -> _Bar:
         return self
@@ -206,7 +208,8 @@ def test_a_group_child_that_dies_mid_group_fails_the_rest_and_the_bar_still_ends
     err = capsys.readouterr().err
     assert "b: FAILED: its process ended with code 3" in err and "c: FAILED: its process ended with code 3" in err
     assert "a: FAILED" not in err
-    assert bars[0].total == 10 and bars[0].updates == [5, 5]  # a when it wrote, b and c when the child ended
+    assert bars[0].total == 10 and bars[0].n == 10  # full: a when it wrote, b and c when the child ended
+    assert all(n > 0 for n in bars[0].updates)  # it never goes back
 
 
 def test_failed_children_are_named_and_the_others_finish(monkeypatch, tmp_path, capsys):
@@ -252,11 +255,32 @@ def test_several_scenarios_in_children_write_every_folder(tmp_path, capsys, fmu_
     out = capsys.readouterr().out
     assert sorted(p.name for p in tmp_path.iterdir()) == names
     assert "3 scenarios in 2 processes" in out
-    # free_swing alone; energy_decay and friction_budget one after another in the other child
-    assert "[1/3] energy_decay:" in out and "[2/3] free_swing:" in out and "[3/3] friction_budget:" in out
+    # free_swing alone, energy_decay and friction_budget one after another in the other child: numbered 1 to 3
+    # in the order they start
+    headers = [line.split()[:2] for line in out.splitlines() if line.startswith("[")]
+    assert [index for index, _ in headers] == ["[1/3]", "[2/3]", "[3/3]"]
+    assert sorted(name.rstrip(":") for _, name in headers) == names
     assert out.count("scenarios wrote") == 1 and "3 of 3 scenarios wrote" in out  # the children's sums not shown
 
 
 def test_jobs_below_one_is_refused_in_one_line(tmp_path, capsys):
     assert main(["run", "all", "--jobs", "0", "--out", str(tmp_path)]) == 2
     assert capsys.readouterr().err.strip() == "double-pendulum: error: --jobs must be at least 1, got 0"
+
+
+def test_a_child_header_is_numbered_in_the_order_scenarios_start():
+    starts = iter(["7/11", "8/11"])
+    child = scenario_pool.Child(("a", "b"), process=None, current="a", number=lambda: next(starts))
+    assert child.take("[1/11] a: first ...\n") == ("[7/11] a: first ...", None)
+    assert child.take("a: wrote x\n") == ("a: wrote x", "a")
+    assert child.take("[2/11] b: second ...\n") == ("[8/11] b: second ...", None)
+
+
+def test_the_bar_credits_running_scenarios_with_their_time_so_far_up_to_a_cap():
+    weight = {"long": 100, "short": 10, "finished": 30}
+    long_child = scenario_pool.Child(("long",), process=None, current="long", started=50.0)
+    short_child = scenario_pool.Child(("short",), process=None, current="short", started=50.0)
+    # 20 s into both: the long one has 20 of its 100 s, the short one 9 of its 10 (the cap), finished ones all
+    assert scenario_pool.progress_done(weight, {"finished"}, [long_child, short_child], now=70.0) == 30 + 20 + 9
+    # a reported scenario counts whole, not twice
+    assert scenario_pool.progress_done(weight, {"finished", "short"}, [long_child, short_child], now=70.0) == 60

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis import stability_cases
+from double_pendulum.analysis.solvers import stability_cases
 from double_pendulum.model.parameters import PendulumParameters
 
 

@@ -11,14 +11,14 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum.analysis import decay_map
-from double_pendulum.analysis import suspension_transfer as study
-from double_pendulum.analysis.decay_fit import fit_model
-from double_pendulum.analysis.decay_map import MAP_UNITS, DecayMap, decay_maps
-from double_pendulum.analysis.energy_flow import ENERGY_FLOW_OUTPUTS, energy_flow_summary, peak_frequency
-from double_pendulum.analysis.measurement import FRAME_INTERVAL
-from double_pendulum.analysis.suspension_identification import FitFrames, MeasuredDecay
-from double_pendulum.analysis.suspension_response import ForceSpectrum
+from double_pendulum.analysis.decay.fit import fit_model
+from double_pendulum.analysis.suspension import decay_map
+from double_pendulum.analysis.suspension import transfer as study
+from double_pendulum.analysis.suspension.decay_map import MAP_UNITS, DecayMap, decay_maps
+from double_pendulum.analysis.suspension.energy_flow import ENERGY_FLOW_OUTPUTS, energy_flow_summary, peak_frequency
+from double_pendulum.analysis.suspension.identification import FitFrames, MeasuredDecay
+from double_pendulum.analysis.suspension.response import ForceSpectrum
+from double_pendulum.analysis.track.measurement import FRAME_INTERVAL
 
 M12 = 0.6  # m1 + m2 [kg]
 

@@ -8,16 +8,16 @@ from conftest import quick_scenario
 from double_pendulum.scenarios import suspension_transfer as st
 from double_pendulum.scenarios.friction_budget import SEED_RELEASE
 
-from double_pendulum.analysis.decay_fit import calibrate_error_model, fit_model
-from double_pendulum.analysis.decay_map import BASE_SETTINGS, MAP_SETTINGS, decay_rate_sweep
-from double_pendulum.analysis.measurement import FRAME_INTERVAL, load_track, reconstruct
-from double_pendulum.analysis.suspension_identification import (
+from double_pendulum.analysis.decay.fit import calibrate_error_model, fit_model
+from double_pendulum.analysis.suspension.decay_map import BASE_SETTINGS, MAP_SETTINGS, decay_rate_sweep
+from double_pendulum.analysis.suspension.identification import (
     FIT_SETTINGS,
     FitFrames,
     identify_suspension,
     suspension_values,
 )
-from double_pendulum.analysis.suspension_response import pivot_force_spectrum
+from double_pendulum.analysis.suspension.response import pivot_force_spectrum
+from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, load_track, reconstruct
 from double_pendulum.results_io import read_results_csv
 
 

@@ -7,7 +7,7 @@ import os
 import numpy as np
 import pytest
 
-from double_pendulum.analysis import chaos
+from double_pendulum.analysis.chaos import flips
 from double_pendulum.analysis.sweep import (
     WORKERS_ENV,
     chunk,
@@ -98,8 +98,8 @@ def test_reduce_returns_only_what_is_asked_for(fmu_path, serial_results):
 
 
 def test_batch_work_split_over_processes_is_identical_to_one_batch():
-    serial = chaos.flip_time_map(16, 16, t_max=1.5, max_workers=1)
-    parallel = chaos.flip_time_map(16, 16, t_max=1.5, max_workers=2)
+    serial = flips.flip_time_map(16, 16, t_max=1.5, max_workers=1)
+    parallel = flips.flip_time_map(16, 16, t_max=1.5, max_workers=2)
     assert parallel.workers == 2
     np.testing.assert_array_equal(parallel.time, serial.time)
     np.testing.assert_array_equal(parallel.rod, serial.rod)

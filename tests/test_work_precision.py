@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 from conftest import quick_scenario
 
-from double_pendulum.analysis import work_precision as wp
-from double_pendulum.analysis.reference import Reference
+from double_pendulum.analysis.solvers import work_precision as wp
+from double_pendulum.analysis.solvers.reference import Reference
 
 
 def test_work_precision_report_on_a_tiny_configuration(quick_results):
@@ -94,7 +94,7 @@ def test_cheap_runs_are_timed_several_times_and_expensive_ones_once():
 def test_the_cross_check_reference_floor_resolves_the_errors_the_bands_report(tmp_path):
     """SciPy's DOP853 cross-check: the chaotic case's floor lies far below the 1e-6 band it ranks, and the
     cheap check is keyed apart from the Radau one (--thorough)."""
-    from double_pendulum.analysis import reference
+    from double_pendulum.analysis.solvers import reference
 
     case = wp.CASES[1]
     ref = reference.reference_solution(case.start, 0.5, wp.BASE_COMM_STEP, cache_dir=tmp_path)

@@ -1,24 +1,35 @@
 """Command line: build the FMU, run scenarios through it, list them, print the FMU's variables.
 
 Misuse and failures end with one line on stderr and a non-zero exit code, never a traceback:
-2 for a bad command line or unusable files, 1 if a scenario failed, 130 on Ctrl-C.
+2 for a bad command line or unusable files, 1 if a scenario failed, 130 on Ctrl-C, 141 when the reader of
+the output went away (``double-pendulum variables | head -1``).
+
+A run keeps its temporary files (the FMUs fmpy extracts, in this process, its workers and its child
+processes) in a folder of its own under ``$TMPDIR`` and removes it when it ends, however it ends
+(:func:`private_tempdir`).
 """
 
 from __future__ import annotations
 
 import argparse
 import ast
+import contextlib
 import importlib
 import importlib.util
 import inspect
 import json
+import os
 import shutil
 import sys
+import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 from . import __version__
-from .fmu.build import DEFAULT_FMU_PATH, build_all, build_fmu
+from .analysis.interrupts import acknowledge, handling_interrupts, interrupted
+from .component.variables import INTERFACES
+from .fmu.build import DEFAULT_FMU_PATH, build_all
 from .scenario_lines import failed_line, header_line, wrote_line
 from .scenarios import SCENARIOS
 
@@ -77,24 +88,68 @@ def _writable_folder(path: str) -> Path:
         probe.unlink()
     except OSError as error:
         reason = error.strerror or str(error)
-        raise CliError(f"cannot write results to {folder}: {reason}") from None
+        raise CliError(f"cannot write results to {folder}: {reason} (pass --out DIR to write elsewhere)") from None
     return folder
 
 
+def is_project_folder(folder: Path) -> bool:
+    """Whether ``folder`` is this project's own source folder (its pyproject.toml names the project), where
+    the README's commands keep the FMUs in ``build/``."""
+    pyproject = folder / "pyproject.toml"
+    try:
+        return 'name = "double-pendulum-fmu"' in pyproject.read_text(encoding="utf-8")
+    except OSError:
+        return False
+
+
+def default_fmu_path(out: Path) -> Path:
+    """Where ``run`` keeps the FMUs unless ``--fmu`` says: ``build/DoublePendulum.fmu`` in the project's own
+    folder, elsewhere ``OUT/fmu/DoublePendulum.fmu``, so that a run from any other folder writes only into
+    its ``--out`` folder."""
+    if is_project_folder(Path.cwd()):
+        return DEFAULT_FMU_PATH
+    return out / "fmu" / DEFAULT_FMU_PATH.name
+
+
+def fmu_set(fmu: Path) -> list[Path]:
+    """The files ``build`` writes with the DoublePendulum FMU ``fmu``: the other FMUs next to it, the coupled
+    system (SSP and container FMU) and the FMI 3.0 FMU in ``fmi3/``."""
+    others = [fmu.parent / f"{name}.fmu" for name in INTERFACES if f"{name}.fmu" != fmu.name]
+    systems = [fmu.parent / "PendulumOnSuspension.ssp", fmu.parent / "PendulumOnSuspension.fmu"]
+    return [fmu, *others, *systems, fmu.parent / "fmi3" / fmu.name]
+
+
+def fmu_set_is_current(fmu: Path) -> bool:
+    """Whether ``fmu`` is newer than its sources and, for an FMU named as ``build`` names it, the rest of
+    :func:`fmu_set` is there and current too (an FMU of another name is checked alone)."""
+    from .fmu.build import fmu_is_current
+
+    if not fmu_is_current(fmu):
+        return False
+    if fmu.name != DEFAULT_FMU_PATH.name:
+        return True
+    built = fmu.stat().st_mtime
+    others = fmu_set(fmu)[1:]
+    interfaces = [path for path in others if path.stem in INTERFACES and path.parent == fmu.parent]
+    return all(fmu_is_current(path, path.stem) for path in interfaces) and all(
+        path.is_file() and path.stat().st_mtime >= built for path in others if path not in interfaces)
+
+
 def _load_fmu(path: str, rebuild: bool):
-    """Build the FMU if missing or stale, then open it with fmpy; unusable files become a CliError."""
+    """Build the FMUs if the FMU or the rest of its set is missing or stale (:func:`fmu_set_is_current`), then
+    open the FMU with fmpy; unusable files become a CliError."""
     import zipfile
 
-    from .fmu.build import fmu_is_current
     from .fmu.runner import FmuRunner
 
     fmu = Path(path)
-    if rebuild or not fmu_is_current(fmu):
-        print(f"building {fmu} (missing or older than the sources) ...", flush=True)
+    if rebuild or not fmu_set_is_current(fmu):
+        print(f"building the FMUs next to {fmu} (missing or older than the sources) ...", flush=True)
         try:
-            build_fmu(fmu)
+            build_all(fmu)
         except OSError as error:
-            raise CliError(f"cannot build the FMU at {fmu}: {error.strerror or error}") from None
+            raise CliError(f"cannot build the FMU at {fmu}: {error.strerror or error} "
+                           "(pass --fmu PATH to build it elsewhere)") from None
     try:
         return FmuRunner(fmu)
     except (zipfile.BadZipFile, KeyError, OSError) as error:
@@ -139,10 +194,17 @@ def run_scenario(module, name: str, runner, out: Path, quick: bool, thorough: bo
         with draft_figures(quick):  # quick runs draw their figures at a lower resolution
             module.run(runner, staging, quick=quick, **options)
         _mark_quick(staging, quick)
+        if interrupted():  # Ctrl-C that the FMU turned into a failed run, which the scenario carried on from
+            raise KeyboardInterrupt
     except KeyboardInterrupt:
+        acknowledge()
         shutil.rmtree(staging, ignore_errors=True)
         raise
     except Exception:
+        if interrupted():  # the failure is Ctrl-C, reported by the FMU as an error
+            acknowledge()
+            shutil.rmtree(staging, ignore_errors=True)
+            raise KeyboardInterrupt from None
         failed = out / f"{name}.failed"
         shutil.rmtree(failed, ignore_errors=True)
         staging.rename(failed)
@@ -236,6 +298,30 @@ def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path
     return run_in_children(names, out, Path(args.fmu), quick=args.quick, thorough=args.thorough, jobs=jobs)
 
 
+@contextlib.contextmanager
+def private_tempdir() -> Iterator[Path]:
+    """A temporary folder of this run under ``$TMPDIR``, made the temporary folder of this process and of the
+    processes it starts (``TMPDIR``), removed with all it holds at the end, however the run ends; the runners
+    this process keeps (:func:`~double_pendulum.analysis.sweep.close_runners`) are closed first."""
+    from .analysis.sweep import close_runners
+
+    folder = Path(tempfile.mkdtemp(prefix="double-pendulum-run-"))
+    saved_env, saved_tempdir = os.environ.get("TMPDIR"), tempfile.tempdir
+    os.environ["TMPDIR"], tempfile.tempdir = str(folder), str(folder)
+    try:
+        yield folder
+    finally:
+        if interrupted():  # the clean-up below must not be cut short by the repeated interrupt
+            acknowledge()
+        close_runners()
+        if saved_env is None:
+            os.environ.pop("TMPDIR", None)
+        else:
+            os.environ["TMPDIR"] = saved_env
+        tempfile.tempdir = saved_tempdir
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     names = _check_scenarios(args.scenarios)
     if args.quick and args.thorough:
@@ -243,11 +329,14 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.jobs is not None and args.jobs < 1:
         raise CliError(f"--jobs must be at least 1, got {args.jobs}")
     out = _writable_folder(args.out)
+    if args.fmu is None:
+        args.fmu = str(default_fmu_path(out))
     from .analysis.sweep import default_workers  # one scenario per core this process may use
 
     jobs = min(len(names), args.jobs or default_workers())
     start, cpu_start = time.perf_counter(), _cpu_seconds()
-    failed = _run_in_children(names, args, out, jobs) if jobs > 1 else _run_in_this_process(names, args, out)
+    with private_tempdir():
+        failed = _run_in_children(names, args, out, jobs) if jobs > 1 else _run_in_this_process(names, args, out)
     if len(names) > 1 and args.index is None:  # a child of run_in_children leaves the sum to its parent
         print(f"{len(names) - len(failed)} of {len(names)} scenarios wrote {out} in "
               f"{time.perf_counter() - start:.1f} s (CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
@@ -289,8 +378,10 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("scenarios", nargs="+", metavar="SCENARIO",
                        help="scenario names (see below), or 'all' alone")
     p_run.add_argument("--out", default="results", help="output folder (default: results)")
-    p_run.add_argument("--fmu", default=str(DEFAULT_FMU_PATH),
-                       help=f"FMU to use, built if missing or older than the sources (default: {DEFAULT_FMU_PATH})")
+    p_run.add_argument("--fmu", default=None,
+                       help=f"FMU to use, built with the other FMUs next to it if missing or older than the sources "
+                       f"(default: {DEFAULT_FMU_PATH} in the project's folder, elsewhere OUT/fmu/"
+                       f"{DEFAULT_FMU_PATH.name})")
     p_run.add_argument("--rebuild", action="store_true", help="rebuild the FMU first")
     p_run.add_argument("--quick", action="store_true", help="short runs, for smoke tests (about 30 s for all)")
     p_run.add_argument("--thorough", action="store_true",
@@ -318,7 +409,8 @@ def main(argv: list[str] | None = None) -> int:
     """Parse ``argv`` and run the command; return the exit code (errors as one line on stderr)."""
     args = build_parser().parse_args(argv)
     try:
-        return args.func(args)
+        with handling_interrupts():
+            return args.func(args)
     except CliError as error:
         print(f"{PROG}: error: {error}", file=sys.stderr)
         return 2
@@ -326,6 +418,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: interrupted; finished scenarios are kept, unfinished ones are discarded",
               file=sys.stderr)
         return 130
+    except BrokenPipeError:  # the reader of stdout went away: say nothing more there
+        _stdout_to_devnull()
+        return 141
+
+
+def _stdout_to_devnull() -> None:
+    """Point stdout at /dev/null, so that flushing what is left of it cannot fail again."""
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    with contextlib.suppress(OSError, ValueError):
+        os.dup2(devnull, sys.stdout.fileno())
+    os.close(devnull)
 
 
 def entry() -> None:
@@ -335,14 +438,16 @@ def entry() -> None:
     process teardown after its FMUs were used, turning a finished run into an abort. All results
     are written by the time :func:`main` returns, so the process exits directly with its code.
     """
-    import os
-
     try:
         code = main()
     except KeyboardInterrupt:  # Ctrl-C while parsing or importing
         print(f"{PROG}: interrupted", file=sys.stderr)
         code = 130
-    sys.stdout.flush()
+    try:
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _stdout_to_devnull()
+        code = code or 141
     sys.stderr.flush()
     os._exit(code)
 

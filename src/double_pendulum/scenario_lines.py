@@ -16,12 +16,18 @@ WROTE = "wrote"
 FAILED = "FAILED"
 
 _HEADER = re.compile(r"\[\d+/\d+\] (?P<name>\w+): ")
+_HEADER_INDEX = re.compile(r"^\[\d+/\d+\]")
 _OUTCOME = re.compile(rf"(?P<name>\w+): (?P<outcome>{WROTE}|{FAILED})\b")
 
 
 def header_line(index: str, name: str, description: str) -> str:
     """The line that announces scenario ``name`` (``index``: its "k/N" in the run)."""
     return f"[{index}] {name}: {description} ..."
+
+
+def renumbered(line: str, index: str) -> str:
+    """A header ``line`` with its "k/N" replaced by ``index``."""
+    return _HEADER_INDEX.sub(f"[{index}]", line, count=1)
 
 
 def wrote_line(name: str, folder: Path, seconds: float, cpu_seconds: float) -> str:

@@ -18,35 +18,46 @@ in the same group, so it reads that one's cached fit instead of fitting it again
 :data:`double_pendulum.scenarios.READS_FITS_OF`).
 
 The children's lines reach the terminal as they come, each marked with the name of the scenario
-running in its child (a child's header line ``[k/N] NAME: ...`` says which); their progress
-counters are plain lines (``DOUBLE_PENDULUM_PROGRESS=lines``: two tqdm bars would overwrite each
-other), while the parent shows one bar over the scenarios, each weighted by its expected CPU time,
-so that its rate and time left mean something. A scenario's share of the bar is added when its
-``wrote`` or ``FAILED`` line arrives, what is left of a child's share when the child ends.
+running in its child (a child's header line ``[k/N] NAME: ...`` says which, k counting the scenarios in
+the order they start); their progress counters are plain lines (``DOUBLE_PENDULUM_PROGRESS=lines``: two
+tqdm bars would overwrite each other), while the parent shows one bar over the scenarios, each weighted
+by its expected CPU time, so that its rate and time left mean something. A running scenario is credited
+with the time it has run so far (a child keeps a core busy), up to :data:`CREDIT_CAP` of its share; its
+whole share is added when its ``wrote`` or ``FAILED`` line arrives, what is left of a child's share when
+the child ends. So the bar moves from the start at about the rate the cores work, and its first estimates
+of the time left are not inflated by the scenarios that have not finished yet.
+
+Ctrl-C reaches the children too (they share the terminal's process group): each discards its unfinished
+scenario and ends; the parent waits up to :data:`STOP_GRACE_S` for them, kills what is left, and a
+second Ctrl-C ends that wait at once (:func:`double_pendulum.analysis.interrupts.hurried`).
 """
 
 from __future__ import annotations
 
+import itertools
 import os
 import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
+from .analysis.interrupts import acknowledge, hurried
 from .analysis.progress import ENV as PROGRESS_ENV
 from .analysis.progress import progress_bar, write_line
 from .analysis.sweep import WORKERS_ENV
-from .scenario_lines import FAILED, WROTE, failed_line, header_name, outcome
+from .scenario_lines import FAILED, WROTE, failed_line, header_name, outcome, renumbered
 from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF
 
 POLL_S = 0.2
 """How often [s] the parent looks for finished children."""
-STOP_GRACE_S = 10.0
+STOP_GRACE_S = 5.0
 """How long [s] interrupted children may take to clean up before they are killed."""
+CREDIT_CAP = 0.9
+"""At most this fraction of a running scenario's share of the progress bar is credited before it reports."""
 
 
 def expected_cpu_s(name: str, quick: bool) -> float:
@@ -171,11 +182,20 @@ class Child:
     current: str
     outcomes: dict[str, str] = field(default_factory=dict)
     relays: list[threading.Thread] = field(default_factory=list)
+    started: float = field(default_factory=time.monotonic)
+    """When :attr:`current` started (time.monotonic)."""
+    number: Callable[[], str] | None = None
+    """The next "k/N" for a header line (the parent counts the scenarios in the order they start); None: the
+    child's own."""
 
     def take(self, line: str) -> tuple[str, str | None]:
-        """Read a line of the child: switch :attr:`current` on a header line, note a first outcome;
-        return the line as the parent prints it and the scenario that has just reported (or None)."""
-        self.current = header_name(line, self.names) or self.current
+        """Read a line of the child: switch :attr:`current` on a header line (numbered in the order the
+        scenarios start), note a first outcome; return the line as the parent prints it and the scenario
+        that has just reported (or None)."""
+        header = header_name(line, self.names)
+        if header is not None:
+            self.current, self.started = header, time.monotonic()
+            line = line if self.number is None else renumbered(line, self.number())
         reported = outcome(line, self.names)
         text = marked(reported[0] if reported else self.current, line)
         if reported is None or reported[0] in self.outcomes:
@@ -208,11 +228,12 @@ def _relay(child: Child, stream: IO[str], target: Callable[[], IO[str]], lock: t
 
 
 def start_child(names: Sequence[str], command: list[str], lock: threading.Lock,
-                reported: Callable[[str], None]) -> Child:  # fmt: skip
-    """Start a child running the scenarios ``names`` and the threads that relay its stdout and stderr."""
+                reported: Callable[[str], None], number: Callable[[], str] | None = None) -> Child:  # fmt: skip
+    """Start a child running the scenarios ``names`` and the threads that relay its stdout and stderr
+    (``number``: the "k/N" of the next scenario to start in the run, for its header line)."""
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, bufsize=1,
                                env=child_environment())  # fmt: skip
-    child = Child(tuple(names), process, current=names[0])
+    child = Child(tuple(names), process, current=names[0], number=number)
     for stream, target in ((process.stdout, lambda: sys.stdout), (process.stderr, lambda: sys.stderr)):
         thread = threading.Thread(target=_relay, args=(child, stream, target, lock, reported), daemon=True)
         thread.start()
@@ -234,13 +255,15 @@ def _finish(child: Child) -> int:
 
 
 def _stop(children: Sequence[Child]) -> None:
-    """After Ctrl-C: the children got the signal too; give them time to discard their unfinished
-    folders, then kill what is left."""
+    """After Ctrl-C: the children got the signal too; give them :data:`STOP_GRACE_S` to discard their
+    unfinished folders (less if a second Ctrl-C hurries), then kill what is left."""
     deadline = time.monotonic() + STOP_GRACE_S
+    while any(child.process.poll() is None for child in children):
+        if hurried() or time.monotonic() >= deadline:
+            break
+        time.sleep(0.05)
     for child in children:
-        try:
-            child.process.wait(timeout=max(0.0, deadline - time.monotonic()))
-        except subprocess.TimeoutExpired:
+        if child.process.poll() is None:
             child.process.kill()
         _finish(child)
 
@@ -256,6 +279,15 @@ def _failures_of_ended(child: Child, lock: threading.Lock) -> tuple[list[str], l
     return failures, unreported
 
 
+def progress_done(weight: Mapping[str, int], done: Collection[str], running: Sequence[Child], now: float) -> int:
+    """Expected CPU seconds [s] done at ``now`` (time.monotonic): the whole ``weight`` of the scenarios ``done``,
+    and the time each running child's current scenario has run so far, up to :data:`CREDIT_CAP` of its
+    weight (a child keeps a core busy)."""
+    credit = sum(min(now - child.started, CREDIT_CAP * weight[child.current]) for child in running
+                 if child.current not in done)  # fmt: skip
+    return int(sum(weight[name] for name in done) + credit)
+
+
 def run_in_children(
     names: Sequence[str], out: Path, fmu: Path, *, quick: bool, thorough: bool, jobs: int
 ) -> list[str]:
@@ -263,28 +295,38 @@ def run_in_children(
     one scenario per child, or in a quick run ``jobs`` children with a group each); return the names
     of those that failed, in the order of ``names``. Ctrl-C stops every child and raises
     KeyboardInterrupt once they have cleaned up."""
-    number = {name: f"{k}/{len(names)}" for k, name in enumerate(names, start=1)}
     weight = {name: max(1, round(expected_cpu_s(name, quick))) for name in names}
     lock = threading.Lock()
     waiting, running, failed = scenario_groups(names, quick=quick, jobs=jobs), [], []
+    order = [name for group in waiting for name in group]  # the children's own "k/N": until their header is seen
+    starts = itertools.count(1)
+    done: set[str] = set()  # scenarios whose whole share the bar holds
+
+    def number() -> str:
+        return f"{next(starts)}/{len(names)}"
+
+    def reported(name: str) -> None:
+        done.add(name)
+
     label = f"{len(names)} scenarios, progress in expected CPU seconds"
     with progress_bar(sum(weight.values()), label, unit="CPU s") as bar:
-        def reported(name: str) -> None:
-            bar.update(weight[name])
-
         try:
             while waiting or running:
                 while waiting and len(running) < jobs:
                     group = waiting.pop(0)
-                    command = child_command(group, [number[n] for n in group], out, fmu, quick, thorough)
-                    running.append(start_child(group, command, lock, reported))
+                    indices = [f"{order.index(n) + 1}/{len(names)}" for n in group]
+                    command = child_command(group, indices, out, fmu, quick, thorough)
+                    running.append(start_child(group, command, lock, reported, number))
                 _pause(POLL_S)
                 for child in [c for c in running if c.process.poll() is not None]:
                     running.remove(child)
                     failures, unreported = _failures_of_ended(child, lock)
                     failed.extend(failures)
-                    bar.update(sum(weight[n] for n in unreported))
+                    done.update(unreported)
+                with lock:
+                    bar.update(max(0, progress_done(weight, done, running, time.monotonic()) - bar.n))
         except KeyboardInterrupt:
+            acknowledge()
             _stop(running)
             raise
     return [name for name in names if name in failed]

@@ -35,6 +35,7 @@ import os
 import sys
 import tempfile
 import threading
+import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
@@ -44,6 +45,7 @@ from typing import Any
 import numpy as np
 
 from ..fmu.runner import FmuRunError, FmuRunner
+from .interrupts import acknowledge, sigint_blocked, worker_ignores_sigint
 from .progress import progress_bar as _progress_bar
 
 CHUNKS_PER_WORKER = 4
@@ -130,18 +132,49 @@ class WorkerPool:
     workers: int
 
 
+STOP_WORKERS_S = 2.0
+"""How long [s] stopped workers may take to end after SIGTERM before they are killed."""
+
+
+def stop_workers(executor: ProcessPoolExecutor) -> None:
+    """End ``executor``'s worker processes now (SIGTERM, SIGKILL after :data:`STOP_WORKERS_S`) and drop the
+    work not yet done, instead of waiting for it as ``shutdown`` does: after Ctrl-C or a failed item."""
+    processes = list((getattr(executor, "_processes", None) or {}).values())  # no public way to reach them
+    for process in processes:
+        process.terminate()
+    executor.shutdown(wait=False, cancel_futures=True)
+    deadline = time.monotonic() + STOP_WORKERS_S
+    for process in processes:
+        process.join(max(0.0, deadline - time.monotonic()))
+        if process.is_alive():
+            process.kill()
+            process.join()
+    executor.shutdown(wait=True)
+
+
 @contextlib.contextmanager
 def worker_pool(max_workers: int | None = None, n_items: int | None = None) -> Iterator[WorkerPool | None]:
     """A :class:`WorkerPool` of ``max_workers`` spawned processes (None: one per core; at most ``n_items``),
-    shut down on exit; ``None`` when one worker would do (callers then run in this process)."""
+    shut down on exit; ``None`` when one worker would do (callers then run in this process).
+
+    The workers ignore Ctrl-C; if the block ends with an exception (Ctrl-C, a failed item) they are stopped
+    at once (:func:`stop_workers`), so no worker outlives the call or computes what nobody will read."""
     workers = default_workers() if max_workers is None else max_workers
     if n_items is not None:
         workers = min(workers, max(n_items, 1))
     if workers <= 1:
         yield None
         return
-    with ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        yield WorkerPool(pool, workers)
+    executor = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                                   initializer=worker_ignores_sigint)  # fmt: skip
+    try:
+        yield WorkerPool(executor, workers)
+    except BaseException as error:
+        if isinstance(error, KeyboardInterrupt):
+            acknowledge()
+        stop_workers(executor)
+        raise
+    executor.shutdown(wait=True)
 
 
 def parallel_map(
@@ -179,7 +212,7 @@ def parallel_map(
                     results[i] = _call(func, item, shared)
                     bar.update(weights[i])
                 return results, 1
-            with _without_fmu_resources_on_path():  # workers start on these submits
+            with _without_fmu_resources_on_path(), sigint_blocked():  # workers start on these submits
                 futures = {pool.executor.submit(_call, func, item, shared): i for i, item in enumerate(items)}
             for future in as_completed(futures):
                 i = futures[future]
@@ -227,19 +260,39 @@ _RUNNERS: dict[str, tuple[FmuRunner, threading.Lock]] = {}
 _RUNNERS_LOCK = threading.Lock()
 
 
+def process_runner(key: str, path: Callable[[], str]) -> tuple[FmuRunner, threading.Lock]:
+    """This process's runner for the FMU ``key`` (extracted from ``path()`` on first use, kept for later
+    calls, removed by :func:`close_runners` or at the exit of a worker process) and the lock that makes
+    its calls one at a time."""
+    with _RUNNERS_LOCK:
+        if key not in _RUNNERS:
+            runner = FmuRunner(path())
+            multiprocessing.util.Finalize(runner, runner.close, exitpriority=10)
+            _RUNNERS[key] = (runner, threading.Lock())
+        return _RUNNERS[key]
+
+
+def close_runners() -> None:
+    """Close this process's runners (:func:`process_runner`): their extracted FMUs leave the temporary folder.
+    A run calls it when it ends (its main process exits without running exit handlers)."""
+    with _RUNNERS_LOCK:
+        for runner, _ in _RUNNERS.values():
+            runner.close()
+        _RUNNERS.clear()
+
+
 def _worker_runner(source: FmuSource) -> tuple[FmuRunner, threading.Lock]:
     """This process's runner for ``source`` (extracted on first use, removed at process exit)."""
-    with _RUNNERS_LOCK:
-        if source.key not in _RUNNERS:
-            path = source.path
-            if source.content is not None and (path is None or not Path(path).is_file()):
-                folder = Path(tempfile.mkdtemp(prefix="dp-sweep-"))
-                path = str(folder / f"{source.key}.fmu")
-                Path(path).write_bytes(source.content)
-            runner = FmuRunner(path)
-            multiprocessing.util.Finalize(runner, runner.close, exitpriority=10)
-            _RUNNERS[source.key] = (runner, threading.Lock())
-        return _RUNNERS[source.key]
+
+    def path() -> str:
+        if source.content is not None and (source.path is None or not Path(source.path).is_file()):
+            folder = Path(tempfile.mkdtemp(prefix="dp-sweep-"))
+            written = folder / f"{source.key}.fmu"
+            written.write_bytes(source.content)
+            return str(written)
+        return str(source.path)
+
+    return process_runner(source.key, path)
 
 
 @dataclass(frozen=True)

@@ -12,17 +12,11 @@ from .chaos import (
     plot_poincare_sections,
     plot_predictability,
 )
-from .decay import (
-    plot_circle_fit,
-    plot_decay_rate_cuts,
-    plot_decay_rate_map,
-    plot_energy_decay,
-    plot_energy_flow,
-    plot_force_spectrum,
-)
+from .decay import plot_circle_fit, plot_energy_decay
 from .losses import plot_energy_fit, plot_loss_shares, plot_profiles
+from .prediction import plot_prediction_errors, plot_track_comparison
 from .solvers import plot_work_precision
-from .track import plot_prediction_errors, plot_track_comparison
+from .suspension import plot_decay_rate_cuts, plot_decay_rate_map, plot_energy_flow, plot_force_spectrum
 from .trajectories import (
     plot_angles,
     plot_energy,

@@ -131,7 +131,7 @@ def plot_lyapunov_convergence(
     ax.axhline(0.0, color="k", lw=0.6)
     ax.set(xlabel="averaging time t [s]", ylabel="largest Lyapunov exponent estimate lambda(t) [1/s]",
            title=f"convergence of the largest Lyapunov exponent: {title}" if title else "convergence of lambda")
-    legend_outside(ax)
+    legend_below(fig, *ax.get_legend_handles_labels(), ncols=1)  # long labels: below, as wide as the axes
     ax.grid(alpha=0.3, which="both")
     return save(fig, path)
 

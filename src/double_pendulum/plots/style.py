@@ -17,17 +17,47 @@ from matplotlib.legend import Legend  # noqa: E402
 
 FIGURE_DPI = 120
 """Resolution [dots per inch] of the saved figures."""
-DRAFT_DPI = 60
-"""Resolution [dots per inch] of draft figures (quick runs): rendering at 120 dpi is about half of a
-figure's cost."""
+DRAFT_DPI = 100
+"""Resolution [dots per inch] of draft figures (quick runs). At 60 dpi their text was too small to read; a
+figure's cost hardly depends on it (the layout and the drawing of its artists dominate), what the draft saves
+is the layout (:func:`save`)."""
 _DRAFT: ContextVar[bool] = ContextVar("draft_figures", default=False)
 """Whether :func:`save` writes draft figures now (:func:`draft_figures`; this package's own setting:
-matplotlib's rcParams stay the user's)."""
+matplotlib's rcParams stay the user's, but for math fonts the machine lacks: :func:`use_installed_fonts`)."""
 DRAFT_PAD_INCHES = 0.1
 """Margin [in] around a draft figure's content (matplotlib's default ``savefig.pad_inches``)."""
 DRAFT_SPACING: dict[str, float] = {"hspace": 0.5, "wspace": 0.35}
 """Space between the subplots of a draft figure (fractions of the mean axes height and width), instead of
 ``tight_layout``'s measured spacing: room for a title above and tick labels and an axis label below."""
+
+
+def _installed(family: str) -> bool:
+    """Whether Matplotlib's font list has ``family``."""
+    from matplotlib import font_manager
+
+    return any(font.name == family for font in font_manager.fontManager.ttflist)
+
+
+def font_settings() -> dict[str, str]:
+    """Settings that keep the figures' math text (log-axis tick labels among it) to fonts the machine has.
+
+    Every math font set built into Matplotlib loads the STIX fonts as its fallback when it parses math text; a
+    Matplotlib without them (a distribution's package that leaves out the fonts Matplotlib ships) then prints
+    "findfont: Font family ['STIXGeneral'] not found" for each lookup. Without STIX: the ``custom`` set (its
+    letters from ``mathtext.rm`` and the like: DejaVu Sans by default, calligraphic ones from it too rather than
+    a cursive font few machines have) and no fallback; with it, nothing to change."""
+    if _installed("STIXGeneral"):
+        return {}
+    return {"mathtext.fontset": "custom", "mathtext.fallback": "None", "mathtext.cal": "sans:italic"}
+
+
+def use_installed_fonts() -> None:
+    """Apply :func:`font_settings` (nothing, where the user's fonts are there); done when the plots are imported.
+    A text keeps the math font set of the time it was made, so this cannot wait for :func:`save`."""
+    plt.rcParams.update(font_settings())
+
+
+use_installed_fonts()
 
 
 @contextmanager

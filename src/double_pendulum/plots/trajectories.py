@@ -12,12 +12,13 @@ from .style import legend_below, legend_outside, save
 
 
 def plot_angles(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
-    """Angles phi1, phi2 [rad] over time, one panel per run."""
+    """Angles phi1, phi2 [rad] over time, one panel per run; unwrapped (a rod that turns over keeps counting)."""
     fig, axes = plt.subplots(len(runs), 1, figsize=(9, 3 * len(runs)), squeeze=False)
     for ax, (label, r) in zip(axes[:, 0], runs.items()):
         ax.plot(r["time"], r["phi1"], label="phi1 (upper rod)")
         ax.plot(r["time"], r["phi2"], label="phi2 (lower rod)")
-        ax.set(title=f"{label}: rod angles from the vertical", xlabel="t [s]", ylabel="angle [rad]")
+        ax.set(title=f"{label}: rod angles from the vertical, unwrapped (each full turn adds 2 pi)",
+               xlabel="time t [s]", ylabel="angle, unwrapped [rad]")
         legend_outside(ax)
         ax.grid(alpha=0.3)
     return save(fig, path)

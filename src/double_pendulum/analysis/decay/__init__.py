@@ -1,0 +1,2 @@
+"""The measured energy decay (scenario ``energy_decay``): decay laws and weighted fits (:mod:`.fit`), the
+summary and track table (:mod:`.summary`), the error budget (:mod:`.error_budget`) and the report."""

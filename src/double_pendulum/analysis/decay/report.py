@@ -1,0 +1,210 @@
+r"""The Markdown report of the ``energy_decay`` scenario: figures from its summary and the discussion.
+
+Every number comes from the summary (:mod:`.decay_summary`); the sections explain the geometry, the
+energy's errors, the exponential fit E = a exp(b t) [J], the comparison of decay models and why a and
+b differ from the seed's a = 0.813 J, b = -0.024 1/s.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from ..track.measurement import FPS, SEED_TOTAL_MASS_KG, SG_POLYORDER, SG_WINDOW
+from .error_budget import budget_table
+from .fit import AUTOCORRELATION_LAG_S
+
+
+def plus_minus(value: float, err: float, scale: float = 1.0, digits: int = 4) -> str:
+    """``value +- err``, both multiplied by ``scale`` (e.g. 1e3 for m -> mm), with ``digits`` decimals."""
+    return f"{value * scale:.{digits}f} +- {err * scale:.{digits}f}"
+
+
+def comparison_rows(summary: dict[str, Any]) -> str:
+    """Markdown table of the decay models: parameters with errors, chi2_red, dAIC, dBIC, Akaike weight."""
+    lines = ["| model | parameters | chi2_red | dAIC | dBIC | Akaike weight |", "|---|---|---|---|---|---|"]
+    for row in summary["model_comparison"]:
+        units = row["units"]
+        params = ", ".join(
+            f"{n} = {v:.4g} +- {row['stderr'][n]:.2g} {units[n] if units[n] != '1' else ''}".rstrip()
+            for n, v in row["params"].items()
+        )
+        lines.append(
+            f"| {row['model']} | {params} | {row['chi2_red']:.3f} | {row['delta_aic']:.1f} | "
+            f"{row['delta_bic']:.1f} | {row['akaike_weight']:.3f} |"
+        )
+    return "\n".join(lines)
+
+
+def variant_rows(summary: dict[str, Any]) -> str:
+    """Markdown table of the exponential fit a [J], b [1/s] (errors inflated for correlation) per energy, weights."""
+    labels = {
+        "equal_weights": "Savitzky-Golay energy, equal weights",
+        "cd_equal_weights": "central-difference energy, equal weights",
+        "position_noise_relative": "Savitzky-Golay energy, propagated noise as relative weights",
+        "seed_eq25": "Savitzky-Golay energy, seed's eq. 25",
+        "seed_recipe_cd_eq25": "central-difference energy, seed's eq. 25 (the seed's recipe)",
+        "equal_weights_with_release": "Savitzky-Golay energy, equal weights, hand release included",
+    }
+    lines = ["| energy, weights | a [J] | b [1/s] | chi2_red | n |", "|---|---|---|---|---|"]
+    rows = {"Savitzky-Golay energy, calibrated errors (main result)": summary}
+    rows.update({labels[k]: v for k, v in summary["weighting_variants"].items()})
+    for label, v in rows.items():
+        chi2 = "-" if v["chi2_red"] is None else f"{v['chi2_red']:.2f}"
+        a = plus_minus(v["a_J"], v["a_J_stderr_autocorr"])
+        b = plus_minus(v["b_per_s"], v["b_per_s_stderr_autocorr"], digits=5)
+        lines.append(f"| {label} | {a} | {b} | {chi2} | {v['n_points']} |")
+    return "\n".join(lines)
+
+
+def _geometry_section(s: dict[str, Any]) -> str:
+    """Frames, pivot, rod lengths [mm] and position noise."""
+    pivot = s["pivot_origin_m"]
+    noise = s["position_noise_m"]
+    return f"""## Geometry
+
+- Frames: {s["n_frames"]} at {FPS} fps; flagged as tracker jumps: {s["n_flagged"]}; hand release over at
+  frame {s["release_frame"]} (t = {s["release_time_s"]:.3f} s); frames in the fits: {s["n_fit"]}.
+- Pivot (circle fit of the upper bob, in the table's coordinates):
+  x = {plus_minus(pivot["x"], pivot["sigma_x"], 1e3, 2)} mm, y = {plus_minus(pivot["y"], pivot["sigma_y"], 1e3, 2)} mm;
+  rms distance of the upper bob from the circle {1e3 * s["circle_rms_residual_m"]:.2f} mm.
+- l1 = {plus_minus(s["l1_m"], s["l1_stderr_m"], 1e3, 2)} mm (circle radius);
+  l2 = {plus_minus(s["l2_m"], s["l2_stderr_m"], 1e3, 2)} mm (mean bob distance, std {1e3 * s["l2_std_m"]:.1f} mm).
+  Both errors treat the frames as independent; the radii wander slowly, so they are lower bounds: the
+  upper bob's distance from the pivot drifts by {1e3 * s["r1_drift_m_per_s"] * s["n_frames"] / FPS:+.1f} mm
+  over the run (camera or mount moving). The energy uses the angles, which a radial shift leaves unchanged.
+- Position noise (frame-to-frame jitter of the rod lengths): upper bob {1e3 * noise["upper_bob"]:.2f} mm,
+  lower bob {1e3 * noise["lower_bob"]:.2f} mm.
+"""
+
+
+def _energy_section(s: dict[str, Any]) -> str:
+    """The energy, the derivative filters' gains and the calibrated error model."""
+    em, sc = s["error_model"], s["scatter"]
+    sg = s["derivative_filters"]["savgol"]["gain"]
+    cd = s["derivative_filters"]["central_difference"]["gain"]
+    return f"""## Energy and its errors
+
+The energy is `double_pendulum.model.energy.total_energy` for point masses m1 = {s["masses_kg"]["m1"]} kg,
+m2 = {s["masses_kg"]["m2"]} kg on the measured rods (potential zero with both bobs at rest below the
+fitted pivot). The angular velocities come from a Savitzky-Golay derivative ({SG_WINDOW} frames, order
+{SG_POLYORDER}): on a harmonic motion at 10 / 20 / 25 rad/s it returns {sg["10_rad_s"]:.3f} /
+{sg["20_rad_s"]:.3f} / {sg["25_rad_s"]:.3f} of the true rate, the seed's central differences
+{cd["10_rad_s"]:.3f} / {cd["20_rad_s"]:.3f} / {cd["25_rad_s"]:.3f} (kinetic energy: the square).
+
+The propagated position noise gives energy errors of only {1e3 * em["median_sigma_noise_J"]:.1f} mJ
+(median); the exponential fit with them has chi2_red = {em["chi2_red_with_noise_only"]:.0f}, so the
+scatter of the energy is not white position noise. It grows with speed: the rms residual is
+{1e3 * sc["rms_residual_slowest_quarter_J"]:.0f} mJ in the slowest quarter of the frames and
+{1e3 * sc["rms_residual_fastest_quarter_J"]:.0f} mJ in the fastest, single frames are off by up to
+{sc["max_abs_residual_J"]:.2f} J, and the distance between the bobs changes by up to
+{1e3 * sc["max_bob_distance_change_in_two_frames_m"]:.0f} mm within two frames (a rigid rod would not).
+The fits therefore use errors calibrated on the data by maximum likelihood, alternating with the
+exponential fit: sigma^2 = sigma_noise^2 + s0^2 + dv^2 (m1^2 v1^2 + m2^2 v2^2) with
+s0 = {1e3 * em["floor_J"]:.1f} mJ and dv = {em["dv_m_per_s"]:.3f} m/s (the seed's eq. 25 has
+dv = {em["seed_dv_m_per_s"]} m/s and no floor).
+"""
+
+
+def _fit_section(s: dict[str, Any]) -> str:
+    """The exponential fit, its correlation-inflated errors and the difference to the seed."""
+    seed = s["seed"]
+    return f"""## Exponential fit E = a exp(b t)
+
+a = {plus_minus(s["a_J"], s["a_J_stderr"])} J, b = {plus_minus(s["b_per_s"], s["b_per_s_stderr"], digits=5)} 1/s
+(standard errors of the fit). The residuals are correlated over a swing: the variance inflation
+factor 1 + 2 sum(rho_k) over {AUTOCORRELATION_LAG_S} s of lags is {s["autocorrelation_factor"]:.2f},
+which makes the errors a +- {s["a_J_stderr_autocorr"]:.4f} J, b +- {s["b_per_s_stderr_autocorr"]:.5f} 1/s.
+
+The seed: a = {seed["a_J"]} J +- {100 * seed["a_rel_err"]:.2f} %, b = {seed["b_per_s"]} 1/s
++- {100 * seed["b_rel_err"]:.2f} %. Difference in b: {seed["b_difference_per_s"]:+.5f} 1/s, that is
+{seed["b_difference_in_seed_sigma"]:+.2f} times the seed's error and
+{seed["b_difference_in_combined_sigma"]:+.2f} times the combined error; in a: {seed["a_difference_J"]:+.4f} J,
+{seed["a_difference_in_combined_sigma"]:+.2f} times the combined error.
+
+The same fit with other energies and weights (errors inflated for the correlation):
+
+{variant_rows(s)}
+"""
+
+
+def _comparison_section(s: dict[str, Any]) -> str:
+    """The decay models compared; the free exponent p of dE/dt = -k E^p against 1/2, 1, 3/2."""
+    rows = {r["model"]: r for r in s["model_comparison"]}
+    power = rows["power"]
+    p, sp = power["params"]["p"], power["stderr"]["p"]
+    sp_corr = sp * math.sqrt(s["autocorrelation_factor"])
+    return f"""## Model comparison (same frames, calibrated errors)
+
+{comparison_rows(s)}
+
+Best by AIC: {s["model_comparison"][0]["model"]}. The criteria count every frame as independent; with
+the correlation factor the differences are worth about 1/{s["autocorrelation_factor"]:.1f} of the
+printed values. The free exponent of dE/dt = -k E^p is p = {p:.2f} +- {sp:.2f} (+- {sp_corr:.2f} with
+the correlation): Coulomb friction has p = 1/2 ({(p - 0.5) / sp_corr:+.1f} sigma), losses proportional
+to the energy p = 1 ({(p - 1.0) / sp_corr:+.1f} sigma), quadratic drag (E ~ 1/(1 + t/tau)^2, the seed's
+alternative "inverse square of time") p = 3/2 ({(p - 1.5) / sp_corr:+.1f} sigma, dAIC =
+{rows["quadratic_drag"]["delta_aic"]:.0f}).
+"""
+
+
+def _discussion_section(s: dict[str, Any]) -> str:
+    """Why a and b differ from the seed's: origin, velocity smoothing, energy model, weights, frames."""
+    m1, m2 = s["masses_kg"]["m1"], s["masses_kg"]["m2"]
+    cd20 = s["derivative_filters"]["central_difference"]["gain"]["20_rad_s"]
+    sg20 = s["derivative_filters"]["savgol"]["gain"]["20_rad_s"]
+    var = s["weighting_variants"]
+    return f"""## Why a and b differ from the seed's
+
+- **Origin and rod lengths.** The seed put the pivot at the grid point of least variance of the
+  distance; here it is a geometric circle fit. The potential energy is measured from the pivot, and
+  1 mm of height is (m1 + m2) g * 1 mm = {1e3 * (m1 + m2) * 9.81e-3:.1f} mJ; the seed does not say where
+  its potential is zero.
+- **Velocity smoothing at 30 fps.** As the seed explains (4.2.2, fig. 8), the frames before and after
+  the lowest point cut the corner and flatten the speed peaks: central differences return
+  {100 * cd20:.1f} % of the rate of a 20 rad/s motion ({100 * cd20**2:.0f} % of its kinetic energy), the
+  Savitzky-Golay derivative {100 * sg20:.1f} %. Larger kinetic energies mean a larger a: with equal
+  weights a = {var["cd_equal_weights"]["a_J"]:.4f} J from central differences,
+  {var["equal_weights"]["a_J"]:.4f} J from the Savitzky-Golay derivative.
+- **Energy model.** Point masses on massless rods: the seed's pendulum moves
+  {SEED_TOTAL_MASS_KG} kg in total (4.2.3) against m1 + m2 = {m1 + m2:.3f} kg, so about
+  {SEED_TOTAL_MASS_KG - m1 - m2:.1f} kg of acrylic rods are missing from the energy and make the
+  computed energy depend on the configuration: one source of the floor s0.
+- **Weights.** The seed weighted with eq. 25, whose errors nearly vanish at the turning points although
+  the energy scatters there too: the slowest tenth of the frames carries
+  {100 * s["scatter"]["seed_weight_share_of_slowest_tenth"]:.0f} % of the total weight. With eq. 25 weights
+  b = {var["seed_eq25"]["b_per_s"]:.4f} 1/s, with equal weights {var["equal_weights"]["b_per_s"]:.4f} 1/s:
+  the weights move b by more than its statistical error, a sign that the exponential is only an
+  approximation to the decay.
+- **Frames.** The energy rises during the first frames while the hand lets go; those frames are left
+  out. Table 1 covers {s["n_frames"] / FPS:.1f} s (the seed speaks of a 30 s measurement).
+- **Rounding.** The seed prints b = -0.024 with two digits: every value from -0.0245 to -0.0235 is
+  printed so, a range as wide as the seed's own error of b.
+"""
+
+
+def _budget_section(s: dict[str, Any]) -> str:
+    """The error budget of a and b (statistical and systematic, total in quadrature) beside the seed's."""
+    if "error_budget" not in s:
+        return ""
+    bud = s["error_budget"]
+    return f"""## Error budget of a and b
+
+The errors quoted above are statistical only. Re-doing the fit with one choice changed at a time
+(`src/double_pendulum/analysis/decay_error_budget.py`):
+
+{budget_table(bud)}
+
+Total: a = {bud["a_J"]:.4f} +- {bud["total_a_J"]:.4f} J ({bud["total_a_relative"]:.1%}), b = {bud["b_per_s"]:.5f}
++- {bud["total_b_per_s"]:.5f} 1/s ({bud["total_b_relative"]:.1%}). The rod-mass row is a bias of the
+point-mass energy (the acrylic members carry energy too); the seed's 1.26 % and 4.89 % are
+statistical errors of its fit alone.
+"""
+
+
+def report_text(summary: dict[str, Any]) -> str:
+    """The Markdown report: figures from ``summary`` and the discussion of the differences to the seed."""
+    sections = (_geometry_section, _energy_section, _fit_section, _budget_section, _comparison_section,
+                _discussion_section)
+    body = "\n".join(section(summary) for section in sections)
+    return "# Energy decay of the seed pendulum (Table 1)\n\n" + body

@@ -1,0 +1,200 @@
+r"""Which loss mechanisms drain the real pendulum? The loss identification of the ``loss_identification``
+scenario (:func:`identify_losses`): every model (:mod:`.mechanisms`) fitted to the measured energy
+(:mod:`.fitting`), compared (:mod:`.comparison`), the best one re-run through the FMU, and what the fits
+support (:mod:`.claims`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ...model.parameters import SEED_RIGID_LINKS
+from ..suspension.identification import MeasuredDecay, measured_decay
+from ..track.measurement import Reconstruction, load_track, reconstruct
+from . import claims as loss_claims
+from .comparison import (
+    air_share_at_defaults,
+    common_factor,
+    comparison_rows,
+    decay_numbers,
+    half_residuals,
+    identifiability,
+    parameter_table,
+    profile_item,
+    profile_items,
+    profile_summary,
+    share_errors,
+)
+from .fitting import fit_models, problem_from_track, run_budget
+from .mechanisms import (
+    FULL_MODELS,
+    MECHANISMS,
+    OMEGA_REG,
+    QUICK_MODELS,
+    SUSPENSION_K,
+    SUSPENSION_M,
+    THOROUGH_MODELS,
+    mechanisms_of,
+    model_values,
+    shares,
+)
+
+
+def measured_loss(md: MeasuredDecay) -> float:
+    """Energy lost [J] over the fitted frames according to the measured exponential fit."""
+    a, b = md.fit.value("a"), md.fit.value("b")
+    return a * (math.exp(b * md.frames.t[0]) - math.exp(b * md.frames.t[-1]))
+
+
+def seed_reconstruction() -> Reconstruction:
+    """The seed's track reconstructed with the rigid links :data:`SEED_RIGID_LINKS`."""
+    return reconstruct(load_track(), rods=SEED_RIGID_LINKS)
+
+
+def measured(rec: Reconstruction | None = None, window_s: float | None = None) -> MeasuredDecay:
+    """The measured decay after the release of a reconstruction (default: :func:`seed_reconstruction`),
+    optionally only the first ``window_s`` seconds [s]."""
+    return measured_decay(seed_reconstruction() if rec is None else rec, window_s)
+
+
+# --- the whole identification --------------------------------------------------------------------
+
+
+@dataclass(frozen=True, eq=False)
+class LossIdentification:
+    """Everything the scenario writes: the summary and the arrays of its table and figures."""
+
+    summary: dict[str, Any]
+    t: np.ndarray
+    e_measured: np.ndarray
+    sigma: np.ndarray
+    e_sim: np.ndarray
+    works: dict[str, np.ndarray]
+
+
+def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """Does the suspension dominate the loss? From the suspension's share in every model that has it
+    and the top model's composition (a plain sentence and the numbers); not asked (``None``) when no
+    fitted model has a suspension (the quick run)."""
+    label = MECHANISMS["suspension"].label
+    if not any("suspension" in r["model"].split("+") for r in rows):
+        return {"suspension_dominates": None, "suspension_share_by_model": {},
+                "answer": "Not tested: no model with a suspension was fitted in this run (quick mode fits "
+                          "air+drag alone); the default run fits air+suspension."}  # fmt: skip
+    with_susp = {r["model"]: r["shares"].get(label) for r in rows if label in r["shares"] and r["converged"]}
+    best = rows[0]
+    dominates = bool(label in best["shares"] and best["shares"][label] > 0.5)
+    if dominates:
+        share = best["shares"][label]
+        text = f"Yes: the top model ({best['model']}) loses {share:.0%} of its energy in the suspension."
+    else:
+        parts = ", ".join(f"{m}: {s:.0%} (delta AIC {next(r['delta_aic'] for r in rows if r['model'] == m):.1f})"
+                          for m, s in with_susp.items())  # fmt: skip
+        if label in best["shares"]:
+            text = f"No: the suspension carries {best['shares'][label]:.0%} of the loss in the top model"
+        else:
+            text = f"No: the top model ({best['model']}) needs no suspension loss"
+        text += f"; suspension share where it is fitted: {parts}." if parts else "."
+    return {"suspension_dominates": dominates, "answer": text, "suspension_share_by_model": with_susp}
+
+
+def goal_checks(numbers: Mapping[str, float], halves: Mapping[str, Any]) -> dict[str, Any]:
+    """The issue's goal: b_sim within 2 % of b_measured, p_sim within 2 p_measured_stderr, no trend."""
+    b_dev = numbers["b_sim_per_s"] / numbers["b_measured_per_s"] - 1.0
+    p_dev = (numbers["p_sim"] - numbers["p_measured"]) / numbers["p_measured_stderr"]
+    checks = {
+        "b_relative_deviation": b_dev,
+        "b_within_2_percent": bool(abs(b_dev) <= 0.02),
+        "p_deviation_in_stderr": p_dev,
+        "p_within_2_stderr": bool(abs(p_dev) <= 2.0),
+        "no_trend_between_halves": not halves["trend"],
+    }
+    checks["met"] = all(checks[k] for k in ("b_within_2_percent", "p_within_2_stderr", "no_trend_between_halves"))
+    return checks
+
+
+def identify_losses(
+    runner: Any, *, quick: bool = False, thorough: bool = False, max_workers: int | None = None
+) -> LossIdentification:
+    """Fit every model (:data:`FULL_MODELS`; thorough: :data:`THOROUGH_MODELS`; quick: :data:`QUICK_MODELS`,
+    in this process, at :data:`QUICK_SIM_SETTINGS` with :data:`QUICK_RUN_BUDGET` runs: one Gauss-Newton
+    step) in parallel with the in-process component, compare them, profile the best one (thorough mode only:
+    in the runs so far its intervals matched the curvature errors, for 8 more fits, about 18 s of CPU) and
+    re-run it through ``runner`` (the FMU) for the headline numbers. One pool of worker processes serves
+    every round and the profile. All modes fit the whole record (the first 8 s alone leave the losses
+    unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim`` obtains its
+    ``air+drag`` by :func:`identified_fit` from the same problem (:func:`problem_from_track` in the same
+    mode: the same start, budget and settings), so it reads this mode's fit."""
+    from ..sweep import parallel_map, worker_pool  # noqa: PLC0415 - process pools only when identifying
+
+    rec = seed_reconstruction()
+    md = measured(rec)
+    problem = problem_from_track(rec, md, quick=quick)
+    models = QUICK_MODELS if quick else THOROUGH_MODELS if thorough else FULL_MODELS
+    profile: dict[str, Any] = {}
+    max_workers = 1 if quick else max_workers  # one model: no worker processes to start
+    with worker_pool(max_workers) as pool:
+        fits, workers = fit_models(models, problem, max_workers, pool, short=not thorough, max_runs=run_budget(quick))
+        factor = common_factor(fits)
+        rows = comparison_rows(fits, factor)
+        best = next(f for f in fits if f.model == rows[0]["model"])
+        if thorough:
+            items = profile_items(best, factor)
+            chi2s, _ = parallel_map(profile_item, items, shared=problem, max_workers=max_workers, label="profile",
+                                    pool=pool)  # fmt: skip
+            profile = profile_summary(best, factor, items, chi2s)
+    works = sorted({m.work for m in mechanisms_of(best.model)})
+    result = problem.simulate(model_values(best.model, best.theta), outputs=("E_pendulum", *works), runner=runner)
+    e_sim = np.asarray(result["E_pendulum"])[problem.offsets]
+    _, kappa = problem.scaled_residuals(e_sim)
+    numbers = decay_numbers(problem, problem.energy, e_sim)
+    halves = half_residuals(problem, e_sim, kappa, factor)
+    loss = measured_loss(md)
+    summary = {
+        "scenario": "loss_identification",
+        "source": "seed Table 1 (data/seed_table1.csv), rigid links SEED_RIGID_LINKS",
+        "pendulum": {k: getattr(rec.params, k) for k in ("m1", "m2", "l1", "l2", *SEED_RIGID_LINKS)},
+        "t0_s": problem.t0,
+        "record_s": float(problem.t[-1] - problem.t[0]),
+        "n_frames": len(problem.t),
+        "quick": quick,
+        "thorough": thorough,
+        "models_fitted": list(models),
+        "workers": workers,
+        "top_model": best.model,
+        "top_model_means": "the lowest AIC; models within delta AIC 2 (supported_models) fit about as well, so "
+                           "b_sim_per_s, p_sim, parameters and top_model_shares are the top model's, not a verdict",
+        **numbers,
+        "top_model_shares": shares(result, best.model),
+        "top_model_shares_stderr": share_errors(best, shares(result, best.model), factor),
+        "parameters": parameter_table(best, factor),
+        "identifiability": identifiability(best, factor),
+        "profile_likelihood": profile,
+        "energy_scale_kappa": kappa,
+        "correlation_factor_F": factor,
+        "residual_halves": halves,
+        "goal": goal_checks(numbers, halves),
+        "measured_loss_J": loss,
+        "simulated_loss_J": float(sum(float(result[w][-1]) for w in works)),
+        **suspension_answer(rows),
+        "supported_models": loss_claims.supported_models(rows),
+        "b_sim_range_all_models_per_s": loss_claims.b_sim_range(rows),
+        "drag_torque_against_seed_rolling_friction": next(
+            (loss_claims.seed_rolling_friction(rec.params, r["parameters"]["tau_b"]["value"]) for r in rows
+             if r["model"] == "air+drag"), None),
+        "air_drag_at_defaults": air_share_at_defaults(problem, loss),
+        "models": rows,
+        "suspension_fixed": {"k_N_per_m": SUSPENSION_K, "M_s_kg": SUSPENSION_M},
+        "omega_reg_rad_per_s": OMEGA_REG,
+        "null_means": {"suspension_dominates": "not tested: no model with a suspension was fitted (quick mode)",
+                       "profile_likelihood": "empty: profiled with --thorough only (its intervals matched the "
+                                             "curvature errors in the runs so far)"},
+        "start_state": {k: problem.base[k] for k in ("phi1_0", "phi2_0", "omega1_0", "omega2_0")},
+    }
+    t = problem.t
+    return LossIdentification(summary, t, problem.energy, problem.sigma, kappa * e_sim,
+                              {w: np.asarray(result[w])[problem.offsets] for w in works})  # fmt: skip
