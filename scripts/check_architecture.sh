@@ -11,6 +11,8 @@ python=${1:-.venv/bin/python}
 python="$(cd "$(dirname "$python")" && pwd)/$(basename "$python")"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+# setuptools reuses build/lib and keeps files deleted since: build from a clean scratch folder
+rm -rf build/lib build/bdist.*
 "$python" -m pip wheel -q --no-deps -w "$tmp/wheel" . >/dev/null
 "$python" -m zipfile -e "$tmp"/wheel/*.whl "$tmp/tree"
 cp .importlinter "$tmp/tree/"

@@ -10,6 +10,8 @@ mode=--quick
 [ "${2:-}" = "--full" ] && mode=
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+# setuptools reuses build/lib and keeps files deleted since: build from a clean scratch folder
+rm -rf build/lib build/bdist.*
 "$python" -m pip wheel -q --no-deps -w "$tmp/wheel" . >/dev/null
 "$python" -m venv "$tmp/venv"
 "$tmp/venv/bin/pip" install -q "$tmp"/wheel/*.whl
