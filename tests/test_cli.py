@@ -226,6 +226,12 @@ def test_run_from_another_folder_keeps_every_fmu_in_the_out_folder(tmp_path, mon
     assert names == ["DoublePendulum.fmu", "PendulumOnSuspension.fmu", "PendulumOnSuspension.ssp", "Suspension.fmu",
                      "fmi3/DoublePendulum.fmu"]  # fmt: skip
     assert all(path.is_file() for path in fmu_set(fmu)) and fmu_set_is_current(fmu)
+    newer = tmp_path / "DoublePendulumFmi3.py"  # an FMI 3 adapter source changed since: the set is stale
+    newer.write_text("")
+    os.utime(newer, (fmu.stat().st_mtime + 60,) * 2)
+    monkeypatch.setattr("double_pendulum.fmu.build_fmi3.adapter_sources", lambda: [newer])
+    assert not fmu_set_is_current(fmu)
+    monkeypatch.undo()
     (out / "fmu" / "PendulumOnSuspension.ssp").unlink()  # one missing: the next run builds the set again
     assert not fmu_set_is_current(fmu)
 

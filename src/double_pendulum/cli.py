@@ -128,11 +128,15 @@ def fmu_set_is_current(fmu: Path) -> bool:
         return False
     if fmu.name != DEFAULT_FMU_PATH.name:
         return True
+    from .fmu.build_fmi3 import adapter_sources as fmi3_sources
+
     built = fmu.stat().st_mtime
     others = fmu_set(fmu)[1:]
     interfaces = [path for path in others if path.stem in INTERFACES and path.parent == fmu.parent]
+    fmi3 = fmu.parent / "fmi3" / fmu.name  # also built from its own adapter
     return all(fmu_is_current(path, path.stem) for path in interfaces) and all(
-        path.is_file() and path.stat().st_mtime >= built for path in others if path not in interfaces)
+        path.is_file() and path.stat().st_mtime >= built for path in others if path not in interfaces
+    ) and all(source.stat().st_mtime <= fmi3.stat().st_mtime for source in fmi3_sources())
 
 
 def _load_fmu(path: str, rebuild: bool):
