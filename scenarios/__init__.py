@@ -20,20 +20,20 @@ SCENARIOS: tuple[str, ...] = (
 )
 
 EXPECTED_CPU_S: dict[str, float] = {
-    "cosimulation": 46.0,
-    "free_swing": 6.0,
-    "friction_budget": 11.0,
-    "energy_decay": 2.3,
-    "loss_identification": 92.0,
-    "suspension_transfer": 122.0,
-    "measured_vs_sim": 20.0,
-    "work_precision": 85.0,
-    "stability": 32.0,
-    "chaos": 154.0,
-    "base_excitation": 57.0,
+    "cosimulation": 19.6,
+    "free_swing": 2.1,
+    "friction_budget": 5.2,
+    "energy_decay": 1.1,
+    "loss_identification": 46.1,
+    "suspension_transfer": 54.6,
+    "measured_vs_sim": 24.0,
+    "work_precision": 47.1,
+    "stability": 15.3,
+    "chaos": 63.0,
+    "base_excitation": 45.0,
 }
-"""CPU time [s] of each scenario's default run, as last measured (first run, 2 cores, one worker process
-each, 2026-12-02; chaos and suspension_transfer less the parts moved to ``--thorough`` after it): ``run all``
+"""CPU time [s] of each scenario's default run, as last measured (first run of ``run all`` on a fresh clone,
+2 cores, one worker process each, 2026-12-02, after the faster driven component and solvers): ``run all``
 starts the longest first, packs the small ones into shared children and weights its progress bar by them;
 nothing else depends on them."""
 
