@@ -155,7 +155,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     # runs on the measured frames: identified, no suspension, the resonant end of the iso-b curve
     runs = {"identified": ident_run, "no suspension": base_run}
     flows = {"identified": ident_flow}
-    points = {f"identified (k fixed at {ident.k:g} N/m)": (ident.k, ident.c)}
+    points = {f"c fitted at the assumed k = {ident.k:g} N/m (conditional, not identified)": (ident.k, ident.c)}
     points.update({f"c refitted at k = {f.k:.3g} N/m": (f.k, f.c) for f in trace})
     if resonant is not None:
         runs["resonant"], flows["resonant"] = resonant_runs

@@ -89,7 +89,7 @@ def _mark_points(
     if slope_through is not None:
         k0, c0 = slope_through
         ks = np.geomspace(np.min(k_range), np.max(k_range), 50)
-        ax.plot(ks, c0 * (ks / k0) ** 2, color="orange", lw=1.4, label="c ~ k^2 through the identified point "
+        ax.plot(ks, c0 * (ks / k0) ** 2, color="orange", lw=1.4, label="c ~ k^2 through the fitted point "
                 "(stiff limit)")
     for (label, (k, c)), marker in zip((points or {}).items(), "o^sDv"):
         ax.plot([k], [c], marker, color="r", mec="k", ms=8, label=label, clip_on=False, zorder=5)
@@ -132,7 +132,7 @@ def plot_decay_rate_map(
         mesh = _decay_panel(ax, panels[title], levels, norm)
         if title == main:
             _mark_points(ax, panels[title]["k"], points, slope_through)
-            title += " (identified suspension mass)" if points else ""
+            title += " (the assumed suspension mass)" if points else ""
         ax.set_title(title)
     axes[0, 0].set_ylabel("suspension damping c [N s/m]")
     fig.colorbar(mesh, ax=axes[0].tolist(), label="decay rate b of the pendulum energy, E ~ exp(b t) [1/s]",
