@@ -37,7 +37,7 @@ def test_decay_rate_map_orders_panels_by_mass_with_one_colour_bar_and_the_legend
     assert len(fig.axes) == 4  # three panels and one shared colour bar
     assert "[1/s]" in fig.axes[-1].get_ylabel() and "decay rate" in fig.axes[-1].get_ylabel()
     assert all(ax.get_legend() is None for ax in data_axes) and len(fig.legends) == 1
-    assert "identified" in data_axes[1].get_title()  # the points belong to the first panel given (2 kg)
+    assert "assumed" in data_axes[1].get_title()  # the points belong to the first panel given (2 kg)
 
 
 def test_smooth_log_field_keeps_the_grid_values_and_stays_within_their_range():
