@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from functools import cache
+from typing import Any
 
 SparseRow = tuple[tuple[int, float], ...]
 
@@ -25,12 +26,19 @@ def _terms(row: SparseRow, c: int) -> str:
     return " + ".join(f"{a!r} * k{j}[{c}]" for j, a in row) or "0.0"
 
 
-def _compile(name: str, args: str, row: SparseRow, body: str) -> Callable:
-    unpack = "".join(f"    k{j} = ks[{j}]\n" for j in sorted({j for j, _ in row}))
-    source = f"def {name}({args}):\n{unpack}    return [{body}]\n"
-    namespace: dict = {}
+def _define(source: str, name: str, **globals_: Any) -> Callable:
+    """The function ``name`` that ``source`` defines, with ``globals_`` as its globals.
+
+    Every source here is generated from float literals, indices and argument names only.
+    """
+    namespace: dict = dict(globals_)
     exec(compile(source, f"<{name}>", "exec"), namespace)  # noqa: S102 - literals and indices only
     return namespace[name]
+
+
+def _compile(name: str, args: str, row: SparseRow, body: str) -> Callable:
+    unpack = "".join(f"    k{j} = ks[{j}]\n" for j in sorted({j for j, _ in row}))
+    return _define(f"def {name}({args}):\n{unpack}    return [{body}]\n", name)
 
 
 @cache
@@ -46,9 +54,7 @@ def step_combination(row: SparseRow, n: int) -> Callable[[list[float], float, Se
     )
     unpack = "".join(f"    k{j} = ks[{j}]\n" for j in sorted({j for j, _ in row}))
     source = f"def stage(y, h, ks):\n{unpack}{scaled}    return [{body}]\n"
-    namespace: dict = {}
-    exec(compile(source, "<stage>", "exec"), namespace)  # noqa: S102 - literals and indices only
-    return namespace["stage"]
+    return _define(source, "stage")
 
 
 @cache
@@ -83,9 +89,7 @@ def explicit_stages(a: tuple[SparseRow, ...], c: tuple[float, ...], n_stages: in
         source += scaled + f"    k{i} = f(t + {c[i]!r} * h, {state})\n" + unpack(f"k{i}")
     scaled, y_new = combination(b, "hb")
     source += scaled + f"    return {y_new}, [{', '.join(f'k{i}' for i in range(n_stages))}]\n"
-    namespace: dict = {}
-    exec(compile(source, "<stages>", "exec"), namespace)  # noqa: S102 - literals and indices only
-    return namespace["stages"]
+    return _define(source, "stages")
 
 
 @cache
@@ -106,9 +110,7 @@ def scaled_error_norm(row: SparseRow, n: int) -> Callable[..., float]:
         lines.append(f"    s{c} = atol + rtol * (b{c} if b{c} > a{c} else a{c})")
         terms.append(f"(e{c} / s{c}) ** 2")
     lines.append(f"    return sqrt((0.0 + {' + '.join(terms)}) / {n})")
-    namespace: dict = {"sqrt": math.sqrt}
-    exec(compile("\n".join(lines) + "\n", "<norm>", "exec"), namespace)  # noqa: S102 - literals and indices only
-    return namespace["norm"]
+    return _define("\n".join(lines) + "\n", "norm", sqrt=math.sqrt)
 
 
 def dense_columns(
@@ -136,9 +138,7 @@ def dense_columns(
         hermite = [f"2.0 * dy{c} - h * (fy[{c}] + f_new[{c}])", f"h * fy[{c}] - dy{c}", f"dy{c}"]
         columns.append(f"({', '.join([*reversed(ds), *hermite])})")
     source += f"    return [{', '.join(columns)}]\n"
-    namespace: dict = {}
-    exec(compile(source, "<dense>", "exec"), namespace)  # noqa: S102 - literals and indices only
-    return namespace["dense"]
+    return _define(source, "dense")
 
 
 @cache
@@ -163,9 +163,7 @@ def two_estimate_error_norm(row5: SparseRow, row3: SparseRow, n: int) -> Callabl
     lines.append("    if n5 == 0.0 and n3 == 0.0:")
     lines.append("        return 0.0")
     lines.append(f"    return abs(h) * n5 / sqrt((n5 + 0.01 * n3) * {n})")
-    namespace: dict = {"sqrt": math.sqrt}
-    exec(compile("\n".join(lines) + "\n", "<norm>", "exec"), namespace)  # noqa: S102 - literals and indices only
-    return namespace["norm"]
+    return _define("\n".join(lines) + "\n", "norm", sqrt=math.sqrt)
 
 
 def sparse(weights: Sequence[float]) -> SparseRow:
@@ -194,6 +192,4 @@ def alternating_horner(n: int, m: int) -> Callable[[Sequence[Sequence[float]], S
             expr = f"{expr} * {'x' if i % 2 == 0 else 'u'}"
         results.append(f"{expr} + y[{c}]")
     lines.append(f"    return [{', '.join(results)}]")
-    namespace: dict = {}
-    exec(compile("\n".join(lines) + "\n", "<horner>", "exec"), namespace)  # noqa: S102 - names only
-    return namespace["horner"]
+    return _define("\n".join(lines) + "\n", "horner")

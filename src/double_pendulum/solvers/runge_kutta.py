@@ -44,22 +44,32 @@ VectorField = Callable[[float, list[float]], list[float]]
 SparseRows = Sequence[Sequence[tuple[int, float]]]
 
 
-_CONSTANT_KERNELS: dict[tuple[int, int, bool], Callable] = {}
+_KERNELS: dict[tuple[int, int, str], Callable] = {}
+
+
+def _tableau_kernel(key: object, n: int, kind: str, build: Callable[[], Callable]) -> Callable:
+    """The compiled ``kind`` of kernel of a *module-level constant* tableau part ``key`` for state size
+    ``n``, built once.
+
+    Cached by the constant's identity (a tableau lives as long as the module, so an identity is never
+    reused for other coefficients): finding it costs one small dict look-up, not the hash of a whole
+    tableau.
+    """
+    kernel = _KERNELS.get((id(key), n, kind))
+    if kernel is None:
+        kernel = _KERNELS[(id(key), n, kind)] = build()
+    return kernel
 
 
 def _constant_kernel(row: Sequence, n: int, *, dense_weights: bool = False) -> Callable:
-    """Compiled combination for a *module-level constant* ``row``, cached by its identity (fast).
+    """Compiled combination for a module-level constant ``row`` (:func:`_tableau_kernel`).
 
     Sparse rows ``((j, a_j), ...)`` give ``g(y, h, ks) = y + h sum_j a_j k_j``; dense weights
-    (``dense_weights=True``) give ``g(ks) = sum_j w_j k_j``. Only for rows that live as long as
-    the module (tableau constants), so an identity is never reused for other coefficients.
+    (``dense_weights=True``) give ``g(ks) = sum_j w_j k_j``.
     """
-    key = (id(row), n, dense_weights)
-    kernel = _CONSTANT_KERNELS.get(key)
-    if kernel is None:
-        kernel = weighted_sum(sparse(row), n) if dense_weights else step_combination(tuple(row), n)
-        _CONSTANT_KERNELS[key] = kernel
-    return kernel
+    if dense_weights:
+        return _tableau_kernel(row, n, "weights", lambda: weighted_sum(sparse(row), n))
+    return _tableau_kernel(row, n, "step", lambda: step_combination(tuple(row), n))
 
 
 def _stage_input(y: list[float], h: float, row: Sequence[tuple[int, float]], ks: list[list[float]]) -> list[float]:
@@ -72,24 +82,9 @@ def _weighted_sum(ks: list[list[float]], weights: Sequence[float]) -> list[float
     return weighted_sum(sparse(weights), len(ks[0]))(ks)
 
 
-_TABLEAU_KERNELS: dict[tuple[int, int], Callable] = {}
-
-
-def _tableau_kernel(key: object, n: int, build: Callable[[], Callable]) -> Callable:
-    """The compiled kernel of a *module-level constant* tableau ``key`` for state size ``n``, built once.
-
-    Cached by the constant's identity (a tableau lives as long as the module), so finding it costs
-    one small dict look-up, not the hash of a whole tableau.
-    """
-    kernel = _TABLEAU_KERNELS.get((id(key), n))
-    if kernel is None:
-        kernel = _TABLEAU_KERNELS[(id(key), n)] = build()
-    return kernel
-
-
 def _stages(a: SparseRows, c: Sequence[float], n_stages: int, b: SparseRows, n: int) -> Callable:
     """:func:`~double_pendulum.solvers.combinations.explicit_stages` of a module-level tableau."""
-    return _tableau_kernel(a, n, lambda: explicit_stages(a, tuple(c), n_stages, b, n))
+    return _tableau_kernel(a, n, "stages", lambda: explicit_stages(a, tuple(c), n_stages, b, n))
 
 
 _DOPRI5_B_ROW = sparse(tb.DOPRI5_B)
@@ -130,7 +125,7 @@ class Dopri5:
         return y_new, f_new, ks
 
     def error_norm(self, y, y_new, ks, h, rtol, atol) -> float:
-        norm = _tableau_kernel(_DOPRI5_E_ROW, len(y), lambda: scaled_error_norm(_DOPRI5_E_ROW, len(y)))
+        norm = _tableau_kernel(_DOPRI5_E_ROW, len(y), "norm", lambda: scaled_error_norm(_DOPRI5_E_ROW, len(y)))
         return norm(y, y_new, ks, h, rtol, atol)
 
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):
@@ -172,12 +167,12 @@ class Dop853:
 
     def error_norm(self, y, y_new, ks, h, rtol, atol) -> float:
         n = len(y)
-        norm = _tableau_kernel(tb.DOP853_E5, n, lambda: two_estimate_error_norm(_DOP853_E5_ROW, _DOP853_E3_ROW, n))
-        return norm(y, y_new, ks, h, rtol, atol)
+        build = partial(two_estimate_error_norm, _DOP853_E5_ROW, _DOP853_E3_ROW, n)
+        return _tableau_kernel(tb.DOP853_E5, n, "norm", build)(y, y_new, ks, h, rtol, atol)
 
     def interpolant(self, f, t, y, y_new, fy, f_new, h, ks):
         n = len(y)
-        dense = _tableau_kernel(tb.DOP853_D, n, lambda: dense_columns(_DOP853_EXTRA_STAGES, _DOP853_D_ROWS, n))
+        dense = _tableau_kernel(tb.DOP853_D, n, "dense", lambda: dense_columns(_DOP853_EXTRA_STAGES, _DOP853_D_ROWS, n))
         columns = dense(f, t, y, y_new, fy, f_new, h, ks)  # per component: its 7 coefficients, highest first
         # y + F0 x + F1 x(1-x) + F2 x^2(1-x) + ..., Horner-like with factors alternating x and 1-x
         return partial(alternating_horner(n, 7), columns, y)
