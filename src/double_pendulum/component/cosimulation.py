@@ -462,16 +462,17 @@ class DoublePendulumCoSimulation:
         if state["initialised"]:
             driven = self.driven or any(self._u)
             if same_model and model.config.inputs == driven:
+                # the integrator's vector field reads self._hold: reset it in place (below), nothing rebuilt
                 self.driven, self.model, self.integrator, self.initialised = driven, model, integrator, True
-                self._hold = InputHold(self.time, self._u) if driven else None
                 if driven:
-                    self.integrator.f = build_vector_field(model.config, model.evaluate, self._hold)
+                    self._hold.reset(self.time, self._u)
+                else:
+                    self._hold = None
             else:
-                self.initialise()  # rebuilds model and integrator from the restored parameters
+                self.initialise()  # rebuilds model, integrator and hold from the restored parameters
             hold = state["hold"]
             if hold is not None:
-                self._hold = InputHold(float(hold[0]), hold[1])
-                self.integrator.f = build_vector_field(self.model.config, self.model.evaluate, self._hold)
+                self._hold.reset(float(hold[0]), [float(v) for v in hold[1]])
             self.integrator.set_state(state["integrator"])
             self.time = float(state["time"])
             self._y = list(state["y"])
