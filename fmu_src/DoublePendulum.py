@@ -5,7 +5,7 @@ co-simulation (the mapping itself is :class:`double_pendulum_slave.ComponentSlav
 
 from __future__ import annotations
 
-from double_pendulum_slave import ComponentSlave, DefaultExperiment, runtime_module
+from .double_pendulum_slave import ComponentSlave, DefaultExperiment, runtime_module
 
 _cosim = runtime_module("component.cosimulation")
 _interface = runtime_module("component.variables").INTERFACES["DoublePendulum"]

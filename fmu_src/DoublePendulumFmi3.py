@@ -24,7 +24,7 @@ from __future__ import annotations
 import importlib
 from types import SimpleNamespace
 
-from slave_common import ComponentMapping, fmi_library, leave_host_as_found, runtime_module, runtime_package
+from .slave_common import ComponentMapping, fmi_library, leave_host_as_found, runtime_module, runtime_package
 
 _exchange = runtime_module("component.model_exchange")
 DERIVATIVE_UNITS, LOCAL_STATES, STATES = _exchange.DERIVATIVE_UNITS, _exchange.LOCAL_STATES, _exchange.STATES

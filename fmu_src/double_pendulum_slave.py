@@ -6,16 +6,16 @@ come from its :class:`~double_pendulum.component.variables.FmuInterface`. Each F
 (``DoublePendulum.py``, ``Suspension.py``) only names its interface and component.
 
 All physics, numerics and validation live in the ``double_pendulum`` package, whose runtime part
-(model, solvers, component) the build bundles into the FMU's resources next to this file, with
-pythonfmu's Python part. Both are imported under private names and a Python host is left as it was
-found (``slave_common.py``, shared with the FMI 3 FMU).
+(model, solvers, component) the build bundles into the FMU's resources, with pythonfmu's Python part
+and these adapters. All of them are imported under private names and a Python host is left as it
+was found (``slave_common.py``, shared with the FMI 3 FMU).
 """
 
 from __future__ import annotations
 
 import importlib
 
-from slave_common import (
+from .slave_common import (
     ComponentMapping,
     fmi_library,
     leave_host_as_found,

@@ -1,11 +1,19 @@
 """What every FMU's Python side shares, FMI 2 (pythonfmu) and FMI 3 (pythonfmu3): the bundled code
-under private names, a Python host left as it was found, errors on stderr.
+under private names, a Python host left as it was found, errors reported once.
 
-The build bundles the package's runtime (model, solvers, component) and the FMI library's Python
-part into the FMU's resources next to this file. In a built FMU (``resources/bundle.json`` present)
-both are imported under private names (``_dp_fmu_<id>``, ``_dp_fmu_<id>_<library>``, the id a hash
-of the bundled code), so the FMU always runs its own code, whatever ``double_pendulum``,
-``pythonfmu`` or ``pythonfmu3`` the host process has imported. At build time (no ``bundle.json``)
+The build bundles the package's runtime (model, solvers, component), the FMI library's Python part
+and these adapters into the FMU's resources::
+
+    resources/_dp_fmu_<id>_<Model>.py   the module the FMI library imports (slavemodule.txt names it)
+    resources/_dp_fmu_<id>_adapters/    these adapters, a package
+    resources/double_pendulum/          the runtime, imported as _dp_fmu_<id>
+    resources/pythonfmu/ (pythonfmu3/)  the FMI library's Python part, imported as _dp_fmu_<id>_pythonfmu
+    resources/bundle.json               {"id": a hash of the bundled code, "guard": the C guard is the binary}
+
+In a built FMU (``bundle.json`` present) every module is imported under a private name, so the FMU
+always runs its own code, whatever ``DoublePendulum``, ``slave_common``, ``double_pendulum``,
+``pythonfmu`` or ``pythonfmu3`` the process holds (another author's FMU of the same name, an older
+build of this one), and imports nothing under a public name. At build time (no ``bundle.json``)
 the installed packages are used, as the FMI library's builder needs its own slave classes.
 """
 
@@ -19,21 +27,23 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-RESOURCES = Path(__file__).resolve().parent
-BUNDLE_FILE = "bundle.json"  # written by the build (double_pendulum.fmu.build): {"id": hash of the bundled code}
+RESOURCES = Path(__file__).resolve().parent.parent  # in a built FMU: this package's folder is in resources/
+BUNDLE_FILE = "bundle.json"  # written by the build (double_pendulum.fmu.build)
 STDERR_SWITCH = "DOUBLE_PENDULUM_FMU_STDERR"  # "0": errors go to the FMI log only
 PRIVATE_MARK = "_dp_fmu_"  # every private module name starts with it
 
 
-def _private_prefix() -> str | None:
-    """``_dp_fmu_<id>`` in a built FMU, None at build time."""
+def _bundle() -> dict:
+    """``bundle.json`` in a built FMU, ``{}`` at build time."""
     try:
-        return PRIVATE_MARK + json.loads((RESOURCES / BUNDLE_FILE).read_text())["id"]
+        return json.loads((RESOURCES / BUNDLE_FILE).read_text())
     except FileNotFoundError:
-        return None
+        return {}
 
 
-PRIVATE_PREFIX = _private_prefix()
+BUNDLE = _bundle()
+PRIVATE_PREFIX = PRIVATE_MARK + BUNDLE["id"] if "id" in BUNDLE else None  # _dp_fmu_<id>; None at build time
+GUARDED = bool(BUNDLE.get("guard"))  # the FMU's binary is the C guard, which logs every error (fmu_src/loader/)
 
 
 def _import_private(name: str, folder: Path, *, run_init: bool = True) -> ModuleType:
@@ -80,20 +90,51 @@ def runtime_module(name: str) -> ModuleType:
 def leave_host_as_found(resources: str | None) -> None:
     """Undo what the FMI library's binary did to the host's interpreter to load this FMU.
 
-    It put the FMU's resources folder first on ``sys.path`` and imported the adapter (and through it
-    the shared modules) under public names; a later ``import pythonfmu`` or ``import double_pendulum``
-    in the host would find the FMU's copies there. Once an instance exists, everything it needs is
-    loaded (the bundled code under private names), so both go: the folder from ``sys.path``, the
-    modules loaded from it under public names from ``sys.modules``. Does nothing at build time.
+    It puts the FMU's resources folder first on ``sys.path`` at every instantiation, where a later
+    ``import pythonfmu`` or ``import double_pendulum`` in the host would find the FMU's copies. Once
+    an instance exists, everything it needs is imported (under private names), so the folder goes.
+    The FMU imports nothing under a public name, so ``sys.modules`` needs nothing undone. Does
+    nothing at build time.
     """
     if not PRIVATE_PREFIX:
         return
     folder = os.path.realpath(resources or RESOURCES)
     sys.path[:] = [entry for entry in sys.path if not entry or os.path.realpath(entry) != folder]
-    for name, module in list(sys.modules.items()):
-        origin = getattr(module, "__file__", None)
-        if origin and not name.startswith(PRIVATE_MARK) and os.path.dirname(os.path.realpath(origin)) == folder:
-            del sys.modules[name]
+
+
+class _StoredRepr(type):
+    """A class whose repr is a stored string: ``repr()`` of it makes no new object."""
+
+    def __repr__(cls) -> str:
+        return cls.stored_repr
+
+
+# What pythonfmu's findClass is shown in place of the FMU's class (entry_module_executed).
+_FMI2_SLAVE_NAME = _StoredRepr("Fmi2Slave", (), {"stored_repr": "<class 'pythonfmu.Fmi2Slave'>"})
+_FINDER_STAND_IN = _StoredRepr("StandIn", (_FMI2_SLAVE_NAME,), {"stored_repr": "_"})
+
+
+def entry_module_executed(namespace: dict, local_namespace: dict, model_class: type) -> type:
+    """What the FMI 2 entry module (``resources/_dp_fmu_<id>_<Model>.py``) binds to the model's name.
+
+    pythonfmu 0.7.0 (``PySlaveInstance.cpp``, ``findClass``) imports that module, then runs its
+    source a second time, with the module's namespace as globals and fresh locals, and looks in the
+    locals for a class whose MRO names ``Fmi2Slave``; it then takes the module's attribute of that
+    name. On that second run (``locals() is not globals()``), at every instantiation, it
+
+    * releases one reference to the module's namespace, which it only borrowed: given back here,
+      or the namespace would be freed under the module after a few instantiations;
+    * leaks the list of the MRO and the repr of each class in it, as a string and as bytes (about
+      1.5 KiB for the model's class). It is shown a stand-in instead, whose MRO is two classes of
+      ours, with reprs stored once ("_", and one naming Fmi2Slave) and ``object``: what still leaks
+      is the list, the repr of ``object``, two bytes objects (about 0.3 KiB).
+
+    At import (the first run) the model's class itself is bound, which findClass then takes.
+    """
+    if local_namespace is namespace:
+        return model_class
+    compensate_release(namespace)
+    return _FINDER_STAND_IN
 
 
 def compensate_release(*objects) -> None:
@@ -114,14 +155,15 @@ def compensate_release(*objects) -> None:
 
 
 def report(instance_name: str, model_identifier: str, error: BaseException) -> None:
-    """Print an error to stderr, unless the host collects the FMU's log itself.
+    """Print an error to stderr where nothing else shows it.
 
-    pythonfmu passes an exception's message to the host's logger only when logging is on; stderr
-    makes it visible to a user with logging off too. A host that logs every message and reports the
-    failures it expects (the project's own ``FmuRunner``) sets ``DOUBLE_PENDULUM_FMU_STDERR=0``
-    while it runs the FMU.
+    The C guard in front of the FMI library (every FMU built where a C compiler is) passes every
+    error to the host's logger, debug logging on or off; there stderr would repeat it. Without the
+    guard (pythonfmu's plain binary) the library logs only with debug logging on, and stderr makes
+    the error visible to a user with logging off. A host that logs every message itself (the
+    project's own ``FmuRunner``) sets ``DOUBLE_PENDULUM_FMU_STDERR=0``.
     """
-    if os.environ.get(STDERR_SWITCH, "1") != "0":
+    if not GUARDED and os.environ.get(STDERR_SWITCH, "1") != "0":
         print(f"[{instance_name}] {model_identifier}: {error}", file=sys.stderr, flush=True)
 
 
@@ -220,7 +262,7 @@ class ComponentMapping:
         try:
             sim.do_step(current_time, step_size)
         except Exception as error:
-            self.log(f"doStep failed: {error}", self.error_status)
+            self.log(f"the step was not completed: {error}", self.error_status)
             self._report(error)
             return False
         if sim.notices:

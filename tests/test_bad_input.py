@@ -73,26 +73,38 @@ def _slave(runner, name):
 
 
 @pytest.mark.parametrize("step", [0.0, -0.01, math.nan])
-def test_non_positive_communication_step_is_discarded(runner, step):
+def test_a_non_positive_communication_step_is_an_error_and_reset_recovers(runner, step):
+    """Misuse is fmi2Error (fmi2Discard means a step done in part); the instance is then in the Error
+    state (only get, FMU states, reset and free), and fmi2Reset brings it back."""
     from fmpy.fmi1 import FMICallException
 
     fmu, vrs = _slave(runner, "step")
     with pytest.raises(FMICallException) as info:
         fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=step)
-    assert info.value.status == 2  # fmi2Discard
-    fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)  # still usable
+    assert info.value.status == 3  # fmi2Error
+    with pytest.raises(FMICallException) as info:
+        fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)  # not in the Error state
+    assert info.value.status == 3
+    assert fmu.getReal([vrs["phi1"]])[0] == pytest.approx(1.0)  # values can still be read
+    fmu.reset()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
     assert fmu.getReal([vrs["phi1"]])[0] != 1.0
     fmu.terminate()
     fmu.freeInstance()
 
 
-def test_do_step_out_of_order_is_discarded(runner):
+def test_do_step_out_of_order_is_an_error(runner):
     from fmpy.fmi1 import FMICallException
 
     fmu, _ = _slave(runner, "order")
-    with pytest.raises(FMICallException):
+    with pytest.raises(FMICallException) as info:
         fmu.doStep(currentCommunicationPoint=5.0, communicationStepSize=0.01)
-    fmu.terminate()
+    assert info.value.status == 3
+    with pytest.raises(FMICallException):
+        fmu.terminate()  # terminate is not allowed in the Error state
     fmu.freeInstance()
 
 
@@ -100,8 +112,9 @@ def test_setting_a_parameter_after_initialisation_is_an_error(runner):
     from fmpy.fmi1 import FMICallException
 
     fmu, vrs = _slave(runner, "late")
-    with pytest.raises(FMICallException):
+    with pytest.raises(FMICallException) as info:
         fmu.setReal([vrs["l1"]], [0.5])
+    assert info.value.status == 3  # an error of this instance, not fmi2Fatal
     fmu.freeInstance()
     # a new instance works
     assert runner.simulate({"l1": 0.5}, stop_time=0.1)["time"][-1] == pytest.approx(0.1)
@@ -109,22 +122,30 @@ def test_setting_a_parameter_after_initialisation_is_an_error(runner):
 
 def test_many_failed_calls_on_one_instance_leave_it_and_the_host_running(runner, monkeypatch):
     """pythonfmu releases the slave's references once more for every exception that reaches it; the slave
-    balances them. Before, the fourth refused value on one instance crashed the host (segfault)."""
+    balances them. Before, the fourth refused value on one instance crashed the host (segfault). Each
+    refused value here reaches the Python side (the instance is reset after each)."""
     from fmpy.fmi1 import FMICallException
 
     monkeypatch.setenv("DOUBLE_PENDULUM_FMU_STDERR", "0")
     fmu, vrs = _slave(runner, "many")
+    fmu.reset()
     for k in range(100):
-        with pytest.raises(FMICallException):
+        with pytest.raises(FMICallException) as info:
             fmu.setReal([vrs["pivot_ay"] if k % 2 else 10**6], [math.nan])  # a bad value, an unknown reference
+        assert info.value.status == 3
+        fmu.reset()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
     fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
     assert fmu.getReal([vrs["phi1"]])[0] == pytest.approx(1.0, abs=1e-2)  # it swings on from phi1_0 = 1 rad
     fmu.terminate()
     fmu.freeInstance()
 
 
-def test_with_logging_off_the_message_still_reaches_the_user(fmu_path, tmp_path):
-    """pythonfmu forwards messages only with logging on; the FMU also prints them to stderr."""
+def test_with_logging_off_the_message_still_reaches_the_hosts_logger(fmu_path, tmp_path):
+    """Errors reach the host's logger from instantiation on, debug logging on or off (fmpy's default logger
+    prints them); the FMU does not repeat them on stderr."""
     script = textwrap.dedent(f"""
         import os
         from fmpy import simulate_fmu
@@ -136,7 +157,8 @@ def test_with_logging_off_the_message_still_reaches_the_user(fmu_path, tmp_path)
     """)
     out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert "raised FMICallException" in out.stdout
-    assert "invalid l2 = -0.2 m: must be > 0" in out.stderr
+    assert "[ERROR] fmi2SetReal: ParameterError: invalid l2 = -0.2 m: must be > 0" in out.stdout
+    assert "invalid l2" not in out.stderr
 
 
 def test_solver_failure_is_reported_with_the_time_and_the_run_stops_cleanly(runner):

@@ -145,9 +145,8 @@ def test_without_a_usable_python_instantiate_returns_null_and_says_why_in_one_li
     assert done.returncode == 4, done.stdout + done.stderr  # fmi2Instantiate returned NULL: no crash, no hang
     logged = [line for line in done.stdout.splitlines() if line.startswith("log ")]
     assert len(logged) == 1 and logged[0].startswith("log 3 ")  # one fmi2Error line through the host's logger
-    for text in (logged[0], done.stderr):
-        assert "no usable Python to run this FMU" in text and f"{loader.OVERRIDE_VARIABLE}={override}" in text
-        assert "CPython >= 3.11 with a shared libpython" in text  # what it needs and how to point it there
+    assert "no usable Python to run this FMU" in logged[0] and f"{loader.OVERRIDE_VARIABLE}={override}" in logged[0]
+    assert "CPython >= 3.11 with a shared libpython" in logged[0]  # what it needs and how to point it there
 
 
 def test_the_hosts_python_variables_do_not_reach_the_fmus_interpreter(host, extracted, tmp_path):
@@ -277,7 +276,7 @@ def test_the_loader_answers_for_out_arguments_pythonfmu3_leaves_unwritten(host3,
     folder, description = extracted[FMI3]
     patched = tmp_path / "patched"
     shutil.copytree(folder, patched)
-    adapter = patched / "resources" / "DoublePendulumFmi3.py"
+    (adapter,) = (patched / "resources").glob("_dp_fmu_*_adapters/DoublePendulumFmi3.py")
     adapter.write_text(adapter.read_text() + (
         "\nDoublePendulum.update_discrete_states = lambda self: importlib.import_module(\n"
         "    f'{_library}.modelexchange').Fmi3UpdateDiscreteStatesResult()\n"))
@@ -294,4 +293,4 @@ def test_fmi3_without_a_usable_python_instantiate_returns_null_and_says_why(host
     assert done.returncode == 4, done.stdout + done.stderr
     logged = [line for line in done.stdout.splitlines() if line.startswith("log ")]
     assert len(logged) == 1 and logged[0].startswith("log 3 ")  # one fmi3Error line
-    assert "no usable Python to run this FMU" in logged[0] and "no usable Python" in done.stderr
+    assert "no usable Python to run this FMU" in logged[0] and "CPython >= 3.11" in logged[0]

@@ -43,8 +43,13 @@ class ModelExchange:
         self.fmu = FMU3Model(guid=md.guid, unzipDirectory=unzipdir, modelIdentifier=md.modelExchange.modelIdentifier,
                              instanceName=name)
         self.fmu.instantiate(logMessage=lambda env, status, category, message: self.log.append(message.decode()))
+        self.start = start or {}
+        self.initialise()
+
+    def initialise(self) -> None:
+        """From Instantiated (a new or reset instance) to Continuous-Time Mode at t = 0 with the start values."""
         self.fmu.enterInitializationMode(startTime=0.0)
-        for variable, value in (start or {}).items():
+        for variable, value in self.start.items():
             self.set(variable, value)
         self.fmu.exitInitializationMode()
         self.fmu.updateDiscreteStates()
@@ -258,7 +263,8 @@ def test_a_bad_parameter_is_an_error_naming_the_variable_and_value(fmu3, name, v
 
 
 def test_bad_input_reaches_the_log_and_many_failures_leave_the_host_running(fmu3, monkeypatch):
-    """Each failed call logs its message; a hundred of them on one instance (bad values, unknown
+    """Each failed call is fmi3Error with its message logged, and leaves the instance in the Error state,
+    from which fmi3Reset brings it back; a hundred of them on one instance (bad values, unknown
     references, wrong types, types the FMU does not have) leave it and the host running."""
     monkeypatch.setenv("DOUBLE_PENDULUM_FMU_STDERR", "0")
     instance = ModelExchange(fmu3, CHAOTIC)
@@ -267,14 +273,24 @@ def test_bad_input_reaches_the_log_and_many_failures_leave_the_host_running(fmu3
              lambda: fmu.getInt32([phi1]), lambda: fmu.getFloat32([phi1])]
     try:
         for k in range(100):
-            with pytest.raises(FMICallException):
+            with pytest.raises(FMICallException) as info:
                 calls[k % len(calls)]()
+            assert info.value.status == 3  # fmi3Error, not fmi3Fatal
+            with pytest.raises(FMICallException):
+                fmu.setTime(0.0)  # not allowed in the Error state
+            fmu.reset()
+            instance.initialise()
         log = "\n".join(instance.log)
         assert "invalid input pivot_ay = nan m/s2: must be finite" in log
-        assert "fmi3GetFloat32 is not supported by this FMU" in log  # the loader's answer, not pythonfmu3's throw
+        assert "fmi3GetFloat32: not supported by this FMU" in log  # the guard's answer, not pythonfmu3's throw
+        assert "fmi3SetTime: illegal call sequence: not allowed in state Error" in log
         with pytest.raises(FMICallException):
             instance.set("l1", 0.5)  # a parameter after initialisation
         assert "cannot set parameter l1 = 0.5 after initialisation" in instance.log[-1]
+        fmu.reset()
+        instance.initialise()
         assert instance.derivatives(0.0, instance.states())[0] == pytest.approx(0.0)  # still answers
     finally:
         instance.close()
+
+

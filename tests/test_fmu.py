@@ -56,11 +56,18 @@ def test_fmu_bundles_the_package_its_loader_and_the_python_it_was_built_with(fmu
     with zipfile.ZipFile(fmu_path) as z:
         names = z.namelist()
         assert "resources/double_pendulum/model/dynamics.py" in names
-        assert "resources/DoublePendulum.py" in names
+        bundle = json.loads(z.read("resources/bundle.json"))
+        assert len(bundle["id"]) == 16
+        entry = f"_dp_fmu_{bundle['id']}_DoublePendulum"  # every module under a private name
+        assert z.read("resources/slavemodule.txt").decode() == entry
+        assert f"resources/{entry}.py" in names
+        assert f"resources/_dp_fmu_{bundle['id']}_adapters/DoublePendulum.py" in names
+        assert not [n for n in names if n.startswith("resources/") and n.count("/") == 1 and n.endswith(".py")
+                    and not n.startswith("resources/_dp_fmu_")]  # nothing importable under a public name
         assert "resources/requirements.txt" not in names  # it needs nothing installed
-        assert len(json.loads(z.read("resources/bundle.json"))["id"]) == 16
         if sys.platform.startswith("linux") and loader.c_compiler():
             assert {"binaries/linux64/DoublePendulum.so", "binaries/linux64/libpythonfmu-export.so"} <= set(names)
+            assert bundle["guard"] is True
             record = z.read("resources/python.cfg").decode()
             assert f"version={sys.version_info[0]}.{sys.version_info[1]}" in record
             assert f"home={sys.base_prefix}" in record

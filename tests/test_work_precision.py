@@ -72,9 +72,10 @@ def test_energy_drift_is_relative_to_the_start_energy():
 def test_timing_and_failure_columns():
     assert wp.timing_columns([0.3, 0.1, 0.2]) == {"cpu_time_s": 0.2, "cpu_spread": pytest.approx(1.0), "repeats": 3}
     assert wp.timing_columns([0.0]) == {"cpu_time_s": 0.0, "cpu_spread": 0.0, "repeats": 1}
-    unstable = wp.failure_columns(RuntimeError("doStep failed. FMU says: numerical instability at t = 1 s"))
+    unstable = wp.failure_columns(RuntimeError("fmi2DoStep failed with status 2. FMU says: fmi2DoStep: the step was "
+                                               "not completed: numerical instability at t = 1 s"))
     assert unstable == {"status": "unstable", "message": "numerical instability at t = 1 s"}
-    long = "doStep failed: " + "word " * 60
+    long = "fmi2DoStep: the step was not completed: " + "word " * 60
     assert wp.failure_columns(RuntimeError(long)) == {"status": "failed", "message": "word " * 60}  # never cut
 
 

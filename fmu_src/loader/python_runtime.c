@@ -1,10 +1,13 @@
 /* Find, load and start the CPython that runs a pythonfmu FMU (see python_runtime.h). Linux only. */
 #define _GNU_SOURCE
+#include "glibc_compat.h"
+
 #include "python_runtime.h"
 
 #include <dlfcn.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <gnu/libc-version.h>
 #include <limits.h>
 #include <link.h>
 #include <poll.h>
@@ -15,16 +18,20 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 #include <wchar.h>
 
+#include "guard.h"
+
 extern char **environ;
 
 #define CONFIG_FILE "python.cfg" /* in resources/, written by the build */
 #define QUERY_TIMEOUT_MS 20000   /* a candidate interpreter must answer within this time */
+#ifndef BACKEND_NEEDS /* what the FMI library's binary asks of the system (the build measures it) */
+#define BACKEND_NEEDS "a recent glibc and libstdc++"
+#endif
 
 typedef struct {
     int major, minor;
@@ -47,11 +54,6 @@ static void appendf(char *buffer, size_t size, const char *format, ...) {
     va_end(args);
 }
 
-static int is_file(const char *path) {
-    struct stat st;
-    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
-}
-
 static void parent_folder(char *path) {
     char *slash = strrchr(path, '/');
     if (slash == path) slash[1] = '\0';
@@ -72,30 +74,6 @@ static int own_folder(char *folder, size_t size) {
     return 1;
 }
 
-/* A file URI (file:///p, file://host/p, file:/p; FMI 2), %XX decoded, or a plain path (FMI 3), to a path. */
-static void uri_to_path(const char *uri, char *path, size_t size) {
-    const char *p = uri;
-    int is_uri = strncmp(p, "file:", 5) == 0;
-    if (strncmp(p, "file://", 7) == 0) {
-        p += 7;
-        if (*p != '/') p = strchr(p, '/') ? strchr(p, '/') : "";
-    } else if (is_uri) {
-        p += 5;
-    }
-    size_t n = 0;
-    for (; *p && n + 1 < size; p++) {
-        unsigned int code;
-        if (is_uri && p[0] == '%' && p[1] && p[2] && sscanf(p + 1, "%2x", &code) == 1) {
-            path[n++] = (char)code;
-            p += 2;
-        } else {
-            path[n++] = *p;
-        }
-    }
-    path[n] = '\0';
-    while (n > 1 && path[n - 1] == '/') path[--n] = '\0';
-}
-
 /* The first executable `name` in the folders of PATH (or `name` itself if it holds a slash). */
 static int which(const char *name, char *found, size_t size) {
     if (strchr(name, '/')) {
@@ -108,7 +86,7 @@ static int which(const char *name, char *found, size_t size) {
         const char *end = strchr(start, ':');
         size_t length = end ? (size_t)(end - start) : strlen(start);
         snprintf(found, size, "%.*s/%s", (int)length, length ? start : ".", name);
-        if (access(found, X_OK) == 0 && is_file(found)) return 1;
+        if (access(found, X_OK) == 0 && guard_is_file(found)) return 1;
         if (!end) break;
         start = end + 1;
     }
@@ -234,10 +212,10 @@ static int describe_library(const char *library, python_install *python, char *w
     for (int up = 0; up < 3; up++) {
         parent_folder(home);
         snprintf(landmark, sizeof landmark, "%s/lib/python%d.%d/os.py", home, python->major, python->minor);
-        if (up > 0 && is_file(landmark)) {
+        if (up > 0 && guard_is_file(landmark)) {
             snprintf(python->home, PATH_MAX, "%s", home);
             snprintf(python->executable, PATH_MAX, "%s/bin/python%d.%d", home, python->major, python->minor);
-            if (!is_file(python->executable)) python->executable[0] = '\0';
+            if (!guard_is_file(python->executable)) python->executable[0] = '\0';
             return 1;
         }
     }
@@ -266,6 +244,11 @@ static int read_recorded(const char *resources, python_install *python, char *wh
         else if (strcmp(line, "version") == 0) sscanf(value, "%d.%d", &python->major, &python->minor);
     }
     fclose(file);
+    if (!guard_is_file(python->library) && python->executable[0] && !guard_is_file(python->executable)) {
+        snprintf(why, size, "not found (%s and %s are gone)", python->executable,
+                 python->library[0] ? python->library : "its libpython");
+        return 0;
+    }
     return 1;
 }
 
@@ -276,10 +259,10 @@ static int usable(const python_install *python, char *why, size_t size) {
              python->minor);
     if (python->major != 3 || python->minor < PYTHON_MIN_MINOR)
         snprintf(why, size, "is Python %d.%d, older than 3.%d", python->major, python->minor, PYTHON_MIN_MINOR);
-    else if (!strstr(base_name(python->library), ".so") || !is_file(python->library))
+    else if (!strstr(base_name(python->library), ".so") || !guard_is_file(python->library))
         snprintf(why, size, "is Python %d.%d without a shared libpython (%s missing)", python->major, python->minor,
                  python->library[0] ? python->library : "libpython3.X.so");
-    else if (!is_file(landmark))
+    else if (!guard_is_file(landmark))
         snprintf(why, size, "has no standard library at %s", python->home);
     else
         return 1;
@@ -395,19 +378,27 @@ static void *load_backend(const char *resources_uri, const char *backend_file, c
         snprintf(error, error_size, "cannot locate the FMU's binary folder");
         return NULL;
     }
-    if (resources_uri && resources_uri[0]) uri_to_path(resources_uri, resources, sizeof resources);
-    else snprintf(resources, sizeof resources, "%s/../../resources", folder);
+    if (!resources_uri || !resources_uri[0] || !guard_uri_to_path(resources_uri, resources, sizeof resources))
+        snprintf(resources, sizeof resources, "%s/../../resources", folder);
     if (!python_in_process() && !find_and_start_python(resources, error, error_size)) return NULL;
     snprintf(backend, sizeof backend, "%s/%s", folder, backend_file);
     void *handle = dlopen(backend, RTLD_NOW | RTLD_LOCAL);
-    if (!handle) snprintf(error, error_size, "cannot load pythonfmu's library: %s", dlerror());
+    if (!handle)
+        guard_format(error, error_size, "cannot load the FMI library's binary %s (it needs %s; this machine has glibc %s): %s",
+                     backend_file, BACKEND_NEEDS, gnu_get_libc_version(), dlerror());
     return handle;
 }
 
 void *python_runtime_load_backend(const char *resources_uri, const char *backend_file, char *error,
                                   size_t error_size) {
     pthread_mutex_lock(&load_lock);
-    if (!backend_handle) backend_handle = load_backend(resources_uri, backend_file, error, error_size);
+    if (!backend_handle) {
+        /* stderr's lock is the one lock every copy of the loader in the process shares (the FMUs'
+         * binaries are separate copies): two FMUs never start a Python at the same moment. */
+        flockfile(stderr);
+        backend_handle = load_backend(resources_uri, backend_file, error, error_size);
+        funlockfile(stderr);
+    }
     void *handle = backend_handle;
     pthread_mutex_unlock(&load_lock);
     return handle;

@@ -92,8 +92,8 @@ def checked_parameter(rules: Mapping[str, tuple[str, str]], name: str, value: An
         raise ParameterError(f"unknown parameter {name!r}")
     if initialised:
         raise CoSimulationError(
-            f"cannot set parameter {name} = {value!r} after initialisation (FMI: fixed parameters "
-            "may only be set before fmi2ExitInitializationMode)"
+            f"cannot set parameter {name} = {value!r} after initialisation (FMI: a fixed parameter "
+            "is set before the FMU leaves Initialization Mode)"
         )
     unit, rule = rules[name]
     if rule != "str" and rule != "bool" and isinstance(value, int) and not isinstance(value, bool):

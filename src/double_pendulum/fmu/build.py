@@ -4,8 +4,9 @@ Each FMU of :data:`double_pendulum.component.variables.INTERFACES` (``DoublePend
 ``Suspension``) is built from its adapter ``fmu_src/<model identifier>.py``, which maps FMI calls
 onto a component through the shared ``fmu_src/double_pendulum_slave.py``; the package's runtime
 (``__init__``, :mod:`~double_pendulum.model`, :mod:`~double_pendulum.solvers`,
-:mod:`~double_pendulum.component`) is bundled into the FMU's ``resources/`` so the FMU runs
-without the project installed, and nothing else is (no analysis, plots or CLI). pythonfmu's
+:mod:`~double_pendulum.component`) and the adapters are bundled into the FMU's ``resources/``
+(:mod:`double_pendulum.fmu.bundle`: every module under a private name) so the FMU runs without the
+project installed, and nothing else is (no analysis, plots or CLI). pythonfmu's
 modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the build then
 
 * adds ``UnitDefinitions`` (SI base-unit exponents) and a ``unit`` attribute on every physical
@@ -16,11 +17,13 @@ modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the buil
 * states each output's direct dependencies on the inputs under ``ModelStructure/Outputs``
   (the interface's ``output_dependencies``; ``dependencies=""`` for none),
   which pythonfmu leaves open (open means: depends on every input);
-* on Linux, makes the FMU's binary the loader of :mod:`double_pendulum.fmu.loader` (compiled from
-  source; pythonfmu's library goes beside it), so the FMU runs in hosts that are not Python, and
-  records the building CPython in ``resources/python.cfg``;
-* writes ``resources/bundle.json`` (a hash of the bundled code), which makes the FMU import its
-  bundled code under private names (``fmu_src/double_pendulum_slave.py``).
+* on Linux, makes the FMU's binary the loader and guard of :mod:`double_pendulum.fmu.loader`
+  (compiled from source with the FMU's GUID; pythonfmu's library goes beside it), so the FMU runs
+  in hosts that are not Python and answers every FMI call as the standard says, and records the
+  building CPython in ``resources/python.cfg``;
+* writes ``resources/bundle.json`` (a hash of the bundled code, and whether the guard is the
+  binary), which makes the FMU import its bundled code under private names
+  (``fmu_src/slave_common.py``).
 
 The FMU needs nothing installed where it runs: only a CPython >= 3.11 and its standard library.
 Every FMU written is checked to hold a binary for this platform.
@@ -30,7 +33,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import hashlib
 import importlib.util
 import json
 import os
@@ -43,14 +45,12 @@ from pathlib import Path
 from xml.etree import ElementTree as ET
 
 from ..component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
-from . import loader
+from . import bundle, elf_needs, loader
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
 RUNTIME_SUBPACKAGES = ("model", "solvers", "component")
 DEFAULT_FMU_PATH = Path("build") / f"{MODEL_IDENTIFIER}.fmu"
-# The FMI-to-component mapping every FMI 2 adapter uses, and what it shares with the FMI 3 adapter.
-SHARED_ADAPTERS = ("double_pendulum_slave.py", "slave_common.py")
 
 # SI base-unit exponents of every unit the interfaces use (FMI 2.0 section 2.2.2, FMI 3.0 2.4.3).
 UNIT_EXPONENTS: dict[str, dict[str, int]] = {
@@ -83,32 +83,36 @@ def _adapters_dir() -> Path:
     return Path(next(iter(spec.submodule_search_locations)))
 
 
-def adapter_script(model_identifier: str = MODEL_IDENTIFIER) -> Path:
-    """Return the path of the pythonfmu adapter ``<model_identifier>.py``.
+def adapter_sources(fmi_version: int = 2) -> list[Path]:
+    """fmu_src's modules that the FMI ``fmi_version`` FMUs bundle (:data:`double_pendulum.fmu.bundle.ADAPTERS`).
 
-    It lives in the repository's ``fmu_src/``, installed as ``double_pendulum.adapters``.
+    They live in the repository's ``fmu_src/``, installed as ``double_pendulum.adapters``.
     """
-    return _adapters_dir() / f"{model_identifier}.py"
+    folder = _adapters_dir()
+    return [folder / name for name in bundle.ADAPTERS[fmi_version]]
 
 
-def shared_adapters() -> list[Path]:
-    """Return the paths of the modules all FMI 2 adapters share (bundled into every FMI 2 FMU)."""
-    return [_adapters_dir() / name for name in SHARED_ADAPTERS]
+def copy_adapters(dest: Path, fmi_version: int = 2) -> Path:
+    """Copy the adapters the FMU bundles into ``dest/adapters`` (the builder's name for their folder)."""
+    target = dest / bundle.BUILDER_ADAPTERS
+    target.mkdir(parents=True)
+    for source in adapter_sources(fmi_version):
+        shutil.copy2(source, target / source.name)
+    return target
 
 
 @contextlib.contextmanager
 def builder_imports_forgotten() -> Iterator[None]:
     """Forget the modules an FMI library's builder imports from its temporary copy of the adapter.
 
-    pythonfmu's and pythonfmu3's builders instantiate the adapter to write the modelDescription; the
-    modules it imports (the shared slave modules, from a folder deleted right after) would stay in
-    ``sys.modules`` under their public names, and an FMU instantiated later in this process would
-    pick them up instead of its own bundled copies.
+    pythonfmu's and pythonfmu3's builders import the builder's stub from a temporary folder to write the
+    modelDescription and leave that folder on ``sys.path``; the stub would stay in ``sys.modules``.
     """
-    before = set(sys.modules)
+    before, path = set(sys.modules), list(sys.path)
     try:
         yield
     finally:
+        sys.path[:] = path
         for name in set(sys.modules) - before:
             origin = getattr(sys.modules[name], "__file__", None)
             if origin and not os.path.exists(origin):
@@ -206,13 +210,20 @@ def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
 
 
 @functools.cache
-def _loader_binary(fmi_version: int = 2) -> bytes | None:
-    """The compiled loader, or None (said once on stderr) where it cannot be built."""
+def _loader_binary(fmi_version: int, defines: tuple[tuple[str, str], ...]) -> bytes | None:
+    """The compiled loader for one FMU (``defines``: its GUID, ...), or None (said once on stderr) where it
+    cannot be built."""
     try:
-        return loader.compiled_loader(fmi_version)
+        return loader.compiled_loader(fmi_version, dict(defines))
     except loader.LoaderUnavailable as why:
         _note(str(why))
         return None
+
+
+def instantiation_token(model_description: bytes) -> str:
+    """The FMU's GUID (FMI 2) or instantiation token (FMI 3), which the guard checks at instantiation."""
+    root = ET.fromstring(model_description)
+    return root.get("guid") or root.get("instantiationToken") or ""
 
 
 @functools.cache
@@ -221,48 +232,38 @@ def _note(message: str) -> None:
     print(f"note: {message}", file=sys.stderr, flush=True)
 
 
-def bundle_id(files: dict[str, bytes], model_identifier: str) -> str:
-    """A hash of the code an FMU bundles, except its own adapter: FMUs built from the same sources
-    (DoublePendulum and Suspension) share it, and so share their privately imported modules."""
-    digest = hashlib.sha256()
-    adapter = f"resources/{model_identifier}.py"
-    for name in sorted(files):
-        if name.startswith("resources/") and name.endswith(".py") and name != adapter:
-            digest.update(name.encode() + b"\0" + files[name] + b"\0")
-    return digest.hexdigest()[:16]
-
-
 def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], bytes], fmi_version: int = 2,
-                adapter: str | None = None) -> None:
-    """Rewrite the zip with the completed modelDescription, bytecode, the loader and the bundle's id.
+                defines: dict[str, str] | None = None) -> None:
+    """Rewrite the zip: the private layout of the bundled code, the completed modelDescription, bytecode,
+    the loader (compiled with the FMU's GUID and ``defines``) and ``bundle.json``.
 
-    ``complete`` completes the modelDescription; ``adapter`` is the adapter's file name in
-    ``resources/`` (default ``<model_identifier>.py``). Precompiled bytecode spares every fresh
-    extraction (fmpy extracts the FMU anew for each ``simulate_fmu`` call) the compilation of the
-    bundled sources at start-up.
+    ``complete`` completes the modelDescription. Precompiled bytecode spares every fresh extraction
+    (fmpy extracts the FMU anew for each ``simulate_fmu`` call) the compilation of the bundled
+    sources at start-up.
     """
     with zipfile.ZipFile(fmu) as src:
-        items = [(item, src.read(item.filename)) for item in src.infolist()]
+        files = {item.filename: src.read(item.filename) for item in src.infolist()}
+    files, identity = bundle.bundled_entries(files, model_identifier, fmi_version)
+    files["modelDescription.xml"] = complete(files["modelDescription.xml"])
     platform = loader.PLATFORMS[fmi_version]
     binary = f"binaries/{platform}/{model_identifier}.so"
-    loader_binary = _loader_binary(fmi_version) if any(item.filename == binary for item, _ in items) else None
-    backend = f"binaries/{platform}/{loader.BACKEND_NAMES[fmi_version]}"
-    identity = bundle_id({item.filename: data for item, data in items}, Path(adapter or model_identifier).stem)
+    loader_binary = None
+    if binary in files:
+        guard_defines = {"MODEL_IDENTIFIER": model_identifier,
+                         "FMU_GUID": instantiation_token(files["modelDescription.xml"]),
+                         "BACKEND_NEEDS": elf_needs.describe(files[binary]), **(defines or {})}
+        loader_binary = _loader_binary(fmi_version, tuple(sorted(guard_defines.items())))
+    if loader_binary is not None:  # the library's binary goes behind the loader
+        files[f"binaries/{platform}/{loader.BACKEND_NAMES[fmi_version]}"] = files[binary]
+        files[binary] = loader_binary
+        files[f"resources/{loader.CONFIG_NAME}"] = loader.python_record().encode()
+    files[BUNDLE_FILE] = json.dumps({"id": identity, "guard": loader_binary is not None}).encode()
     tmp = fmu.with_suffix(".fmu.tmp")
     with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
-        for item, data in items:
-            if item.filename == "modelDescription.xml":
-                data = complete(data)
-            if item.filename == binary and loader_binary is not None:
-                dst.writestr(backend, data, compress_type=zipfile.ZIP_DEFLATED)  # the library's, behind the loader
-                data = loader_binary
-            dst.writestr(item, data, compress_type=zipfile.ZIP_DEFLATED)
-            if item.filename.startswith("resources/") and item.filename.endswith(".py"):
-                cached, code = compiled_bytecode(data, item.filename)
-                dst.writestr(cached, code, compress_type=zipfile.ZIP_DEFLATED)
-        dst.writestr(BUNDLE_FILE, json.dumps({"id": identity}))
-        if loader_binary is not None:
-            dst.writestr(f"resources/{loader.CONFIG_NAME}", loader.python_record())
+        for name, data in files.items():
+            dst.writestr(name, data)
+            if name.startswith("resources/") and name.endswith(".py"):
+                dst.writestr(*compiled_bytecode(data, name))
     tmp.replace(fmu)
 
 
@@ -293,12 +294,12 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="dp_fmu_build_") as tmp:
         tmp_dir = Path(tmp)
-        package_copy = _copy_runtime(tmp_dir)
+        (tmp_dir / "script").mkdir()
         with builder_imports_forgotten():
             built = FmuBuilder.build_FMU(
-                adapter_script(model_identifier),
+                bundle.builder_script(tmp_dir / "script", model_identifier, 2),
                 dest=tmp_dir / f"{model_identifier}.fmu",
-                project_files=[package_copy, *shared_adapters()],
+                project_files=[_copy_runtime(tmp_dir), copy_adapters(tmp_dir, 2)],
                 canGetAndSetFMUstate=True,
                 canSerializeFMUstate=True,
             )
@@ -347,5 +348,5 @@ def fmu_is_current(fmu_path: str | Path, model_identifier: str = MODEL_IDENTIFIE
     if not fmu_path.is_file():
         return False
     built = fmu_path.stat().st_mtime
-    sources = [adapter_script(model_identifier), *shared_adapters(), *runtime_sources(), *loader.loader_sources()]
+    sources = [*adapter_sources(2), *runtime_sources(), *loader.loader_sources(2)]
     return all(src.stat().st_mtime <= built for src in sources)

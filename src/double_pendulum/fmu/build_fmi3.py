@@ -22,25 +22,25 @@ import tempfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
 
+from ..component.model_exchange import STATES
 from ..component.variables import INTERFACES, MODEL_IDENTIFIER
+from . import bundle
 from .build import (
-    _adapters_dir,
     _copy_runtime,
     builder_imports_forgotten,
     check_platform_binary,
+    copy_adapters,
     rewrite_fmu,
     unit_definitions,
 )
+from .build import adapter_sources as _adapter_sources
 
 DEFAULT_FMU3_PATH = Path("build") / "fmi3" / f"{MODEL_IDENTIFIER}.fmu"
-ADAPTER = "DoublePendulumFmi3.py"  # the pythonfmu3 class DoublePendulum
-SHARED = ("slave_common.py",)  # bundled beside it
 
 
 def adapter_sources() -> list[Path]:
     """The FMI 3 adapter and the modules it shares (in the installed ``double_pendulum.adapters``)."""
-    folder = _adapters_dir()
-    return [folder / ADAPTER, *(folder / name for name in SHARED)]
+    return _adapter_sources(3)
 
 
 def complete_model_description_fmi3(xml_text: bytes) -> bytes:
@@ -88,20 +88,21 @@ def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH) -> Path:
     dest = Path(dest)
     fmu_path = dest if dest.suffix == ".fmu" else dest / f"{MODEL_IDENTIFIER}.fmu"
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
-    adapter, *shared = adapter_sources()
     with tempfile.TemporaryDirectory(prefix="dp_fmu3_build_") as tmp:
         tmp_dir = Path(tmp)
+        (tmp_dir / "script").mkdir()
         with builder_imports_forgotten():
             built = Path(FmuBuilder.build_FMU(
-                adapter,
+                bundle.builder_script(tmp_dir / "script", MODEL_IDENTIFIER, 3),
                 dest=tmp_dir / "out",
-                project_files=[_copy_runtime(tmp_dir), *shared],
+                project_files=[_copy_runtime(tmp_dir), copy_adapters(tmp_dir, 3)],
                 canGetAndSetFMUState=True,
                 canSerializeFMUState=True,
                 canHandleVariableCommunicationStepSize=True,
                 needsCompletedIntegratorStep=False,
             ))
-        rewrite_fmu(built, MODEL_IDENTIFIER, complete_model_description_fmi3, fmi_version=3, adapter=ADAPTER)
+        rewrite_fmu(built, MODEL_IDENTIFIER, complete_model_description_fmi3, fmi_version=3,
+                    defines={"N_CONTINUOUS_STATES": str(len(STATES))})
         check_platform_binary(built, MODEL_IDENTIFIER, fmi_version=3)
         shutil.move(str(built), fmu_path)
     return fmu_path

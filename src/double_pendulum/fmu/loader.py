@@ -1,11 +1,14 @@
-"""The FMU's binary on Linux: a small C loader, compiled from source when the FMU is built.
+"""The FMU's binary on Linux: a small C loader and guard, compiled from source when the FMU is built.
 
 pythonfmu's Linux library (and pythonfmu3's, for FMI 3) calls the CPython C API without linking
-libpython, so on its own it runs only inside a Python process. The loader (``fmu_src/loader/``:
-``python_runtime.c`` finds, loads and starts a CPython, ``fmi2_loader.c`` forwards the FMI 2
-functions, ``fmi3_loader.c`` the FMI 3 ones) becomes the FMU's
+libpython, so on its own it runs only inside a Python process, and it answers misuse with crashes,
+leaks and fmi2Fatal. The loader (``fmu_src/loader/``: ``python_runtime.c`` finds, loads and starts
+a CPython; ``fmi2_guard.c`` and ``fmi3_guard.c`` stand in front of the FMI library with the
+standard's state machine and checks, sharing ``guard.c``) becomes the FMU's
 ``binaries/<platform>/<model identifier>.so``; the FMI library's own lies beside it
-(:data:`BACKEND_NAMES`). In a Python host the loader uses the host's interpreter and changes
+(:data:`BACKEND_NAMES`). Each FMU's loader is compiled with its GUID (``FMU_GUID``) and what the
+library's binary needs of the system (``BACKEND_NEEDS``, for the message where it cannot load).
+In a Python host the loader uses the host's interpreter and changes
 nothing; in any other host it finds a CPython >= 3.11 with a shared libpython: the one named by
 ``DOUBLE_PENDULUM_FMU_PYTHON``, else the one the FMU was built with (``resources/python.cfg``,
 :func:`python_record`), else ``python3`` on PATH (docs/fmu.md, "Use the FMU in other FMI tools").
@@ -29,8 +32,9 @@ import tempfile
 from pathlib import Path
 
 LOADER_FOLDER = "loader"  # in fmu_src/ (installed as double_pendulum.adapters)
-LOADER_SOURCES = {2: ("python_runtime.c", "fmi2_loader.c"), 3: ("python_runtime.c", "fmi3_loader.c")}
-LOADER_HEADERS = ("python_runtime.h",)
+LOADER_SOURCES = {2: ("python_runtime.c", "guard.c", "fmi2_guard.c"),
+                  3: ("python_runtime.c", "guard.c", "fmi3_guard.c")}
+LOADER_HEADERS = ("python_runtime.h", "guard.h", "glibc_compat.h")
 # The FMI library's own binary in the FMU, beside the loader: pythonfmu's (FMI 2), pythonfmu3's (FMI 3).
 BACKEND_NAMES = {2: "libpythonfmu-export.so", 3: "libpythonfmu3-export.so"}
 # The one platform whose library needs the loader, as each FMI version names its binaries folder.
@@ -38,8 +42,10 @@ PLATFORMS = {2: "linux64", 3: "x86_64-linux"}
 BACKEND_NAME, PLATFORM = BACKEND_NAMES[2], PLATFORMS[2]
 CONFIG_NAME = "python.cfg"  # in resources/: the CPython the FMU was built with
 OVERRIDE_VARIABLE = "DOUBLE_PENDULUM_FMU_PYTHON"
-CFLAGS = ("-shared", "-fPIC", "-O2", "-fvisibility=hidden")
-LIBS = ("-ldl", "-lpthread")
+CFLAGS = ("-shared", "-fPIC", "-O2", "-std=gnu11", "-fvisibility=hidden")
+# libdl and libpthread by file name and as needed: where the old glibc versions the loader binds
+# (glibc_compat.h) live on systems older than glibc 2.34 (there -ldl would find an empty libdl.a).
+LIBS = ("-Wl,--no-as-needed", "-l:libdl.so.2", "-l:libpthread.so.0", "-l:libm.so.6")
 
 
 class LoaderUnavailable(RuntimeError):
@@ -72,20 +78,23 @@ def c_compiler() -> list[str] | None:
 
 
 @functools.cache
-def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tuple[float, ...]) -> bytes:
+def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tuple[float, ...],
+              defines: tuple[tuple[str, str], ...]) -> bytes:
     c_files = [str(path) for path in sources if path.suffix == ".c"]
     with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
         output = Path(tmp) / "loader.so"
-        command = [*compiler, *CFLAGS, f"-I{fmi_headers()}", "-o", str(output), *c_files, *LIBS]
+        macros = [f"-D{name}={value}" if value.isdigit() else f'-D{name}="{value}"' for name, value in defines]
+        command = [*compiler, *CFLAGS, *macros, f"-I{fmi_headers()}", "-o", str(output), *c_files, *LIBS]
         done = subprocess.run(command, capture_output=True, text=True)
         if done.returncode != 0:
             raise RuntimeError(f"compiling the FMU's loader failed: {shlex.join(command)}\n{done.stderr}")
         return output.read_bytes()
 
 
-def compiled_loader(fmi_version: int = 2) -> bytes:
-    """The FMI ``fmi_version`` loader's shared library for this machine (compiled once per process,
-    compiler and source version).
+def compiled_loader(fmi_version: int, defines: dict[str, str]) -> bytes:
+    """The FMI ``fmi_version`` loader's shared library for this machine and one FMU (compiled once per
+    process, compiler, source version and ``defines``: the C string macros ``MODEL_IDENTIFIER``,
+    ``FMU_GUID``, ``BACKEND_NEEDS``, and for FMI 3 the number ``N_CONTINUOUS_STATES``).
 
     Raises :class:`LoaderUnavailable` where it cannot be built (no C compiler; not Linux), and
     ``RuntimeError`` with the compiler's output if compiling fails.
@@ -98,8 +107,12 @@ def compiled_loader(fmi_version: int = 2) -> bytes:
             "no C compiler found ($CC, cc, gcc or clang): the FMUs keep the FMI library's plain binary, "
             "which runs only in Python hosts (docs/fmu.md)"
         )
+    bad = {name: value for name, value in defines.items() if any(c in str(value) for c in '"\\\n')}
+    if bad:
+        raise ValueError(f"loader macros must be plain text: {bad}")
     sources = tuple(loader_sources(fmi_version))
-    return _compiled(tuple(compiler), sources, tuple(path.stat().st_mtime for path in sources))
+    return _compiled(tuple(compiler), sources, tuple(path.stat().st_mtime for path in sources),
+                     tuple(sorted(defines.items())))
 
 
 def python_record() -> str:

@@ -136,10 +136,13 @@ def timing_columns(cpu: list[float]) -> dict[str, float]:
     return {"cpu_time_s": med, "cpu_spread": (max(cpu) - min(cpu)) / med if med > 0 else 0.0, "repeats": len(cpu)}
 
 
+STEP_FAILED = "the step was not completed: "  # what the FMU logs for a step it cannot do (fmu_src/slave_common.py)
+
+
 def failure_columns(error: Exception) -> dict[str, str]:
     """``status`` (``unstable`` if the FMU reported an instability, else ``failed``) and its whole ``message``
-    (without the ``doStep failed:`` prefix, which every failure shares)."""
-    msg = str(error).split("FMU says: ")[-1].removeprefix("doStep failed: ")
+    (without the ``fmi2DoStep: the step was not completed:`` prefix, which every failure shares)."""
+    msg = str(error).split("FMU says: ")[-1].split(STEP_FAILED)[-1]
     return {"status": "unstable" if "instability" in msg else "failed", "message": msg}
 
 
