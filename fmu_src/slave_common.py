@@ -98,8 +98,9 @@ def leave_host_as_found(resources: str | None) -> None:
     """
     if not PRIVATE_PREFIX:
         return
-    folder = os.path.realpath(resources or RESOURCES)
-    sys.path[:] = [entry for entry in sys.path if not entry or os.path.realpath(entry) != folder]
+    folder = os.path.normpath(resources or RESOURCES)  # the library inserts the string it was given
+    if any(entry == folder or os.path.normpath(entry) == folder for entry in sys.path if entry):
+        sys.path[:] = [entry for entry in sys.path if not entry or os.path.normpath(entry) != folder]
 
 
 class _StoredRepr(type):

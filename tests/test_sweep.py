@@ -142,3 +142,50 @@ def test_default_workers_are_capped_by_the_environment_variable_when_it_is_a_pos
     assert default_workers() == (cores if expected is None else min(cores, expected))
     monkeypatch.setenv(WORKERS_ENV, str(cores + 5))
     assert default_workers() == cores  # a cap, never more processes than cores
+
+
+def test_the_reused_instance_gives_the_numbers_of_a_new_instance_for_every_case(fmu_path):
+    """FmuRunner keeps one instance and resets it between runs (fmi2Reset): every case, also one after a
+    failed case and one with inputs, bit for bit what a new instance per case gives."""
+    from double_pendulum.fmu.runner import FmuRunner
+
+    cases = [*_cases(), {"l1": -1.0}, {"phi1_0": 2.5, "air_drag": True}]
+    signal = np.array([(0.0, 0.3), (0.5, 0.3)], dtype=[("time", float), ("tau1", float)])
+
+    def all_runs(runner: FmuRunner) -> list:
+        out = []
+        for case in cases:
+            try:
+                out.append(runner.simulate(case, **OPTIONS))
+            except FmuRunError as error:
+                out.append(str(error).split("FMU says: ")[-1])
+        out.append(runner.simulate({"phi1_0": 0.3}, input=signal, **OPTIONS))
+        return out
+
+    with FmuRunner(fmu_path) as reused, FmuRunner(fmu_path, reuse_instance=False) as fresh:
+        assert reused.reuse_instance
+        a, b = all_runs(reused), all_runs(fresh)
+    assert a[5] == b[5] and "invalid l1 = -1.0 m" in a[5]  # the failed case says why, either way
+    _assert_same([r for r in a if not isinstance(r, str)], [r for r in b if not isinstance(r, str)])
+
+
+@pytest.mark.slow
+def test_a_long_sweep_in_one_worker_adds_little_memory(fmu_path):
+    """400 short cases in one process, after 150 that warm up imports, caches and the allocator's pools:
+    resident memory grows by less than 2 MB (5 MB per 1,000 cases is the bound; before the instance was
+    reused and the guard stood in front, 68 MB per 1,000; benchmarks/sweep_cost.py)."""
+    from double_pendulum.fmu.runner import FmuRunner
+
+    def rss_kib() -> int:
+        with open("/proc/self/statm") as statm:
+            return int(statm.read().split()[1]) * 4
+
+    cases = random_cases(550, seed=5, uniform={"phi1_0": (0.5, 2.5)})
+    with FmuRunner(fmu_path) as runner:
+        for case in cases[:150]:
+            runner.simulate(case, stop_time=0.1, output_interval=0.01)
+        before = rss_kib()
+        for case in cases[150:]:
+            runner.simulate(case, stop_time=0.1, output_interval=0.01)
+        grown = rss_kib() - before
+    assert grown < 2048, f"{grown} KiB over 400 cases"

@@ -10,6 +10,10 @@
  *                     free, ROUNDS times; then the same sequentially; print "threads-created K of M" and
  *                     "threads-identical 1" if every result equals the sequential one bit for bit
  *   soak N            N instantiate/initialise/step/free cycles; print "rss CYCLE KIB" every N/20 cycles
+ *   neighbour DIR2 IDENTIFIER2 GUID2
+ *                     run a case, then another FMU from DIR2 (a pythonfmu FMU of another author that uses
+ *                     the same module names) for 10 steps, then the case again; print "neighbour-ran 1"
+ *                     if the other FMU ran and "neighbour-identical 1" if both runs of the case agree
  * The host's logger formats the message with the arguments it is given, as a C host does: a message
  * passed as a format would crash it here. Exit status 0 if it got to the end. */
 #include <dlfcn.h>
@@ -452,9 +456,9 @@ static int serialized_state_in_a_new_instance(void) {
     fmi2FreeInstance_(b);
     return ok && pa == pb ? 0 : -2;
 }
-/* A step the solver cannot do is fmi2Discard; then Step Failed: no doStep, but status and terminate. */
-static int discarded_step_then_step_failed(void) {
-    fmi2Component c = instantiate(fmi2False);
+/* An instance whose solver gives up within 100 s (euler, h = 0.5 s, fast start): the status of the
+ * step that failed, and where it failed (t). */
+static int step_until_discard(fmi2Component c, double *t) {
     fmi2String euler = "euler";
     fmi2Real big = 0.5, fast = 40.0;
     fmi2SetString_(c, &SOLVER, 1, &euler);
@@ -464,14 +468,34 @@ static int discarded_step_then_step_failed(void) {
     fmi2EnterInitializationMode_(c);
     fmi2ExitInitializationMode_(c);
     int s = fmi2OK;
-    double t = 0.0;
-    for (int k = 0; k < 200 && s == fmi2OK; k++, t += 0.5) s = fmi2DoStep_(c, t, 0.5, fmi2True);
+    for (*t = 0.0; *t < 100.0 && (s = fmi2DoStep_(c, *t, 0.5, fmi2True)) == fmi2OK; *t += 0.5) {
+    }
+    return s;
+}
+/* A step the solver cannot do is fmi2Discard; then Step Failed: the status says so and terminate is
+ * allowed (2 if all that holds, else -2). */
+static int discarded_step_then_terminate(void) {
+    fmi2Component c = instantiate(fmi2False);
+    double t;
+    int s = step_until_discard(c, &t);
     fmi2Boolean terminated = fmi2False;
-    int again = fmi2DoStep_(c, t, 0.5, fmi2True);
+    fmi2Real last = -1;
     int status = fmi2GetBooleanStatus_(c, fmi2Terminated, &terminated);
+    int time_status = fmi2GetRealStatus_(c, fmi2LastSuccessfulTime, &last);
     int end = fmi2Terminate_(c);
     fmi2FreeInstance_(c);
-    return s == fmi2Discard && again == fmi2Error && status == fmi2OK && terminated && end == fmi2OK ? 2 : -2;
+    return s == fmi2Discard && status == fmi2OK && terminated && time_status == fmi2OK && last == t &&
+                   end == fmi2OK
+               ? 2
+               : -2;
+}
+/* In Step Failed no further doStep. */
+static int do_step_after_discard(void) {
+    fmi2Component c = instantiate(fmi2False);
+    double t;
+    int s = step_until_discard(c, &t) == fmi2Discard ? (int)fmi2DoStep_(c, t, 0.5, fmi2True) : -2;
+    fmi2FreeInstance_(c);
+    return s;
 }
 
 static const struct {
@@ -497,7 +521,7 @@ static const struct {
     P(real_status_null_value) P(real_status_unknown_kind) P(status_kind_not_given) P(last_successful_time)
     P(directional_derivative) P(input_derivatives) P(output_derivatives) P(cancel_step) P(null_instance_do_step)
     P(null_instance_set_real) P(null_instance_free) P(freed_instance_used) P(freed_twice)
-    P(fmu_state_restores_the_time) P(serialized_state_in_a_new_instance) P(discarded_step_then_step_failed)
+    P(fmu_state_restores_the_time) P(serialized_state_in_a_new_instance) P(discarded_step_then_terminate) P(do_step_after_discard)
 #undef P
 };
 
@@ -588,6 +612,30 @@ static void run_soak(int cycles) {
     fflush(stdout);
 }
 
+/* A pythonfmu FMU of another author in this process, 10 steps; 1 if it ran. */
+static int run_neighbour(const char *dir, const char *identifier, const char *other_guid) {
+    char path[4096], location[4200];
+    snprintf(path, sizeof path, "%s/binaries/linux64/%s.so", dir, identifier);
+    snprintf(location, sizeof location, "file://%s/resources", dir);
+    void *other = dlopen(path, RTLD_NOW | RTLD_LOCAL);
+    if (!other) {
+        fprintf(stderr, "cannot load %s: %s\n", path, dlerror());
+        return 0;
+    }
+    fmi2InstantiateTYPE *inst = (fmi2InstantiateTYPE *)dlsym(other, "fmi2Instantiate");
+    fmi2SetupExperimentTYPE *setup = (fmi2SetupExperimentTYPE *)dlsym(other, "fmi2SetupExperiment");
+    fmi2EnterInitializationModeTYPE *enter = (fmi2EnterInitializationModeTYPE *)dlsym(other, "fmi2EnterInitializationMode");
+    fmi2ExitInitializationModeTYPE *leave = (fmi2ExitInitializationModeTYPE *)dlsym(other, "fmi2ExitInitializationMode");
+    fmi2DoStepTYPE *step = (fmi2DoStepTYPE *)dlsym(other, "fmi2DoStep");
+    fmi2FreeInstanceTYPE *release = (fmi2FreeInstanceTYPE *)dlsym(other, "fmi2FreeInstance");
+    fmi2Component c = inst("neighbour", fmi2CoSimulation, other_guid, location, &callbacks, fmi2False, fmi2False);
+    int ok = c && setup(c, fmi2False, 0.0, 0.0, fmi2False, 0.0) == fmi2OK && enter(c) == fmi2OK && leave(c) == fmi2OK;
+    for (int k = 0; ok && k < 10; k++) ok = step(c, k * 0.01, 0.01, fmi2True) == fmi2OK;
+    if (c) release(c);
+    dlclose(other);
+    return ok;
+}
+
 /* ------------------------------------------------------------------------------------ main */
 
 int main(int argc, char **argv) {
@@ -626,6 +674,13 @@ int main(int argc, char **argv) {
     if (strcmp(mode, "probes") == 0) run_probes();
     else if (strcmp(mode, "threads") == 0 && k + 2 < argc) run_threads(atoi(argv[k + 1]), atoi(argv[k + 2]));
     else if (strcmp(mode, "soak") == 0 && k + 1 < argc) run_soak(atoi(argv[k + 1]));
+    else if (strcmp(mode, "neighbour") == 0 && k + 3 < argc) {
+        thread_case before = {.start = 1.3}, after = {.start = 1.3};
+        run_case(&before);
+        printf("neighbour-ran %d\n", run_neighbour(argv[k + 1], argv[k + 2], argv[k + 3]));
+        run_case(&after);
+        printf("neighbour-identical %d\n", !isnan(before.phi1) && before.phi1 == after.phi1);
+    }
     else return 2;
     dlclose(library);
     printf("end\n");

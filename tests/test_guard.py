@@ -1,0 +1,345 @@
+"""The guard in front of the FMI library (``fmu_src/loader/fmi2_guard.c``, ``fmi3_guard.c``), tried as the
+test suites of FMI tools would: torture hosts in C (``tests/c_host/fmi2_torture.c``, ``fmi3_torture.c``),
+started with a bare environment, make every call a master may get wrong and check that each gets what
+the standard says (FMI 2.0 sections 2.1 and 4.2.4, FMI 3.0 sections 2.2, 3.2 and 4.2) with a log line
+that says why: no crash, no hang. Then many threads at once, neighbours of the same names, and
+memory over thousands of instantiate/free cycles."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+from foreign_fmu import RATE, START, build_foreign_fmu
+
+from double_pendulum.fmu import loader
+
+HOSTS = Path(__file__).parent / "c_host"
+NO_LOG = ""  # expected fragment: the call logs nothing
+
+pytestmark = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the C loader and these C hosts are for Linux"),
+    pytest.mark.skipif(loader.c_compiler() is None, reason="no C compiler ($CC, cc, gcc or clang) to build the hosts"),
+]
+
+# probe: (status it must get, a fragment of its log line; None: not checked, NO_LOG: no line). The status
+# of fmi2Instantiate probes is 0 for NULL (refused), 1 for an instance; probes of a whole sequence say 0
+# (or the discard's 2) when every step went as the standard says.
+FMI2_PROBES = {
+    "exit_without_enter": (3, "fmi2ExitInitializationMode: illegal call sequence: not allowed in state Instantiated"),
+    "enter_twice": (3, "fmi2EnterInitializationMode: illegal call sequence: not allowed in state Initialization Mode"),
+    "exit_twice": (3, "fmi2ExitInitializationMode: illegal call sequence: not allowed in state Step Complete"),
+    "terminate_twice": (3, "fmi2Terminate: illegal call sequence: not allowed in state Terminated"),
+    "terminate_before_initialisation": (3, "fmi2Terminate: illegal call sequence: not allowed in state Instantiated"),
+    "set_real_after_terminate": (3, "fmi2SetReal: illegal call sequence: not allowed in state Terminated"),
+    "do_step_after_terminate": (3, "fmi2DoStep: illegal call sequence: not allowed in state Terminated"),
+    "setup_experiment_in_step_mode": (3, "fmi2SetupExperiment: illegal call sequence: not allowed in state Step"),
+    "do_step_before_initialisation": (3, "fmi2DoStep: illegal call sequence: not allowed in state Instantiated"),
+    "get_real_when_instantiated": (3, "fmi2GetReal: illegal call sequence: not allowed in state Instantiated"),
+    "step_size_zero": (3, "fmi2DoStep: communicationStepSize = 0 s must be finite and > 0"),
+    "step_size_negative": (3, "communicationStepSize = -0.01 s must be finite and > 0"),
+    "step_size_nan": (3, "communicationStepSize = nan s must be finite and > 0"),
+    "step_size_infinite": (3, "communicationStepSize = inf s must be finite and > 0"),
+    "communication_point_nan": (3, "currentCommunicationPoint = nan s is not the FMU's time 0 s"),
+    "communication_point_not_the_fmus_time": (3, "currentCommunicationPoint = 0.5 s is not the FMU's time 0 s"),
+    "error_state_then_reset": (0, "fmi2DoStep: illegal call sequence: not allowed in state Error"),
+    "start_value_nan": (3, "fmi2SetReal: ParameterError: invalid phi1_0 = nan rad: must be finite"),
+    "negative_mass": (3, "invalid m1 = -0.3 kg: must be > 0"),
+    "unknown_value_reference": (3, "fmi2SetReal: KeyError(999999)"),
+    "unknown_solver": (3, "fmi2SetString: UnknownSolverError: invalid solver = 'radau5'"),
+    "wrong_type": (3, "fmi2GetBoolean: TypeError: Variable with valueReference="),
+    "fixed_parameter_after_initialisation": (3, "cannot set parameter l1 = 0.5 after initialisation"),
+    "errors_leave_siblings_working": (0, "invalid input pivot_ax = nan"),
+    "wrong_guid": (0, 'fmi2Instantiate: fmuGUID "{wrong}" is not this FMU\'s'),
+    "empty_guid": (0, 'fmuGUID "" is not this FMU\'s'),
+    "null_guid": (0, "fmuGUID NULL is not this FMU's"),
+    "model_exchange": (0, "fmuType = 0: this FMU supports co-simulation (fmi2CoSimulation = 1) only"),
+    "null_instance_name": (0, "fmi2Instantiate: instanceName is NULL"),
+    "empty_instance_name": (0, "fmi2Instantiate: instanceName is empty"),
+    "null_resource_location": (0, "fmuResourceLocation is NULL"),
+    "missing_resource_folder": (0, "there is no folder /nonexistent/resources"),
+    "foreign_resource_folder": (0, "is not this FMU's resources folder (no slavemodule.txt in /tmp)"),
+    "null_callbacks": (0, NO_LOG),
+    "null_logger": (0, NO_LOG),
+    "format_directives_in_a_string": (3, "invalid solver = '%s%s%s%n%n%p'"),
+    "get_real_null_references": (3, "fmi2GetReal: vr is NULL with nvr = 2"),
+    "get_real_null_values": (3, "fmi2GetReal: value is NULL with nvr = 2"),
+    "set_real_null_values": (3, "fmi2SetReal: value is NULL with nvr = 2"),
+    "get_integer_null_values": (3, "fmi2GetInteger: value is NULL"),
+    "get_boolean_null_references": (3, "fmi2GetBoolean: vr is NULL"),
+    "get_string_null_values": (3, "fmi2GetString: value is NULL"),
+    "set_boolean_null_values": (3, "fmi2SetBoolean: value is NULL"),
+    "set_integer_null_references": (3, "fmi2SetInteger: vr is NULL"),
+    "zero_values_need_no_arrays": (0, NO_LOG),
+    "set_string_null_element": (3, "fmi2SetString: value[0] (vr = "),
+    "debug_logging_null_categories": (3, "fmi2SetDebugLogging: categories is NULL with nCategories = 2"),
+    "debug_logging_unknown_category": (3, 'unknown log category "logEverything"'),
+    "debug_logging_null_category": (3, "fmi2SetDebugLogging: categories[1] is NULL"),
+    "errors_silenced_by_set_debug_logging": (3, NO_LOG),
+    "get_fmu_state_null": (3, "fmi2GetFMUstate: FMUstate is NULL"),
+    "set_fmu_state_null": (3, "fmi2SetFMUstate: the FMU state is NULL"),
+    "set_fmu_state_foreign_pointer": (3, "is not a live state of this FMU"),
+    "free_fmu_state_null_pointer": (3, "fmi2FreeFMUstate: FMUstate is NULL"),
+    "free_fmu_state_null_state": (0, NO_LOG),
+    "serialized_size_null": (3, "fmi2SerializedFMUstateSize: size is NULL"),
+    "deserialize_garbage": (3, "the bytes are not a state serialized by this FMU"),
+    "deserialize_null_bytes": (3, "fmi2DeSerializeFMUstate: serializedState is NULL"),
+    "real_status_null_value": (3, "fmi2GetRealStatus: value is NULL"),
+    "real_status_unknown_kind": (3, "fmi2GetRealStatus: 99 is not an fmi2StatusKind"),
+    "status_kind_not_given": (2, NO_LOG),  # fmi2Discard (the standard's answer); Discard messages are debug
+    "last_successful_time": (0, NO_LOG),
+    "directional_derivative": (3, "providesDirectionalDerivative = false"),
+    "input_derivatives": (3, "canInterpolateInputs = false"),
+    "output_derivatives": (3, "maxOutputDerivativeOrder = 0"),
+    "cancel_step": (3, "fmi2CancelStep: illegal call sequence"),
+    "null_instance_do_step": (3, NO_LOG),  # no instance to log through: stderr (ORPHANS)
+    "null_instance_set_real": (3, NO_LOG),
+    "null_instance_free": (0, NO_LOG),
+    "freed_instance_used": (3, NO_LOG),
+    "freed_twice": (0, NO_LOG),
+    "fmu_state_restores_the_time": (0, "currentCommunicationPoint = 1 s is not the FMU's time 0.5 s"),
+    "serialized_state_in_a_new_instance": (0, NO_LOG),
+    "discarded_step_then_terminate": (2, "fmi2DoStep: the step was not completed: numerical instability at t = "),
+    "do_step_after_discard": (3, "fmi2DoStep: illegal call sequence: not allowed in state Step Failed"),
+}
+# What the calls without an instance (no logger to use) say on stderr, one line each.
+ORPHANS = ["fmi2Instantiate: functions is NULL", "fmi2Instantiate: functions->logger is NULL",
+           "fmi2DoStep: the instance is NULL", "fmi2SetReal: the instance is NULL",
+           "fmi2DoStep: 0x", "is not a live instance of this FMU (freed, or never instantiated here)",
+           "fmi2FreeInstance: 0x"]
+
+FMI3_PROBES = {
+    "exit_in_instantiated": (3, "fmi3ExitInitializationMode: illegal call sequence: not allowed in state Instantiated"),
+    "exit_twice": (3, "fmi3ExitInitializationMode: illegal call sequence: not allowed in state Step Mode"),
+    "do_step_before_initialisation": (3, "fmi3DoStep: illegal call sequence: not allowed in state Instantiated"),
+    "terminate_twice": (3, "fmi3Terminate: illegal call sequence: not allowed in state Terminated"),
+    "do_step_after_terminate": (3, "fmi3DoStep: illegal call sequence: not allowed in state Terminated"),
+    "set_after_terminate": (3, "fmi3SetFloat64: illegal call sequence: not allowed in state Terminated"),
+    "enter_step_mode_without_event_mode": (3, "fmi3EnterStepMode: illegal call sequence"),
+    "model_exchange_function_in_co_simulation": (3, "fmi3SetTime: not a function of Co-Simulation"),
+    "do_step_in_model_exchange": (3, "fmi3DoStep: not a function of Model Exchange"),
+    "step_size_zero": (3, "fmi3DoStep: communicationStepSize = 0 s must be finite and > 0"),
+    "step_size_nan": (3, "communicationStepSize = nan s"),
+    "communication_point_not_the_fmus_time": (3, "currentCommunicationPoint = 2 s is not the FMU's time 0 s"),
+    "do_step_null_out_argument": (3, "fmi3DoStep: eventHandlingNeeded is NULL"),
+    "start_time_is_the_first_communication_point": (0, NO_LOG),
+    "start_value_nan": (3, "fmi3SetFloat64: ParameterError: invalid phi1_0 = nan rad: must be finite"),
+    "values_count_not_references_count": (3, "fmi3SetFloat64: nValues = 2, but 1 value references"),
+    "get_float64_null_references": (3, "fmi3GetFloat64: valueReferences is NULL"),
+    "get_float64_null_values": (3, "fmi3GetFloat64: values is NULL"),
+    "get_float32_not_a_type_of_this_fmu": (3, "fmi3GetFloat32: not supported by this FMU"),
+    "get_clock": (3, "fmi3GetClock: not supported by this FMU (it has no clocks)"),
+    "format_directives_in_a_string": (3, "invalid solver = '%s%s%n'"),
+    "fixed_parameter_after_initialisation": (3, "cannot set parameter l1 = 0.5 after initialisation (FMI: a fixed "
+                                                "parameter is set before the FMU leaves Initialization Mode)"),
+    "wrong_token": (0, 'instantiationToken "{wrong}" is not this FMU\'s'),
+    "null_token": (0, "instantiationToken NULL is not this FMU's"),
+    "null_resource_path": (0, "resourcePath is NULL"),
+    "null_instance_name": (0, "instanceName is NULL"),
+    "event_mode_requested": (0, "eventModeUsed = true, but this FMU has no Event Mode in Co-Simulation"),
+    "scheduled_execution": (0, "offers Model Exchange and Co-Simulation only"),
+    "null_logger_still_instantiates": (1, NO_LOG),  # FMI 3: the logger may be NULL
+    "update_discrete_states_null_out_argument": (3, "fmi3UpdateDiscreteStates: terminateSimulation is NULL"),
+    "set_continuous_states_wrong_count": (3, "nContinuousStates = 3, but this FMU has 13"),
+    "get_continuous_states_null": (3, "continuousStates is NULL with nContinuousStates = 13"),
+    "set_time_nan": (3, "fmi3SetTime: time = nan s must be finite"),
+    "completed_integrator_step_null": (3, "fmi3CompletedIntegratorStep: enterEventMode is NULL"),
+    "number_of_states": (0, NO_LOG),
+    "get_fmu_state_null": (3, "fmi3GetFMUState: FMUState is NULL"),
+    "set_fmu_state_foreign": (3, "is not a live state of this FMU"),
+    "deserialize_garbage": (3, "are not a serialized state of this FMU"),
+    "debug_logging_null_categories": (3, "fmi3SetDebugLogging: categories is NULL"),
+    "configuration_mode_round_trip": (0, NO_LOG),
+    "directional_derivative": (3, "providesDirectionalDerivatives = false"),
+    "evaluate_discrete_states": (3, "fmi3EvaluateDiscreteStates: not supported by this FMU"),
+    "null_instance": (3, NO_LOG),
+    "error_state_then_reset": (0, "fmi3DoStep: illegal call sequence: not allowed in state Error"),
+}
+
+
+def compile_host(name: str, folder: Path) -> Path:
+    path = folder / name
+    command = [*loader.c_compiler(), "-O2", f"-I{loader.fmi_headers()}", "-o", str(path), str(HOSTS / f"{name}.c"),
+               "-ldl", "-lpthread", "-lm"]
+    subprocess.run(command, check=True, capture_output=True)
+    return path
+
+
+@pytest.fixture(scope="module")
+def hosts(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    folder = tmp_path_factory.mktemp("torture")
+    return {version: compile_host(f"fmi{version}_torture", folder) for version in (2, 3)}
+
+
+@pytest.fixture(scope="module")
+def extracted(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path, object]]:
+    """DoublePendulum (FMI 2 and FMI 3) and Suspension extracted, with their model descriptions."""
+    from fmpy import extract, read_model_description
+
+    folder = tmp_path_factory.mktemp("guarded")
+    paths = {"fmi2": fmu_path, "suspension": fmu_path.parent / "Suspension.fmu",
+             "fmi3": fmu_path.parent / "fmi3" / "DoublePendulum.fmu"}
+    return {name: (Path(extract(str(path), str(folder / name))), read_model_description(str(path)))
+            for name, path in paths.items()}
+
+
+def host_command(host: Path, folder: Path, description, version: int, *mode: str) -> list[str]:
+    names = ("phi1_0", "m1", "l1", "solver", "phi1", "pivot_ax", "air_drag", "fixed_step", "omega2_0")
+    refs = {v.name: v.valueReference for v in description.modelVariables}
+    identifier = (description.coSimulation or description.modelExchange).modelIdentifier
+    token = description.guid if version == 2 else description.instantiationToken
+    return [str(host), str(folder), identifier, token, *(f"{n}={refs[n]}" for n in names if n in refs), *mode]
+
+
+def run(command: list[str], tmp_path: Path, timeout: float = 300) -> subprocess.CompletedProcess:
+    """Run a host with a bare environment (what env -i PATH=/usr/bin:/bin gives it)."""
+    return subprocess.run(command, capture_output=True, text=True, env={"PATH": "/usr/bin:/bin", "HOME": str(tmp_path)},
+                          cwd=tmp_path, timeout=timeout)
+
+
+def parse_probes(stdout: str) -> dict[str, tuple[int, list[tuple[int, str]]]]:
+    probes: dict[str, tuple[int, list[tuple[int, str]]]] = {}
+    name = None
+    for line in stdout.splitlines():
+        if line.startswith("probe "):
+            _, name, status = line.split()
+            probes[name] = (int(status), [])
+        elif line.startswith("  log ") and name:
+            status, _, text = line[6:].partition(" ")
+            probes[name][1].append((int(status), text))
+    return probes
+
+
+def check_probes(probes: dict, expected: dict) -> None:
+    assert set(probes) == set(expected), "every probe has its expectation, and every expectation ran"
+    wrong = []
+    for name, (status, fragment) in expected.items():
+        got, logs = probes[name]
+        if got != status:
+            wrong.append(f"{name}: status {got}, expected {status} ({logs})")
+        elif fragment == NO_LOG and logs:
+            wrong.append(f"{name}: logged {logs}, expected nothing")
+        elif fragment and not any(fragment in text for _, text in logs):
+            wrong.append(f"{name}: no log line with {fragment!r} in {logs}")
+        elif fragment and status == 3 and not any(level == 3 for level, _ in logs):
+            wrong.append(f"{name}: its error was not logged with status fmi2Error/fmi3Error")
+    assert not wrong, "\n".join(wrong)
+
+
+def test_every_fmi2_probe_gets_the_standards_answer_and_a_log_line(hosts, extracted, tmp_path):
+    folder, description = extracted["fmi2"]
+    done = run(host_command(hosts[2], folder, description, 2, "probes"), tmp_path)
+    assert done.returncode == 0 and done.stdout.rstrip().endswith("end"), done.stdout[-3000:] + done.stderr
+    check_probes(parse_probes(done.stdout), FMI2_PROBES)
+    errors = done.stderr.splitlines()
+    assert len(errors) == 6 and all(line.startswith("[DoublePendulum] ") for line in errors), errors
+    for fragment in ORPHANS:
+        assert any(fragment in line for line in errors), (fragment, errors)
+
+
+def test_every_fmi3_probe_gets_the_standards_answer_and_a_log_line(hosts, extracted, tmp_path):
+    folder, description = extracted["fmi3"]
+    done = run(host_command(hosts[3], folder, description, 3, "probes"), tmp_path)
+    assert done.returncode == 0 and done.stdout.rstrip().endswith("end"), done.stdout[-3000:] + done.stderr
+    check_probes(parse_probes(done.stdout), FMI3_PROBES)
+    assert done.stderr.splitlines() == ["[DoublePendulum] fmi3DoStep: the instance is NULL"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("version", [2, 3])
+def test_sixteen_threads_instantiate_step_and_free_at_once(hosts, extracted, tmp_path, version):
+    """16 threads at once, 3 rounds, in 8 processes (the first instantiations of a process start Python
+    and import the bundle, where the races were): every instance created, every result bit-identical
+    to the same case run alone."""
+    folder, description = extracted[f"fmi{version}"]
+    command = host_command(hosts[version], folder, description, version, "threads", "16", "3")
+    processes = [subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                                  env={"PATH": "/usr/bin:/bin", "HOME": str(tmp_path)}) for _ in range(8)]
+    for process in processes:
+        out, err = process.communicate(timeout=300)
+        assert process.returncode == 0, out + err
+        assert "threads-created 48 of 48" in out and "threads-identical 1" in out, out + err
+
+
+@pytest.mark.slow
+def test_memory_stays_flat_over_thousands_of_instantiate_free_cycles(hosts, extracted, tmp_path):
+    """2,000 instantiate/initialise/step/free cycles in the C host: resident memory grows by less than
+    1 KiB per cycle over the last 1,500 (before the guard: about 70 KiB)."""
+    folder, description = extracted["fmi2"]
+    done = run(host_command(hosts[2], folder, description, 2, "soak", "2000"), tmp_path)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr
+    rss = {int(k): int(kib) for _, k, kib in (line.split() for line in done.stdout.splitlines()
+                                              if line.startswith("rss "))}
+    slope = (rss[2000] - rss[500]) / 1500
+    assert slope < 1.0, f"{slope:.2f} KiB per cycle: {rss}"
+
+
+@pytest.fixture(scope="module")
+def foreign(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Another author's pythonfmu FMUs named DoublePendulum and Suspension, extracted."""
+    from fmpy import extract
+
+    folder = tmp_path_factory.mktemp("foreign")
+    built = {model: build_foreign_fmu(folder, model) for model in ("DoublePendulum", "Suspension")}
+    return {model: Path(extract(str(path), str(folder / f"{model}_x"))) for model, path in built.items()}
+
+
+def test_a_foreign_fmu_of_the_same_names_beside_ours_in_a_c_host(hosts, extracted, foreign, tmp_path):
+    """Ours, then another author's DoublePendulum (its own slave_common, double_pendulum, pythonfmu), then
+    ours again: both run, and ours gives the same number. (In a C host the foreign FMU, pythonfmu's plain
+    binary, needs a Python in the process: ours brings it.)"""
+    from fmpy import read_model_description
+
+    folder, description = extracted["fmi2"]
+    theirs = foreign["DoublePendulum"]
+    guid = read_model_description(str(theirs)).guid
+    done = run(host_command(hosts[2], folder, description, 2, "neighbour", str(theirs), "DoublePendulum", guid),
+               tmp_path)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "neighbour-ran 1" in done.stdout and "neighbour-identical 1" in done.stdout, done.stdout + done.stderr
+
+
+NEIGHBOURS = textwrap.dedent("""
+    import json, sys
+    from fmpy import simulate_fmu
+    order, ours, theirs = sys.argv[1], json.loads(sys.argv[2]), json.loads(sys.argv[3])
+    out = {}
+    def run_ours(tag):
+        for name, path in ours.items():
+            r = simulate_fmu(path, stop_time=0.2, output_interval=0.01, start_values=START[name])
+            out[f"{tag} {name}"] = float(r[OUTPUT[name]][-1])
+    def run_theirs(tag):
+        for name, path in theirs.items():
+            out[f"{tag} theirs {name}"] = float(simulate_fmu(path, stop_time=0.2, output_interval=0.01)["x"][-1])
+    START = {"DoublePendulum": {"phi1_0": 1.3}, "Suspension": {"F_static_y": -20.0}}
+    OUTPUT = {"DoublePendulum": "phi1", "Suspension": "y"}
+    for step in order.split(","):
+        (run_ours if step.startswith("ours") else run_theirs)(step)
+    print(json.dumps(out))
+""")
+
+
+def test_foreign_fmus_of_the_same_names_before_and_after_ours_in_fmpy(extracted, foreign, tmp_path):
+    """In one fmpy process, another author's DoublePendulum and Suspension first, then ours, then theirs
+    and ours again (and ours alone in a fresh process, for the reference): ours runs its own code and
+    gives the same numbers whatever ran before; theirs run theirs."""
+    import json
+
+    ours = {"DoublePendulum": str(extracted["fmi2"][0]), "Suspension": str(extracted["suspension"][0])}
+    theirs = {name: str(path) for name, path in foreign.items()}
+
+    def run_order(order: str) -> dict:
+        done = subprocess.run([sys.executable, "-c", NEIGHBOURS, order, json.dumps(ours), json.dumps(theirs)],
+                              capture_output=True, text=True, cwd=tmp_path, timeout=300)
+        assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
+        return json.loads(done.stdout.strip().splitlines()[-1])
+
+    alone = run_order("ours")
+    mixed = run_order("theirs,ours1,theirs2,ours2")
+    for name in ours:
+        assert mixed[f"ours1 {name}"] == alone[f"ours {name}"] == mixed[f"ours2 {name}"]
+        for tag in ("theirs", "theirs2"):
+            assert mixed[f"{tag} theirs {name}"] == pytest.approx(START + RATE * 0.2)
