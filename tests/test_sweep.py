@@ -169,23 +169,36 @@ def test_the_reused_instance_gives_the_numbers_of_a_new_instance_for_every_case(
     _assert_same([r for r in a if not isinstance(r, str)], [r for r in b if not isinstance(r, str)])
 
 
+MEMORY_SCRIPT = """
+import sys
+from double_pendulum.analysis.sweep import random_cases
+from double_pendulum.fmu.runner import FmuRunner
+
+def rss_kib():
+    with open("/proc/self/statm") as statm:
+        return int(statm.read().split()[1]) * 4
+
+cases = random_cases(550, seed=5, uniform={"phi1_0": (0.5, 2.5)})
+with FmuRunner(sys.argv[1]) as runner:
+    for case in cases[:150]:
+        runner.simulate(case, stop_time=0.1, output_interval=0.01)
+    before = rss_kib()
+    for case in cases[150:]:
+        runner.simulate(case, stop_time=0.1, output_interval=0.01)
+    print(rss_kib() - before)
+"""
+
+
 @pytest.mark.slow
 def test_a_long_sweep_in_one_worker_adds_little_memory(fmu_path):
-    """400 short cases in one process, after 150 that warm up imports, caches and the allocator's pools:
-    resident memory grows by less than 2 MB (5 MB per 1,000 cases is the bound; before the instance was
-    reused and the guard stood in front, 68 MB per 1,000; benchmarks/sweep_cost.py)."""
-    from double_pendulum.fmu.runner import FmuRunner
+    """400 short cases in a worker of its own, after 150 that warm up imports, caches and the allocator's
+    pools: resident memory grows by less than 2 MB (5 MB per 1,000 cases is the bound; before the instance
+    was reused and the guard stood in front, 68 MB per 1,000; benchmarks/sweep_cost.py)."""
+    import subprocess
+    import sys
 
-    def rss_kib() -> int:
-        with open("/proc/self/statm") as statm:
-            return int(statm.read().split()[1]) * 4
-
-    cases = random_cases(550, seed=5, uniform={"phi1_0": (0.5, 2.5)})
-    with FmuRunner(fmu_path) as runner:
-        for case in cases[:150]:
-            runner.simulate(case, stop_time=0.1, output_interval=0.01)
-        before = rss_kib()
-        for case in cases[150:]:
-            runner.simulate(case, stop_time=0.1, output_interval=0.01)
-        grown = rss_kib() - before
+    done = subprocess.run([sys.executable, "-c", MEMORY_SCRIPT, str(fmu_path)], capture_output=True, text=True,
+                          timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    grown = int(done.stdout.strip().splitlines()[-1])
     assert grown < 2048, f"{grown} KiB over 400 cases"

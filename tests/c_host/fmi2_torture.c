@@ -5,7 +5,8 @@
  *
  * DIR is an extracted FMU (binaries/linux64/IDENTIFIER.so), NAME=VR the value references the probes
  * use (phi1_0 m1 l1 solver phi1 pivot_ax air_drag fixed_step omega2_0). MODE:
- *   probes            run every probe; print "probe NAME STATUS" and its log lines "  log STATUS TEXT"
+ *   probes [NAME]     run every probe (or the one named); print "probe NAME STATUS" and its log lines
+ *                     "  log STATUS TEXT"
  *   threads N ROUNDS  N threads at once instantiate, set a start value, run 20 steps, read phi1 and
  *                     free, ROUNDS times; then the same sequentially; print "threads-created K of M" and
  *                     "threads-identical 1" if every result equals the sequential one bit for bit
@@ -525,8 +526,10 @@ static const struct {
 #undef P
 };
 
-static void run_probes(void) {
+/* Every probe, or only the one named `only` (not NULL). */
+static void run_probes(const char *only) {
     for (size_t k = 0; k < sizeof PROBES / sizeof PROBES[0]; k++) {
+        if (only && strcmp(only, PROBES[k].name) != 0) continue;
         n_logs = 0;
         int status = PROBES[k].run();
         printf("probe %s %d\n", PROBES[k].name, status);
@@ -671,7 +674,7 @@ int main(int argc, char **argv) {
     }
     FMI2_ALL(RESOLVE)
     const char *mode = argv[k];
-    if (strcmp(mode, "probes") == 0) run_probes();
+    if (strcmp(mode, "probes") == 0) run_probes(k + 1 < argc ? argv[k + 1] : NULL);
     else if (strcmp(mode, "threads") == 0 && k + 2 < argc) run_threads(atoi(argv[k + 1]), atoi(argv[k + 2]));
     else if (strcmp(mode, "soak") == 0 && k + 1 < argc) run_soak(atoi(argv[k + 1]));
     else if (strcmp(mode, "neighbour") == 0 && k + 3 < argc) {

@@ -5,7 +5,8 @@
  *
  * DIR is an extracted FMU (binaries/x86_64-linux/IDENTIFIER.so), NAME=VR the value references the
  * probes use (phi1_0 phi1 l1 solver pivot_ax). MODE:
- *   probes            run every probe; print "probe NAME STATUS" and its log lines "  log STATUS TEXT"
+ *   probes [NAME]     run every probe (or the one named); print "probe NAME STATUS" and its log lines
+ *                     "  log STATUS TEXT"
  *   threads N ROUNDS  as fmi2_torture.c, with Co-Simulation instances
  * Exit status 0 if it got to the end. */
 #include <dlfcn.h>
@@ -325,6 +326,7 @@ int main(int argc, char **argv) {
     FMI3_USED(RESOLVE)
     if (strcmp(argv[k], "probes") == 0) {
         for (size_t p = 0; p < sizeof PROBES / sizeof PROBES[0]; p++) {
+            if (k + 1 < argc && strcmp(argv[k + 1], PROBES[p].name) != 0) continue;
             n_logs = 0;
             int status = PROBES[p].run();
             printf("probe %s %d\n", PROBES[p].name, status);

@@ -1,0 +1,67 @@
+"""What the FMUs' Linux binaries ask of a target machine, read from the built binaries (docs/fmu.md,
+"What a Linux machine needs"): the loader only glibc 2.17 symbol versions and the C libraries (so it
+loads on older systems and can say what is missing), pythonfmu's and pythonfmu3's libraries what the
+docs state."""
+
+from __future__ import annotations
+
+import re
+import sys
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from double_pendulum.fmu import elf_needs, loader
+
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "fmu.md"
+GLIBC_FLOOR = "GLIBC_2.17"  # CentOS 7, manylinux2014
+C_LIBRARIES = {"libc.so.6", "libdl.so.2", "libpthread.so.0", "libm.so.6"}
+
+pytestmark = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the loader is for Linux"),
+    pytest.mark.skipif(loader.c_compiler() is None, reason="no C compiler: the FMUs keep pythonfmu's binary"),
+]
+
+
+def binaries(fmu_path: Path) -> dict[str, bytes]:
+    """Every FMU's Linux binaries, by ``<FMU>/<file>``."""
+    out = {}
+    for fmu in (fmu_path, fmu_path.parent / "Suspension.fmu", fmu_path.parent / "fmi3" / "DoublePendulum.fmu"):
+        with zipfile.ZipFile(fmu) as archive:
+            for name in archive.namelist():
+                if name.endswith(".so"):
+                    out[f"{fmu.parent.name}/{fmu.name}/{name}"] = archive.read(name)
+    return out
+
+
+def test_the_loader_asks_only_for_old_glibc_symbol_versions_and_the_c_libraries(fmu_path):
+    loaders = {name: data for name, data in binaries(fmu_path).items() if "libpythonfmu" not in name}
+    assert len(loaders) == 3
+    for name, data in loaders.items():
+        needs = elf_needs.version_needs(data)
+        assert set(needs) <= C_LIBRARIES, f"{name} links {set(needs) - C_LIBRARIES}"  # no libstdc++, no libpython
+        newest = elf_needs.newest(needs, "GLIBC")
+        assert elf_needs.version_key(newest) <= elf_needs.version_key(GLIBC_FLOOR), f"{name} needs {newest}"
+
+
+def test_the_docs_state_what_the_fmi_libraries_need(fmu_path):
+    """docs/fmu.md names the glibc and libstdc++ versions pythonfmu's and pythonfmu3's binaries ask for."""
+    text = DOCS.read_text()
+    libraries = {name.rsplit("/", 1)[-1]: data for name, data in binaries(fmu_path).items() if "libpythonfmu" in name}
+    assert set(libraries) == {"libpythonfmu-export.so", "libpythonfmu3-export.so"}
+    for name, data in libraries.items():
+        needs = elf_needs.version_needs(data)
+        glibc, glibcxx = elf_needs.newest(needs, "GLIBC"), elf_needs.newest(needs, "GLIBCXX")
+        line = next((line for line in text.splitlines() if f"`{name}`" in line), "")
+        assert glibc.partition("_")[2] in re.findall(r"glibc (?:>= )?([\d.]+)", line), (name, glibc, line)
+        assert glibcxx in line, (name, glibcxx, line)
+
+
+def test_the_version_reader_reads_what_the_loader_was_built_with(fmu_path):
+    data = next(data for name, data in binaries(fmu_path).items() if name.endswith("linux64/DoublePendulum.so"))
+    needs = elf_needs.version_needs(data)
+    assert "GLIBC_2.2.5" in needs["libc.so.6"] or "GLIBC_2.17" in needs["libc.so.6"]
+    assert elf_needs.describe(data).startswith("glibc >= 2.")
+    with pytest.raises(ValueError, match="not a 64-bit"):
+        elf_needs.version_needs(b"#!/bin/sh\n")
