@@ -145,8 +145,8 @@ def test_chaos_horizons_and_error_curves():
     }
     runs = [_prediction([0.0], [0.0], "a"), _prediction([0.0], [0.0], "b")]
     curves = tc.error_curves(runs, spread)
-    assert list(curves)[:3] == ["a: lower bob, smoothed", "b: lower bob, per frame", "b: lower bob, smoothed"]
-    assert curves[list(curves)[-1]] is spread
+    assert list(curves.smoothed) == ["a", "b"] and curves.per_frame[0] == "b"  # the main run: the last
+    assert curves.spread is spread
     assert tc.errors_units(runs)["e2_b"] == "m"
 
 

@@ -202,9 +202,10 @@ def test_natural_frequency_marks_and_shown_spectrum():
     ident = type("Ident", (), {"k": 2e4, "c": 30.0, "m_s": 2.0})()
     marks = study.natural_frequency_marks(spectrum, ident)
     assert list(marks.values()) == pytest.approx([100.0, math.sqrt(2e4 / 2.6)])
-    assert "= 100 rad/s" in next(iter(marks))
+    assert "= 100 rad/s" in next(iter(marks)) and all("assumed" in label for label in marks)  # k, M_s: not measured
     omega, spectra = study.shown_force_spectra(spectrum)
-    assert omega[0] >= study.SPECTRUM_SHOWN_FROM and len(omega) == len(spectra["F_x"]) == len(spectra["F_y"])
+    assert omega[0] >= study.SPECTRUM_SHOWN_FROM and [len(s) for s in spectra.values()] == [len(omega)] * 2
+    assert [label.split()[-1] for label in spectra] == ["F_x", "F_y"]
 
 
 def test_decay_maps_sweeps_the_main_grid_then_coarser_ones_per_extra_mass(monkeypatch):
