@@ -34,6 +34,16 @@ def fmu3_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return build_fmu3(tmp_path_factory.mktemp("fmu3") / "DoublePendulum.fmu")
 
 
+@pytest.fixture(scope="session", autouse=True)
+def close_kept_runners() -> Iterator[None]:
+    """At the end of each test process, close the FMU runners the sweeps keep per process (each holds an extracted
+    FMU), as ``double-pendulum run`` does when it ends (``analysis.sweep.close_runners``)."""
+    yield
+    from double_pendulum.analysis.sweep import close_runners
+
+    close_runners()
+
+
 @pytest.fixture(scope="session")
 def runner(fmu_path: Path):
     """An fmpy runner for the session's FMU."""

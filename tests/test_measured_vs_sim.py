@@ -205,7 +205,7 @@ def test_cause_is_model_error_when_the_fit_allows_more_than_twice_the_observed_h
     assert "model error" in cause_text(_cause_summary(0.4, None))  # the ensemble: beyond the 2 s prediction
     assert "start's uncertainty limits it" in cause_text(_cause_summary(0.6, 1.0))
     assert "whole 2.0 s prediction" in cause_text(_cause_summary(None, None))
-    assert fmt_horizon(None, 2.0) == "> 2.0" and fmt_horizon(0.123, 2.0) == "0.12"
+    assert fmt_horizon(None, 2.0) == "none in 2.00" and fmt_horizon(0.123, 2.0) == "0.12"  # censored: no "> 2"
 
 
 def test_quick_run_compares_both_starts_with_the_track(quick_results):
