@@ -77,13 +77,13 @@ def _opening(summary: dict[str, Any]) -> str:
         "several co-simulation masters, and each run was compared with the one FMU that integrates both together "
         f"(errors at {summary['stop_time_s']:g} s after a regular and a chaotic start).",
         "Plain exchange of values once per macro step (Jacobi, what libcosim and fmpy's container FMU do) has an "
-        + (f"error proportional to the step (fitted orders {min(jacobi):.2f} to {max(jacobi):.2f})" if jacobi else
+        + (f"error proportional to the step (fitted orders {min(jacobi):.3f} to {max(jacobi):.3f})" if jacobi else
            "error that falls with the step") + " and creates or destroys a little energy.",
         "Repeating each step with the FMUs' saved and restored states until the exchanged values agree (the "
         "iterative master) is second order, and "
         + (f"{'it' if methods == ['iterative'] else ', '.join(methods)} was the cheapest way to an angle error of "
            f"1e-4 rad in every case run." if cheapest else "no run reached an angle error of 1e-4 rad."),
-        "A suspension light against the pendulum makes plain exchange blow up: the measured stability limits "
+        "A suspension much lighter than the pendulum makes plain exchange blow up: the measured stability limits "
         + ("agree with the derived ones" if holds else "do NOT all agree with the derived ones")
         + " (below); the CPU times are from a shared machine and rank only runs that differ clearly.",
     ], {

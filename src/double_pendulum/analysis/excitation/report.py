@@ -106,8 +106,8 @@ def _opening(s: Mapping[str, Any], quick: bool) -> str:
         f"A single pendulum shaken at {s['kapitza_frequency_rad_per_s']:g} rad/s stays upright above an amplitude of "
         f"{1e3 * s['kapitza_threshold_amplitude_m']:.3f} mm (Kapitza's pendulum), which the exact theory of the motion "
         f"as simulated matches to {abs(100 * s['kapitza_relative_error_vs_held_exact']):.4f} %.",
-        f"For the double pendulum, {s['acheson_stable_points']} of {s['acheson_map_points']} shaking frequencies and "
-        f"amplitudes hold it upright, and the theory agrees on "
+        f"For the double pendulum, {s['acheson_stable_points']} of {s['acheson_map_points']} combinations of shaking "
+        f"frequency and amplitude hold it upright, and the theory agrees on "
         f"{100 * s['acheson_agreement_fraction']:.0f} % of them (Acheson's inverted double pendulum).",
         f"Driven by a small torque, both rods resonate at the damped linear theory's peaks to within "
         f"{100 * s['resonance_max_abs_relative_error']:.2f} %, the resolution of the frequencies tried.",

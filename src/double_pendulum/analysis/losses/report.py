@@ -82,6 +82,22 @@ def _factor_text(s: Mapping[str, Any]) -> str:
             f"numbers join the tie: {parts} (F = {s['correlation_factor_F']:.2f} here).")
 
 
+def _pair_text(s: Mapping[str, Any], max_corr: float = 0.95) -> str:
+    """Within each supported pair of losses, whether the record fixes each loss or only their combination."""
+    parts = []
+    for r in s["models"]:
+        corr = r.get("parameter_correlation")
+        if r["model"] not in s["supported_models"]["models"] or not corr or len(corr) != 2:
+            continue
+        a, b = list(r["parameters"])
+        if abs(corr[0][1]) > max_corr:
+            parts.append(f"in {model_title(r['model'])} {a} and {b} correlate at r = {corr[0][1]:+.3f}")
+    if not parts:
+        return ""
+    return ("Within the pairs the record fixes only the combination, not each loss (neither is identified on its "
+            "own, so the shares above are the total loss restated under the assumed pair): " + "; ".join(parts) + ".")
+
+
 def _correlation_note(s: Mapping[str, Any]) -> str:
     """What a strong correlation of the parameters means for the shares."""
     if not any(s["identifiability"].get("strongly_correlated", {}).values()):
@@ -254,6 +270,8 @@ neither b nor p). Errors of fitted numbers are multiplied by sqrt(F). {_factor_t
 ## Which models the record supports
 
 {s['supported_models']['text']}
+
+{_pair_text(s)}
 
 How plausible the fitted friction is, against the seed's own estimate: {seed_friction_text(s)}
 

@@ -399,7 +399,7 @@ def _opening(s: Mapping[str, Any], quick: str) -> str:
     b0 = s["refit"]["no suspension"]["b_E_pendulum_per_s"]
     return report_opening(f"Can the pivot's suspension explain the measured energy decay?{quick}", [
         f"The camera shows the pendulum's energy decaying at b = {m['b_per_s']:.4f} 1/s; air drag and bearing friction "
-        f"at the seed's own estimates account for only {b0:.4f} 1/s of it, so this report asks whether a springy, "
+        f"at the seed's own estimates account for only {abs(b0):.4f} 1/s of it, so this report asks whether a springy, "
         "damped mount of the pivot could take the rest.",
         "Maps of the decay rate over the mount's stiffness k and damping c show that many mounts reproduce the "
         "measured rate, along a curve in (k, c), not one.",
