@@ -29,7 +29,7 @@ from double_pendulum.analysis.chaos.ensemble import initial_states, pendulum_fie
 from double_pendulum.analysis.chaos.lyapunov import LyapunovResult, lyapunov_benettin, lyapunov_two_trajectory
 from double_pendulum.analysis.chaos.plan import FULL, QUICK, THOROUGH, H, Plan, precision
 from double_pendulum.analysis.progress import step
-from double_pendulum.analysis.sweep import default_workers, parallel_map, run_sweep
+from double_pendulum.analysis.sweep import default_workers, parallel_map, run_sweep, where_runs
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.model.parameters import AirDragParameters, BearingParameters, PendulumParameters
 from double_pendulum.model.vector_field import ModelConfig
@@ -227,7 +227,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     parts.sort(key=lambda part: -PART_COST.get(part[0], 0))
     workers = default_workers() if plan.workers is None else plan.workers
     step(f"{len(parts)} parts (FMU runs, Lyapunov exponents by {len(plan.methods()) + 1} integrations, spectrum, "
-         f"energy scan, with friction, ensembles, Poincare sections) on {min(workers, len(parts))} processes")
+         f"energy scan, with friction, ensembles, Poincare sections) {where_runs(len(parts), workers)}")
     values, _ = parallel_map(run_part, parts, max_workers=workers, label="chaos parts", unit="part")
     done = {name: value for (name, _), value in zip(parts, values)}
     fmu, fmu_vs_batch = done["fmu"]

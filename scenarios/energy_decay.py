@@ -25,7 +25,14 @@ import numpy as np
 
 from double_pendulum import plots
 from double_pendulum.analysis.decay.error_budget import error_budget
-from double_pendulum.analysis.decay.fit import SEED_FIT, FitResult, calibrate_error_model, comparison_table, fit_all
+from double_pendulum.analysis.decay.fit import (
+    SEED_FIT,
+    FitResult,
+    calibrate_error_model,
+    comparison_table,
+    fit_all,
+    record_correlation_factor,
+)
 from double_pendulum.analysis.decay.report import report_text
 from double_pendulum.analysis.decay.summary import (
     TRACK_CSV_UNITS,
@@ -76,7 +83,8 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
     m = rec.free_motion
     t, e = rec.t[m], rec.energy[m]
     errors = calibrate_error_model(t, e, rec.sigma_energy[m], rec.momentum[m])
-    fits = fit_all(t, e, errors.sigma, absolute_sigma=True)
+    factor = record_correlation_factor(t, e, errors.sigma)  # the one F of this record, for errors and AIC alike
+    fits = fit_all(t, e, errors.sigma, absolute_sigma=True, factor=factor)
     main = fit_exponential(t, e, errors.sigma, True)
     exp_fit = next(f for f in fits if f.model == "exponential")
     summary: dict[str, Any] = {

@@ -32,8 +32,9 @@ from pathlib import Path
 from typing import Any
 
 from double_pendulum import plots
+from double_pendulum.analysis.losses.claims import SUPPORTED_DAIC
 from double_pendulum.analysis.losses.identification import identify_losses
-from double_pendulum.analysis.losses.mechanisms import parameters_of
+from double_pendulum.analysis.losses.mechanisms import model_title, parameters_of
 from double_pendulum.analysis.losses.report import report_text
 from double_pendulum.results_io import table_from_columns, write_json, write_results_csv, write_text
 
@@ -50,8 +51,10 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False, thorough: bool = Fal
     units = {"t": "s", "E_measured": "J", "sigma_E": "J", "E_simulated": "J", **{w: "J" for w in ident.works}}
     write_results_csv(out_dir / "energy.csv", table, units)
     best = s["top_model"]
-    plots.plot_energy_fit(ident.t, ident.e_measured, ident.sigma, ident.e_sim, best, out_dir / "energy_fit.png")
-    plots.plot_loss_shares(s["models"], out_dir / "loss_shares.png")
+    tied = len(s["supported_models"]["models"]) if s["supported_models"] else 1
+    label = model_title(best) + (f" (the lowest AIC of {tied} models that tie)" if tied > 1 else "")
+    plots.plot_energy_fit(ident.t, ident.e_measured, ident.sigma, ident.e_sim, label, out_dir / "energy_fit.png")
+    plots.plot_loss_shares(s["models"], out_dir / "loss_shares.png", supported_daic=SUPPORTED_DAIC)
     if s["profile_likelihood"]:
         labels = {p.name: f"{p.name}: {p.description} [{p.unit}]" for p in parameters_of(best)}
         plots.plot_profiles(s["profile_likelihood"], labels, out_dir / "profiles.png")

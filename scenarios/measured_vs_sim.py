@@ -120,8 +120,6 @@ QUICK_GEOMETRY_FIT_FRAMES = 15
 PREDICTION_S = 20.0
 """Length [s] of each prediction, to the end of the track (quick: :data:`QUICK_PREDICTION_S`)."""
 QUICK_PREDICTION_S = 3.0
-COORDINATES_S = 10.0
-"""Seconds after t0 shown in ``coordinates.png`` (the whole prediction would crowd the swings)."""
 WINDOW_SENSITIVITY = (15, 30, 60)
 """Other fit windows [frames] tried for the start and geometry (``thorough`` only: three more fits, about 35 s
 of CPU; in the last run they moved the geometry by less than 1.5 mm and 1.2 deg and gave 5 cm horizons of
@@ -148,24 +146,27 @@ def _plots(
     predictions: list[Prediction],
     spread: tuple[np.ndarray, np.ndarray],
 ) -> None:
-    """``coordinates.png`` (track and runs in the track's coordinates, the first :data:`COORDINATES_S`) and
-    ``prediction_error.png``."""
-    shown = min(n_frames, round(COORDINATES_S / FRAME_INTERVAL) + 1)
-    t, measured = measured_coordinates(rec, i0, shown)
+    """``coordinates.png`` (track and four runs in the track's coordinates over the whole comparison) and
+    ``prediction_error.png`` (every run), a run in the same colour in both."""
+    t, measured = measured_coordinates(rec, i0, n_frames)
+    colours = plots.run_colours([run_title(p.label) for p in predictions])
     runs = {}
     for p in predictions:
         if p.label in ("lsq_fixed_geometry_identified", "lsq_pivot_shift_identified"):
             continue  # in the error plot only: the coordinates would crowd
         ts, coords = simulated_coordinates(rec, p)
-        runs[run_title(p.label)] = (ts[:shown], {k: v[:shown] for k, v in coords.items()})
+        runs[run_title(p.label)] = (ts, coords)
+    span = (n_frames - 1) * FRAME_INTERVAL
     starts = {"start time t0 of the predictions": float(rec.t[i0])}
-    plots.plot_track_comparison(t, measured, runs, out_dir / "coordinates.png", starts=starts)
+    plots.plot_track_comparison(t, measured, runs, out_dir / "coordinates.png", starts=starts, colours=colours,
+                                title=f"bob coordinates: measured track and FMU predictions from t0, the whole "
+                                      f"{span:.2f} s compared")  # fmt: skip
+    curves = error_curves(predictions, spread)
     plots.plot_prediction_errors(
-        error_curves(predictions, spread),
-        list(THRESHOLDS_M),
-        out_dir / "prediction_error.png",
-        floor=rod_length_floor(rec, i0, n_frames),
-        title=f"distance between the simulated and the measured bob position (smoothed: moving median over "
+        curves.smoothed, list(THRESHOLDS_M), out_dir / "prediction_error.png", per_frame=curves.per_frame,
+        spread=curves.spread, floor=rod_length_floor(rec, i0, n_frames), colours=colours,
+        dashed=[run_title("lsq_pivot_shift_identified")],  # close to the main run: dashed to tell them apart
+        title=f"distance between the simulated and the measured lower bob (smoothed: moving median over "
               f"{SMOOTHING_S:g} s)",
     )
 

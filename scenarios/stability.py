@@ -40,7 +40,7 @@ from double_pendulum.analysis.solvers.stability_cases import (
     summary_rows,
     worst_passing,
 )
-from double_pendulum.analysis.sweep import runner_map
+from double_pendulum.analysis.sweep import runner_map, where_runs
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.results_io import write_json, write_results_csv, write_table_csv, write_text
 
@@ -52,7 +52,7 @@ DESCRIPTION = "stiff and extreme cases through the FMU with pass criteria (table
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
     """Run every case; write the table, the report, and plots/CSVs of the worst passing cases."""
     table = cases()
-    step(f"{len(table)} cases through fmpy on parallel processes")
+    step(f"{len(table)} cases through fmpy {where_runs(len(table), 1 if quick else None)}")
     outcomes = runner_map(run_case_item, [(case, quick) for case in table], runner, max_workers=1 if quick else None,
                           costs=[case_cost(case, quick) for case in table], label="stability cases", unit="case")
     rows, results = [], {}

@@ -39,6 +39,7 @@ from typing import Any
 from double_pendulum.scenarios.energy_decay import SEED_FIT
 
 from double_pendulum import plots
+from double_pendulum.analysis.decay.error_budget import error_budget
 from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.suspension import transfer as study
 from double_pendulum.analysis.suspension.decay_map import (
@@ -54,6 +55,7 @@ from double_pendulum.analysis.suspension.identification import (
     FIT_SETTINGS,
     LOSSES,
     identify_suspension,
+    measured_decay,
     pendulum_values,
     point_summary,
     simulate_frames_from,
@@ -143,8 +145,9 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     if resonant is not None:
         values = {**base, **suspension_values(resonant[0], resonant[1], plan.m_s_main)}
         tasks += [("frames", values, ctx), ("flow", values, ctx)]
-    step(f"{len(plan.valley_k_factors)} refits along the valley, {len(plan.window_checks_s)} window checks, "
-         "the Fisher matrix and the energy-flow runs")
+    extra = [f"{n} {what}" for n, what in ((len(plan.valley_k_factors), "refits along the valley"),
+                                           (len(plan.window_checks_s), "window checks")) if n]  # fmt: skip
+    step(", ".join([*extra, "the Fisher matrix and the energy-flow runs"]))
     done = runner_map(checks, tasks, runner, max_workers=plan.max_workers, costs=[TASK_COST[t[0]] for t in tasks],
                       label="suspension checks", unit="task")
     n_trace, n_window = len(plan.valley_k_factors), len(plan.window_checks_s)
@@ -161,6 +164,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         runs["resonant"], flows["resonant"] = resonant_runs
         points["resonant end of the curve"] = resonant
     step("summary, tables, plots and the report")
+    # energy_decay's total error of the whole record's b (the quick run fits only its first seconds: the same error)
+    total_b_err = error_budget(rec, measured_decay(rec).frames.sigma)["total_b_per_s"]
 
     summary: dict[str, Any] = {
         "scenario": "suspension_transfer",
@@ -169,11 +174,11 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         "energy_fitted": "E_pendulum (the bobs' energy, what the camera measures)",
         "settings": {"map": MAP_SETTINGS, "map_without_suspension": BASE_SETTINGS, "fits": FIT_SETTINGS,
                      "losses": LOSSES},
-        "measured": study.measured_summary(md, SEED_B),
+        "measured": study.measured_summary(md, SEED_B, total_b_err),
         "start_state": model.start.as_dict(),
         "identified": {**point_summary(md, ident, ident.chi2), "fixed": {"k": ident.k, "M_s": ident.m_s},
                        "conditional_on": CONDITIONAL_ON},
-        "refit": {label: study.run_summary(md, r, ident.chi2) for label, r in runs.items()},
+        "refit": {label: study.run_summary(md, r, ident.chi2, total_b_err) for label, r in runs.items()},
         "valley": {
             "fisher": fisher,
             "trace": [point_summary(md, f, ident.chi2) for f in trace],

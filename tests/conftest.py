@@ -34,6 +34,16 @@ def fmu3_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return build_fmu3(tmp_path_factory.mktemp("fmu3") / "DoublePendulum.fmu")
 
 
+@pytest.fixture(scope="session", autouse=True)
+def close_kept_runners() -> Iterator[None]:
+    """At the end of each test process, close the FMU runners the sweeps keep per process (each holds an extracted
+    FMU), as ``double-pendulum run`` does when it ends (``analysis.sweep.close_runners``)."""
+    yield
+    from double_pendulum.analysis.sweep import close_runners
+
+    close_runners()
+
+
 @pytest.fixture(scope="session")
 def runner(fmu_path: Path):
     """An fmpy runner for the session's FMU."""
@@ -96,6 +106,38 @@ def quick_scenario(results: Path, name: str) -> tuple[Path, dict]:
     return folder, json.loads((folder / "summary.json").read_text())
 
 
+# --- $TMPDIR: the suite leaves it as it found it -------------------------------------------------------------
+#
+# The controlling process gives the whole session (its workers inherit the environment) a $TMPDIR of its own, a
+# folder in the user's: whatever a test or the code under test leaves in a temporary folder lands there. At the
+# end the session fails if anything is left in it, naming it, and removes the folder, so the user's $TMPDIR holds
+# nothing new either way. pytest's own tmp_path folders stay where pytest keeps them (PYTEST_DEBUG_TEMPROOT: the
+# user's $TMPDIR, pytest-of-USER, which pytest rotates), so a failed test's files can still be looked at.
+_SESSION_TMP: dict[str, object] = {}
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    if hasattr(config, "workerinput"):  # an xdist worker: the controller set $TMPDIR up
+        return
+    outer = tempfile.gettempdir()
+    folder = Path(tempfile.mkdtemp(prefix="double-pendulum-tests-", dir=outer))
+    _SESSION_TMP.update(folder=folder, saved=os.environ.get("TMPDIR"), saved_root=os.environ.get(TEMPROOT))
+    os.environ.setdefault(TEMPROOT, outer)
+    os.environ["TMPDIR"], tempfile.tempdir = str(folder), None
+
+
+TEMPROOT = "PYTEST_DEBUG_TEMPROOT"
+"""Where pytest puts its tmp_path folders (its own setting): the user's $TMPDIR, not the session's."""
+
+
+def session_leftovers(folder: Path) -> list[str]:
+    """What a session left in its $TMPDIR ``folder``: every entry, with the size of the folders among them."""
+    def size(path: Path) -> int:
+        return sum(p.stat().st_size for p in path.rglob("*") if p.is_file()) if path.is_dir() else path.stat().st_size
+
+    return sorted(f"{p.name} ({size(p) / 1e6:.1f} MB)" for p in folder.iterdir())
+
+
 # pythonfmu (<= 0.7.0, upstream issue NTNU-IHB/PythonFMU#228) can corrupt the heap while the
 # process tears down after its FMUs were used, aborting *after* every test has finished and
 # turning a green run into exit code 134. Leave the finished session without the teardown.
@@ -103,6 +145,22 @@ _exit_status: list[int] = []
 
 
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    folder = _SESSION_TMP.get("folder")
+    if isinstance(folder, Path) and not hasattr(session.config, "workerinput"):
+        left = session_leftovers(folder) if folder.is_dir() else []
+        shutil.rmtree(folder, ignore_errors=True)
+        for name, saved in (("TMPDIR", _SESSION_TMP["saved"]), (TEMPROOT, _SESSION_TMP["saved_root"])):
+            if saved is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = str(saved)
+        tempfile.tempdir = None
+        if left:
+            reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+            message = f"the test session left {len(left)} entries in its $TMPDIR (removed now): {', '.join(left)}"
+            if reporter is not None:
+                reporter.write_line(f"FAILED: {message}", red=True)
+            exitstatus = session.exitstatus = pytest.ExitCode.TESTS_FAILED
     _exit_status.append(int(exitstatus))
 
 

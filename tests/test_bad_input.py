@@ -148,9 +148,11 @@ def test_with_logging_off_the_message_still_reaches_the_hosts_logger(fmu_path, t
     prints them); the FMU does not repeat them on stderr."""
     script = textwrap.dedent(f"""
         import os
-        from fmpy import simulate_fmu
+        from fmpy import extract, simulate_fmu
+        # extracted here: fmpy removes its own extraction only when the run returns, not when it raises
+        unzipped = extract({str(fmu_path)!r}, unzipdir={str(tmp_path / "fmu")!r})
         try:
-            simulate_fmu({str(fmu_path)!r}, stop_time=1.0, start_values={{"l2": -0.2}})
+            simulate_fmu(unzipped, stop_time=1.0, start_values={{"l2": -0.2}})
         except Exception as error:
             print("raised", type(error).__name__, flush=True)
         os._exit(0)

@@ -108,6 +108,23 @@ def test_unusable_output_folder_is_one_clear_line(tmp_path, capsys, kind):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "cannot write results to" in err and "Traceback" not in err
     assert "--out" in err  # how to write elsewhere
+    if kind == "file":
+        assert "it is a file, not a folder" in err and "File exists" not in err
+
+
+def test_an_empty_output_name_is_refused_not_taken_for_the_current_folder(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "free_swing", "--out", ""]) == 2
+    assert "--out needs a folder name" in capsys.readouterr().err
+    assert list(tmp_path.iterdir()) == []  # nothing written here
+
+
+def test_an_unknown_option_shows_the_usage_of_its_command(capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["run", "free_swing", "--frobnicate"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("usage: double-pendulum run ") and "unrecognized arguments: --frobnicate" in err
 
 
 def test_corrupt_fmu_is_one_clear_line(tmp_path, capsys, monkeypatch):

@@ -113,7 +113,8 @@ def test_engines_step_like_run_coupled_with_the_same_macro_step(fmus, tmp_path):
     pv, sv = split_values(values)
     expected = {}
     for scheme, initial in (("jacobi", 2), ("jacobi_sequential", 0)):
-        slaves = [FmuSlave(extract(str(f)), read_model_description(str(f)), v) for f, v in zip(fmus, (pv, sv))]
+        slaves = [FmuSlave(extract(str(f), unzipdir=str(tmp_path / scheme / f.stem)), read_model_description(str(f)), v)
+                  for f, v in zip(fmus, (pv, sv))]  # extracted under tmp_path, not left in $TMPDIR
         try:
             expected[scheme] = run_coupled(*slaves, stop_time=stop, macro_step=h, scheme=scheme,
                                            initial_exchanges=initial)

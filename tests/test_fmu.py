@@ -211,12 +211,14 @@ def test_bad_parameters_give_an_error_status_naming_the_variable(runner, start, 
     assert runner.simulate({}, stop_time=0.1)["time"][-1] == pytest.approx(0.1)
 
 
-def test_bad_parameters_raise_in_plain_fmpy_too(fmu_path):
-    from fmpy import simulate_fmu
+def test_bad_parameters_raise_in_plain_fmpy_too(fmu_path, tmp_path):
+    from fmpy import extract, simulate_fmu
     from fmpy.fmi1 import FMICallException
 
+    # extracted here: fmpy removes the folder it extracts into only when the run returns, not when it raises
+    unzipped = extract(str(fmu_path), unzipdir=str(tmp_path / "fmu"))
     with pytest.raises(FMICallException):
-        simulate_fmu(str(fmu_path), stop_time=1.0, start_values={"l1": -1.0})
+        simulate_fmu(unzipped, stop_time=1.0, start_values={"l1": -1.0})
 
 
 def test_numerical_blow_up_is_reported_not_returned(runner):

@@ -57,7 +57,7 @@ def synthetic_problem() -> fitting.FitProblem:
 @pytest.fixture(scope="module")
 def synthetic_fit(synthetic_problem) -> tuple[fitting.ModelFit, float]:
     fit = fitting.fit_loss_model("air+drag", synthetic_problem)
-    return fit, comparison.common_factor([fit])
+    return fit, comparison.common_factor(synthetic_problem)
 
 
 def test_identification_recovers_the_true_losses_within_its_stated_uncertainty(synthetic_fit):
@@ -124,7 +124,7 @@ def test_a_nested_model_warm_started_from_its_parent_ends_no_worse(synthetic_pro
     Gauss-Newton only accepts steps that lower chi2, so the larger model cannot end above its parent
     (it would then count as not converged and drop out of the comparison)."""
     parent, _ = synthetic_fit
-    (start,) = fitting.fit_item_of("air+drag+bearing", [parent]).starts
+    ((start,),) = [item.starts for item in fitting.fit_items_of("air+drag+bearing", [parent])]
     assert start[:2] == pytest.approx(tuple(parent.theta))
     assert start[2] == pytest.approx(fitting.WARM_START_FRACTION * mechanisms.MECHANISMS["bearing"].parameters[0].ref)
     fit = fitting.fit_loss_model("air+drag+bearing", synthetic_problem, start=start, max_nfev=8)
@@ -146,7 +146,8 @@ def test_models_within_two_aic_are_reported_with_weights_and_the_range_of_the_ai
     out = loss_claims.supported_models(rows)
     assert list(out["models"]) == ["air+drag", "air+viscous"]  # the top model too: no winner
     assert out["air_share_range"] == [0.1, 0.4]
-    assert "air+viscous (delta AIC 1.20, weight 0.30: air drag 10%, viscous joint damping 90%)" in out["text"]
+    assert ("air drag + viscous joint damping (delta AIC 1.20, weight 0.30: air drag 10%, viscous joint damping 90%)"
+            in out["text"])
     assert "from 10% to 40%" in out["text"]
     assert loss_claims.b_sim_range(rows) == [-0.0256, -0.0252]  # air alone reproduces b as well
     assert loss_claims.supported_models([{**rows[2], "delta_aic": 0.0}])["air_share_range"] == [1.0, 1.0]
@@ -154,9 +155,9 @@ def test_models_within_two_aic_are_reported_with_weights_and_the_range_of_the_ai
 
 def test_the_suspension_joins_a_fitted_model_at_each_damping_of_its_scan():
     parent = fitting.ModelFit("air", np.array([2.5]), 1.0, 100, np.zeros((100, 1)), np.zeros(100), 1.0, 1)
-    starts = fitting.fit_item_of("air+suspension", [parent]).starts
-    assert starts == tuple((2.5, c) for c in mechanisms.MECHANISMS["suspension"].parameters[0].warm_scan)
-    assert fitting.fit_item_of("air", [parent]).starts == ()
+    (item,) = fitting.fit_items_of("air+suspension", [parent])
+    assert item.starts == tuple((2.5, c) for c in mechanisms.MECHANISMS["suspension"].parameters[0].warm_scan)
+    assert fitting.fit_items_of("air", [parent]) == [fitting.FitItem("air")]
 
 
 def test_drag_per_joint_nests_the_common_drag_torque_and_starts_at_its_optimum():
@@ -169,12 +170,35 @@ def test_drag_per_joint_nests_the_common_drag_torque_and_starts_at_its_optimum()
     parent = fitting.ModelFit("air+drag", np.array([2.2, 1.1e-3]), 600.0, 100, np.zeros((100, 2)), np.zeros(100),
                               1.0, 1)
     air = fitting.ModelFit("air", np.array([6.0]), 640.0, 100, np.zeros((100, 1)), np.zeros(100), 1.0, 1)
-    item = fitting.fit_item_of("air+drag2", [air, parent])
+    (item,) = fitting.fit_items_of("air+drag2", [air, parent])  # air is nested in air+drag: no start of its own
     assert item.starts == ((2.2, 1.1e-3, 1.1e-3),) and item.max_nfev == fitting.SHORT_RUN_BUDGET
-    assert fitting.fit_item_of("air+drag2", [air, parent], short=False).max_nfev == 30
-    assert fitting.fit_item_of("air+bearing", [air, parent]).max_nfev == 30  # a rival, not a generalisation
+    assert fitting.fit_items_of("air+drag2", [air, parent], short=False)[0].max_nfev == 30
+    assert fitting.fit_items_of("air+bearing", [air, parent])[0].max_nfev == 30  # a rival, not a generalisation
     worse = fitting.ModelFit("air+drag2", np.ones(3), 601.0, 100, np.zeros((100, 3)), np.zeros(100), 1.0, 1)
     assert not comparison.converged(worse, [parent, worse])
+
+
+def test_a_pair_of_losses_starts_from_each_loss_alone_and_keeps_the_fit_that_ends_lowest(monkeypatch):
+    """air+viscous nests air drag alone and viscous damping alone: one start from each optimum (the better parent
+    first), and :func:`fitting.fit_models` keeps whichever ends lower, not the one from the better parent."""
+    def fake(model: str, theta: list[float], chi2: float) -> fitting.ModelFit:
+        return fitting.ModelFit(model, np.array(theta), chi2, 100, np.zeros((100, len(theta))), np.zeros(100), 1.0, 1)
+
+    air, viscous = fake("air", [6.0], 640.0), fake("viscous", [1.7e-4], 610.6)
+    items = fitting.fit_items_of("air+viscous", [air, viscous])
+    w = fitting.WARM_START_FRACTION
+    assert [i.starts for i in items] == [((w * 1.5, 1.7e-4),), ((6.0, w * 1e-4),)]
+
+    def fake_fit_item(item: fitting.FitItem, problem: object) -> fitting.ModelFit:
+        if item.model != "air+viscous":
+            return {"air": air, "viscous": viscous}[item.model]
+        from_air = item.starts[0][0] == 6.0
+        return fake(item.model, list(item.starts[0]), 610.4 if from_air else 610.6)  # the worse parent ends lower
+
+    monkeypatch.setattr(fitting, "fit_item", fake_fit_item)
+    fits, _ = fitting.fit_models(("air", "viscous", "air+viscous"), object(), max_workers=1)
+    assert [f.model for f in fits] == ["air", "viscous", "air+viscous"]
+    assert fits[-1].chi2 == 610.4 and fits[-1].theta[0] == 6.0
 
 
 def test_the_default_models_leave_the_three_mechanism_ones_and_air_drag2_to_the_thorough_run():
@@ -226,13 +250,89 @@ def test_identified_fit_fits_a_model_as_the_identification_of_its_mode_does(monk
     problem = object()  # never simulated: the fake fits only record their items
     # the identification's rounds (identify_losses: short=True, the mode's run budget)
     fitting.fit_models(models, problem, max_workers=1, max_runs=fitting.run_budget(quick))
-    identification = {i.model: i for i in items}
+    identification = [i for i in items if i.model == "air+drag"]
     items.clear()
     fit = fitting.identified_fit("air+drag", problem, quick=quick)
     assert fit.model == "air+drag"
     assert {i.model for i in items} == ({"air+drag"} if quick else {"air", "drag", "air+drag"})
-    assert items[-1] == identification["air+drag"]
-    assert bool(items[-1].starts) != quick  # default: warm-started from a one-mechanism fit; quick: references
-    assert items[-1].max_nfev == (mechanisms.QUICK_RUN_BUDGET if quick else 30)  # quick: one Gauss-Newton step
+    mine = [i for i in items if i.model == "air+drag"]
+    assert mine == identification and len(mine) == (1 if quick else 2)  # default: from air alone and drag alone
+    assert all(bool(i.starts) != quick for i in mine)  # default: warm-started from a one-mechanism fit
+    assert all(i.max_nfev == (mechanisms.QUICK_RUN_BUDGET if quick else 30) for i in mine)  # quick: one step
     with pytest.raises(ValueError):
         fitting.identified_fit("air+drag+bearing", problem)
+
+
+def _fake_fit(model: str, chi2: float, theta: list[float] | None = None) -> fitting.ModelFit:
+    n = len(mechanisms.parameters_of(model))
+    jac = np.eye(100)[:, :n] + 0.01  # a well-conditioned Jacobian: finite errors
+    return fitting.ModelFit(model, np.ones(n) if theta is None else np.array(theta), chi2, 100, jac, np.zeros(100),
+                            1.0, 1)
+
+
+def test_a_supported_model_without_air_drag_sets_the_lower_end_of_the_air_share_to_zero():
+    rows = [
+        {"model": "viscous", "delta_aic": 0.0, "akaike_weight": 0.5, "converged": True,
+         "shares": {"viscous joint damping": 1.0}},
+        {"model": "air+drag", "delta_aic": 0.7, "akaike_weight": 0.4, "converged": True,
+         "shares": {"air drag": 0.37, "bearing drag torque": 0.63}},
+        {"model": "air+viscous", "delta_aic": 1.9, "akaike_weight": 0.1, "converged": True, "reduces_to": "viscous",
+         "shares": {"air drag": 0.0, "viscous joint damping": 1.0}},
+    ]
+    out = loss_claims.supported_models(rows)
+    assert out["air_share_range"] == [0.0, 0.37]
+    assert list(out["models"]) == ["viscous", "air+drag"] and out["reduced"] == {"air+viscous": "viscous"}
+    assert "viscous joint damping alone (delta AIC 0.00" in out["text"] and "no candidate of its own" in out["text"]
+
+
+def test_a_model_that_fits_no_better_than_one_nested_in_it_reduces_to_that_model():
+    fits = [_fake_fit("viscous", 610.60), _fake_fit("air", 641.0), _fake_fit("air+viscous", 610.61),
+            _fake_fit("air+drag", 608.9), _fake_fit("drag", 619.0)]
+    rows = {r["model"]: r for r in comparison.comparison_rows(fits, 1.28)}
+    assert rows["air+viscous"]["reduces_to"] == "viscous"
+    assert rows["air+drag"]["reduces_to"] is None  # it gains 10 in chi2 over drag alone
+    assert rows["air+drag"]["model_in_words"] == "air drag + bearing drag torque"
+
+
+def test_the_suspension_at_its_nested_limit_is_reported_as_a_bound_not_a_fit():
+    fits = [_fake_fit("air", 641.06), _fake_fit("air+drag", 608.9), _fake_fit("drag", 619.0),
+            _fake_fit("air+suspension", 833.6, [0.29, 112.0])]
+    factor = 1.28
+    rows = {r["model"]: r for r in comparison.comparison_rows(fits, factor)}
+    susp = rows["air+suspension"]
+    assert not susp["converged"] and susp["best_is_limit_model"] == "air"
+    # at best it fits as the rigid pivot (air alone) plus one fitted number: 2 more in AIC
+    assert susp["delta_aic_at_best"] == pytest.approx(rows["air"]["delta_aic"] + 2.0)
+    assert susp["delta_aic_at_best"] < susp["delta_aic"]  # where the fit stopped is no bound
+    assert all(p["stderr"] is None for p in susp["parameters"].values())  # no errors at a point that is no optimum
+    bound = loss_claims.suspension_bound(list(rows.values()))
+    assert bound["delta_aic_at_best"] == susp["delta_aic_at_best"] and bound["stopped_at"]["c_suspension"] == 112.0
+    assert comparison.limit_model("air+drag") is None and comparison.limit_model("air+drag+suspension") == "air+drag"
+
+
+def test_a_larger_correlation_factor_lets_models_with_fewer_numbers_join_the_tie():
+    rows = [{"model": m, "chi2": chi2, "k": k, "converged": True}
+            for m, chi2, k in (("air+drag", 608.9, 3), ("drag", 619.0, 2), ("air", 641.1, 2))]
+    joins = loss_claims.supported_from_factor(rows, 1.28)
+    assert set(joins) == {"drag", "air"}  # air+drag is in the tie at F = 1.28
+    # drag alone: (619.0 - 608.9) / F - 2 < 2 from F = 10.1 / 4 on
+    assert joins["drag"] == pytest.approx(10.1 / 4.0, rel=0.01) and joins["air"] is None  # air needs F > 8
+
+
+def test_two_parameters_that_trade_off_are_not_identified_each():
+    fit = _fake_fit("air+drag", 608.9, [2.2, 1.1e-3])
+    jac = np.column_stack([np.linspace(0, 1, 100), np.linspace(0, 1, 100) + 1e-3 * np.sin(np.arange(100))])
+    fit = dataclasses.replace(fit, jac=jac)
+    ident = comparison.identifiability(fit, 1.0)
+    assert ident["strongly_correlated"]["air_factor"] == ["tau_b"]
+    assert ident["identified"] == {"air_factor": False, "tau_b": False}
+
+
+def test_a_wider_friction_regularisation_moves_the_motion_more(synthetic_problem, synthetic_fit):
+    fit, _ = synthetic_fit
+    effect = comparison.regularisation_effect(synthetic_problem, "air+drag", fit.theta)
+    rows = effect["by_omega_reg_rad_per_s"]
+    widths = [f"{w:g}" for w in sorted(comparison.REGULARISATION_WIDTHS)]  # 1e-3, 1e-2, 1e-1 rad/s
+    angles = [rows[w]["max_angle_difference_rad"] for w in widths]
+    assert angles == sorted(angles) and angles[0] < 1e-5 < angles[-1]
+    assert all(rows[w]["joint_work_relative_change"] < 0 for w in widths)  # a soft sign function loses less

@@ -145,8 +145,8 @@ def test_chaos_horizons_and_error_curves():
     }
     runs = [_prediction([0.0], [0.0], "a"), _prediction([0.0], [0.0], "b")]
     curves = tc.error_curves(runs, spread)
-    assert list(curves)[:3] == ["a: lower bob, smoothed", "b: lower bob, per frame", "b: lower bob, smoothed"]
-    assert curves[list(curves)[-1]] is spread
+    assert list(curves.smoothed) == ["a", "b"] and curves.per_frame[0] == "b"  # the main run: the last
+    assert curves.spread is spread
     assert tc.errors_units(runs)["e2_b"] == "m"
 
 
@@ -205,7 +205,7 @@ def test_cause_is_model_error_when_the_fit_allows_more_than_twice_the_observed_h
     assert "model error" in cause_text(_cause_summary(0.4, None))  # the ensemble: beyond the 2 s prediction
     assert "start's uncertainty limits it" in cause_text(_cause_summary(0.6, 1.0))
     assert "whole 2.0 s prediction" in cause_text(_cause_summary(None, None))
-    assert fmt_horizon(None, 2.0) == "> 2.0" and fmt_horizon(0.123, 2.0) == "0.12"
+    assert fmt_horizon(None, 2.0) == "none in 2.00" and fmt_horizon(0.123, 2.0) == "0.12"  # censored: no "> 2"
 
 
 def test_quick_run_compares_both_starts_with_the_track(quick_results):

@@ -55,3 +55,24 @@ def test_the_heavy_scenarios_have_a_thorough_setting(name):
     import importlib
 
     assert cli.accepts_thorough(importlib.import_module(f"double_pendulum.scenarios.{name}"))
+
+
+def test_a_loop_cut_short_by_ctrl_c_says_interrupted_not_done(capsys, monkeypatch):
+    monkeypatch.setattr(progress, "QUIET_SECONDS", 0.0)
+    monkeypatch.delenv(progress.ENV, raising=False)
+    with pytest.raises(KeyboardInterrupt), progress.progress_bar(56, "11 scenarios", unit="CPU s") as bar:
+        bar.update(40)
+        raise KeyboardInterrupt
+    last = capsys.readouterr().err.splitlines()[-1]
+    assert last.startswith("11 scenarios: interrupted at 40/56 after") and "done" not in last
+
+
+def test_a_bar_cut_short_says_so_in_its_description(monkeypatch):
+    monkeypatch.setenv(progress.ENV, "bar")
+    with pytest.raises(KeyboardInterrupt), progress.progress_bar(56, "run", unit="CPU s") as bar:
+        bar.update(40)
+        raise KeyboardInterrupt
+    assert bar.desc == "run: interrupted at 40/56"
+    with progress.progress_bar(3, "fine") as ok:
+        ok.update(3)
+    assert ok.desc == "fine" and ok.n == 3

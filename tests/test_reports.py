@@ -22,7 +22,7 @@ import pytest
 from double_pendulum.scenarios import SCENARIOS
 from fmpy.util import read_csv
 
-from double_pendulum.results_io import read_results_csv, read_table_csv
+from double_pendulum.results_io import IN_SHORT, WORDS_USED, read_results_csv, read_table_csv
 
 TABLES = {"stability.csv", "work_precision.csv", "acheson_bands.csv", "acheson_map.csv", "kapitza_bisection.csv",
           "resonance_peaks.csv", "resonance_curve.csv", "runs.csv", "stability_map.csv"}
@@ -31,6 +31,12 @@ REPORTS = {"energy_decay", "loss_identification", "measured_vs_sim", "stability"
            "work_precision",
            "cosimulation", "base_excitation"}
 """The scenarios that write a report.md."""
+
+JARGON = ("AIC", "BIC", "Akaike weight", "chi2", "chi2_red", "VIF", "Floquet", "monodromy", "spectral radius",
+          "Lyapunov", "Benettin", "Savitzky-Golay", "Gauss-Newton", "Levenberg-Marquardt", "Mathieu", "Jacobian",
+          "Fisher", "rtol", "censored", "in-sample")
+"""Terms a student may not know: a report that uses one explains it under "Words used below", before its first use."""
+SENTENCE_END = re.compile(r"(?<=[.!?])\s+(?=[A-Z0-9])")
 
 MISSING_WORDS = re.compile(r"\b(nan|NaN|None|null)\b")
 EMPTY_CELL = re.compile(r"\|\s*\|")
@@ -149,3 +155,32 @@ def test_record_tables_read_with_the_table_reader_and_pandas(quick_out):
     for path in sorted([*(quick_out / "base_excitation").glob("*.csv"), *(quick_out / "cosimulation").glob("*.csv")]):
         if path.name in TABLES:
             assert len(read_table_csv(path)) == len(pandas.read_csv(path)) > 0, path
+
+
+def _term(term: str) -> re.Pattern:
+    """``term`` as a word of its own (``AIC`` not in ``dAIC``, ``chi2`` not in ``chi2_red``)."""
+    return re.compile(rf"(?<![\w-]){re.escape(term)}(?![\w])")
+
+
+@pytest.mark.parametrize("scenario", sorted(REPORTS))
+def test_report_opens_with_a_plain_summary_and_explains_its_terms_before_using_them(quick_out, scenario):
+    text = (quick_out / scenario / "report.md").read_text()
+    lines = text.splitlines()
+    assert lines[0].startswith("# ") and lines[2] == IN_SHORT, lines[:3]
+    short = text.split(IN_SHORT, 1)[1].split("\n## ", 1)[0].strip()
+    assert 3 <= len(SENTENCE_END.split(short)) <= 5, short
+    words_at = text.find(WORDS_USED)
+    defined = re.findall(r"^- \*\*(.+?)\*\*:", text[words_at:].split("\n---", 1)[0], re.M) if words_at >= 0 else []
+    for term in JARGON:
+        first = _term(term).search(text)
+        if first is None:
+            continue
+        assert any(_term(term).search(d) for d in defined), f"{term!r} is used but not explained"
+        assert first.start() > words_at, f"{term!r} is used before it is explained"
+
+
+def test_the_plain_summary_check_catches_an_unexplained_term():
+    text = "# T\n\n" + IN_SHORT + "\n\nOne. Two. Three uses AIC.\n"
+    assert _term("AIC").search(text) and not _term("AIC").search("a dAIC of 2")
+    assert text.find(WORDS_USED) == -1  # so the test above fails on it: AIC used, nothing explained
+    assert len(SENTENCE_END.split("b = -0.0252 1/s is known. To 8 %. Fine.")) == 3  # decimals end no sentence

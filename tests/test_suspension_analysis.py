@@ -137,15 +137,16 @@ def test_run_summary_recovers_the_rate_and_the_exponential_shape_of_a_run():
     assert md.b == pytest.approx(-0.025, rel=1e-9)
     simulated = 0.8 * np.exp(-0.02 * t)
     run = _structured({"E_pendulum": simulated, "E_total": simulated + 1e-4})
-    s = study.run_summary(md, run, reference_chi2=10.0)
+    s = study.run_summary(md, run, reference_chi2=10.0, total_b_err=0.002)
     assert s["b_E_pendulum_per_s"] == pytest.approx(-0.02, rel=1e-6)
     assert s["b_E_total_per_s"] == pytest.approx(-0.02, rel=0.01)
     assert s["relative_difference_to_measured"] == pytest.approx(-0.2, rel=1e-5)
+    assert s["difference_in_total_sigma"] == pytest.approx(0.005 / 0.002, rel=1e-5)  # against the total error
     assert s["p"] == pytest.approx(1.0, abs=1e-3)  # exponential decay: dE/dt = -k E^1
     chi2 = float(np.sum(((simulated - measured) / sigma) ** 2))
     assert s["chi2"] == pytest.approx(chi2, rel=1e-12)
     assert s["delta_chi2"] == pytest.approx(chi2 - 10.0, rel=1e-12)
-    m = study.measured_summary(md, seed_b=-0.024)
+    m = study.measured_summary(md, seed_b=-0.024, total_b_err=0.002)
     assert m["n_frames"] == 300 and m["release_frame"] == 100
     assert m["a_J"] == pytest.approx(0.8, rel=1e-9)
     assert m["b_per_s_stderr_autocorr"] == pytest.approx(2.0 * m["b_per_s_stderr"])  # sqrt(factor 4)
@@ -202,9 +203,10 @@ def test_natural_frequency_marks_and_shown_spectrum():
     ident = type("Ident", (), {"k": 2e4, "c": 30.0, "m_s": 2.0})()
     marks = study.natural_frequency_marks(spectrum, ident)
     assert list(marks.values()) == pytest.approx([100.0, math.sqrt(2e4 / 2.6)])
-    assert "= 100 rad/s" in next(iter(marks))
+    assert "= 100 rad/s" in next(iter(marks)) and all("assumed" in label for label in marks)  # k, M_s: not measured
     omega, spectra = study.shown_force_spectra(spectrum)
-    assert omega[0] >= study.SPECTRUM_SHOWN_FROM and len(omega) == len(spectra["F_x"]) == len(spectra["F_y"])
+    assert omega[0] >= study.SPECTRUM_SHOWN_FROM and [len(s) for s in spectra.values()] == [len(omega)] * 2
+    assert [label.split()[-1] for label in spectra] == ["F_x", "F_y"]
 
 
 def test_decay_maps_sweeps_the_main_grid_then_coarser_ones_per_extra_mass(monkeypatch):

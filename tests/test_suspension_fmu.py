@@ -146,14 +146,14 @@ def test_split_system_converges_to_the_monolith_at_first_order():
     assert errors[-1] < 3e-3
 
 
-def test_the_two_fmus_couple_like_the_in_process_components(fmu_path, suspension_fmu):
+def test_the_two_fmus_couple_like_the_in_process_components(fmu_path, suspension_fmu, tmp_path):
     from fmpy import extract, read_model_description
 
     slaves = []
     dirs = []
     try:
         for path, start in ((fmu_path, START), (suspension_fmu, {})):
-            dirs.append(extract(str(path)))
+            dirs.append(extract(str(path), unzipdir=str(tmp_path / path.stem)))  # under tmp_path, not loose in $TMPDIR
             slaves.append(FmuSlave(dirs[-1], read_model_description(str(path)), start))
         through_fmus = run_jacobi(*slaves, stop_time=0.1, macro_step=1e-3)
     finally:

@@ -49,11 +49,13 @@ def test_sweep_on_local_processes_gives_the_direct_runs_in_case_order(fmu_path, 
     assert [r["phi1"][0] for r in parallel] == [c["phi1_0"] for c in cases]
 
 
-def test_sweep_on_a_local_dask_cluster_gives_identical_results(fmu_path, serial_results):
+def test_sweep_on_a_local_dask_cluster_gives_identical_results(fmu_path, serial_results, tmp_path):
     pytest.importorskip("distributed", reason="dask[distributed] is not installed")
+    import dask
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
+    with dask.config.set({"temporary-directory": str(tmp_path)}), LocalCluster(  # its scratch space, not $TMPDIR
+            n_workers=1, threads_per_worker=1, processes=False, dashboard_address=None) as cluster:
         on_dask = run_sweep(fmu_path, _cases(), scheduler=cluster.scheduler_address, **OPTIONS)
     _assert_same(on_dask, serial_results)
 

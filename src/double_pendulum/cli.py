@@ -79,8 +79,13 @@ def _indices(index: str | None, count: int) -> list[str]:
 
 
 def _writable_folder(path: str) -> Path:
-    """Create ``path`` if needed and check that files can be written there."""
+    """Create ``path`` if needed and check that files can be written there (an empty name or an existing file is
+    refused: Path("") is the current folder, which ``--out ''`` never means)."""
+    if not path.strip():
+        raise CliError("--out needs a folder name (got an empty one); use --out . for the current folder")
     folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise CliError(f"cannot write results to {folder}: it is a file, not a folder (pass --out DIR)")
     try:
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / f".write-test-{time.monotonic_ns()}"
@@ -358,6 +363,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"{PROG} {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    parser.command_parsers = sub.choices  # type: ignore[attr-defined]  # main() reports unknown options by command
 
     p_build = sub.add_parser("build", help="build DoublePendulum.fmu, Suspension.fmu, the coupled system and "
                              "fmi3/DoublePendulum.fmu",
@@ -411,7 +417,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Parse ``argv`` and run the command; return the exit code (errors as one line on stderr)."""
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args, unknown = parser.parse_known_args(argv)
+    if unknown:  # the command's own usage, not the top level's: the options that command takes
+        parser.command_parsers[args.command].error(f"unrecognized arguments: {' '.join(unknown)}")
     try:
         with handling_interrupts():
             return args.func(args)

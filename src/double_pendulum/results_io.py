@@ -14,7 +14,7 @@ import json
 import math
 import os
 import tempfile
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -150,3 +150,21 @@ def read_table_csv(path: str | Path) -> list[dict[str, Any]]:
 
     with open(path, newline="") as fh:
         return [{k: _table_value(v) for k, v in row.items()} for row in csv.DictReader(fh)]
+
+
+# --- reports -------------------------------------------------------------------------------------
+
+IN_SHORT = "## In short"
+"""The heading of the plain summary every report.md opens with (:func:`report_opening`)."""
+WORDS_USED = "## Words used below"
+"""The heading of the list of the terms a report uses, explained (:func:`report_opening`)."""
+
+
+def report_opening(title: str, in_short: Sequence[str], terms: Mapping[str, str] | None = None) -> str:
+    """The start of a scenario's ``report.md``: the title, "In short" (three to five plain sentences a student
+    understands: what was measured, what was found, how sure) and "Words used below" (each technical term of the
+    report with its meaning, before its first use), then a rule before the report's own sections."""
+    lines = [f"# {title}", "", IN_SHORT, "", " ".join(s.strip() for s in in_short), ""]
+    if terms:
+        lines += [WORDS_USED, "", *(f"- **{term}**: {meaning}" for term, meaning in terms.items()), ""]
+    return "\n".join([*lines, "---", "", ""])

@@ -9,6 +9,11 @@ status, which fmpy reports as an ordinary failure that a scenario may catch and 
 SIGINT then only sets :func:`hurried`, so that waits for child processes end at once and nothing of the
 clean-up is cut short.
 
+The interrupt can land in a finaliser or a weakref callback (a ``WeakKeyDictionary``'s, say), where Python cannot
+raise it and prints "Exception ignored in ..." with a traceback instead. While the run handles SIGINT it drops
+those reports of a KeyboardInterrupt (:func:`_quiet_unraisable`): the interrupt is raised again within
+:data:`REPEAT_S` in the main thread, and a traceback is no message for a user who pressed Ctrl-C.
+
 Worker processes never see Ctrl-C (:func:`worker_ignores_sigint`, :func:`sigint_blocked` while they start):
 the process that started them stops them (:func:`double_pendulum.analysis.sweep.stop_workers`).
 """
@@ -17,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from typing import Any
@@ -69,6 +75,18 @@ def acknowledge() -> None:
         signal.signal(signal.SIGINT, _on_later)
 
 
+def _quiet_unraisable(hook: Any) -> Any:
+    """An ``sys.unraisablehook`` that drops a KeyboardInterrupt Python could not raise (in a finaliser or weakref
+    callback) and passes everything else to ``hook``."""
+
+    def unraisable(info: Any) -> None:
+        if isinstance(info.exc_value, KeyboardInterrupt) or info.exc_type is KeyboardInterrupt:
+            return
+        hook(info)
+
+    return unraisable
+
+
 @contextlib.contextmanager
 def handling_interrupts() -> Iterator[None]:
     """Within the block, SIGINT acts as described in the module docstring; the previous handler is restored
@@ -80,11 +98,14 @@ def handling_interrupts() -> Iterator[None]:
         return
     _state.update(installed=True, interrupted=False, acknowledged=False, hurried=False)
     _stop_repeating.clear()
+    previous_hook = sys.unraisablehook
+    sys.unraisablehook = _quiet_unraisable(previous_hook)
     try:
         yield
     finally:
         _stop_repeating.set()
         signal.signal(signal.SIGINT, previous)
+        sys.unraisablehook = previous_hook
         _state.update(installed=False)
 
 

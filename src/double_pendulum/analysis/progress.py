@@ -127,27 +127,60 @@ class LineProgress:
     def set_postfix_str(self, s: str = "", refresh: bool = True) -> None:
         """Accepted for tqdm compatibility; plain lines carry no postfix."""
 
-    def close(self) -> None:
+    def close(self, stopped: str = "") -> None:
+        """Close with a line saying how far the loop got: "done" if it ended, or ``stopped`` ("interrupted") if
+        it was cut short (then always, so that the last line never claims the work done)."""
         if self.closed:
             return
         self.closed = True
         elapsed = time.monotonic() - self.start
-        if self.printed or (elapsed >= QUIET_SECONDS and self.n):
+        if stopped:
+            self._write(f"{stopped} at {self.n}/{self.total} after {_clock(elapsed)}")
+        elif self.printed or (elapsed >= QUIET_SECONDS and self.n):
             self._write(f"{self.n}/{self.total} done in {_clock(elapsed)} ({self._rate(elapsed)})")
 
     def __enter__(self) -> LineProgress:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
+        self.close(stopped_word(exc_type))
+
+
+def stopped_word(exc_type: type[BaseException] | None) -> str:
+    """How a loop that ended with ``exc_type`` ended, for its closing line: "" (it ended), "interrupted" (Ctrl-C)
+    or "stopped" (an error)."""
+    if exc_type is None:
+        return ""
+    return "interrupted" if issubclass(exc_type, KeyboardInterrupt) else "stopped"
 
 
 class _Off(LineProgress):
     def update(self, n: int = 1) -> None:
         self.n += n
 
-    def close(self) -> None:
+    def close(self, stopped: str = "") -> None:
         self.closed = True
+
+
+class _Bar:
+    """A tqdm bar as a context manager that, when the loop is cut short, says so in the bar ("interrupted at 40/56")
+    before closing, instead of leaving it standing as if it were still counting; everything else is tqdm's."""
+
+    def __init__(self, bar: Any) -> None:
+        self._bar = bar
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._bar, name)
+
+    def __enter__(self) -> _Bar:
+        return self
+
+    def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
+        word = stopped_word(exc_type)
+        if word:
+            self._bar.set_description_str(f"{self._bar.desc}: {word} at {self._bar.n}/{self._bar.total}",
+                                          refresh=False)
+        self._bar.close()
 
 
 def progress_bar(total: int, label: str, *, unit: str = "run", enabled: bool | None = None) -> Any:
@@ -161,7 +194,7 @@ def progress_bar(total: int, label: str, *, unit: str = "run", enabled: bool | N
         return _Off(total, label, unit)
     if mode == "lines":
         return LineProgress(total, label, unit)
-    return tqdm(total=total, desc=label, file=sys.stderr, mininterval=0.5, unit=unit, dynamic_ncols=True)
+    return _Bar(tqdm(total=total, desc=label, file=sys.stderr, mininterval=0.5, unit=unit, dynamic_ncols=True))
 
 
 def track(items: Iterable[T], label: str, *, total: int | None = None, unit: str = "run",

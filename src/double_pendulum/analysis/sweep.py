@@ -445,3 +445,10 @@ def random_cases(
             raise ValueError(f"invalid standard deviation for {name}: {sd!r}")
         draws[name] = rng.normal(mean, sd, size=n)
     return [{**(base or {}), **{k: float(v[i]) for k, v in draws.items()}} for i in range(n)]
+
+
+def where_runs(n_items: int, max_workers: int | None = None) -> str:
+    """Where ``n_items`` items of a sweep with ``max_workers`` (None: :func:`default_workers`) run, for a step line:
+    "in this process" or "on N worker processes"."""
+    n = min(n_items, default_workers() if max_workers is None else max_workers)
+    return "in this process" if n <= 1 else f"on {n} worker processes"

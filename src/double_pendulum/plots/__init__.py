@@ -14,7 +14,7 @@ from .chaos import (
 )
 from .decay import plot_circle_fit, plot_energy_decay
 from .losses import plot_energy_fit, plot_loss_shares, plot_profiles
-from .prediction import plot_prediction_errors, plot_track_comparison
+from .prediction import plot_prediction_errors, plot_track_comparison, run_colours
 from .solvers import plot_work_precision
 from .suspension import plot_decay_rate_cuts, plot_decay_rate_map, plot_energy_flow, plot_force_spectrum
 from .trajectories import (
@@ -54,6 +54,7 @@ __all__ = [
     "plot_work_precision",
     "plot_track_comparison",
     "plot_prediction_errors",
+    "run_colours",
     "plot_energy_fit",
     "plot_loss_shares",
     "plot_profiles",

@@ -8,7 +8,7 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .style import save
+from .style import legend_below, plain_log_numbers, save
 
 MARKERS = {"jacobi": "o", "jacobi_sequential": "v", "extrapolation": "s", "iterative": "^", "libcosim": "x",
            "container": "+"}
@@ -20,7 +20,8 @@ def _cases(rows: list[dict[str, Any]]) -> list[tuple[str, str]]:
 
 def plot_against(rows: list[dict[str, Any]], x: str, y: str, path: str | Path, *, xlabel: str, ylabel: str,
                  title: str) -> Path:
-    """One panel per case: ``y`` over ``x`` (log-log) for every method, stable runs only."""
+    """One panel per case: ``y`` over ``x`` (log-log) for every method, stable runs only; every panel labels both
+    axes (their ranges differ), one legend under the panels."""
     cases = _cases(rows)
     ncols = min(2, len(cases))
     nrows = (len(cases) + ncols - 1) // ncols
@@ -35,10 +36,13 @@ def plot_against(rows: list[dict[str, Any]], x: str, y: str, path: str | Path, *
         ax.set_title(f"{case[0]} start, {case[1]} suspension", fontsize=9)
         ax.set_xlabel(xlabel)
         ax.grid(True, which="both", alpha=0.3)
-    for ax in axes[0][::ncols]:
         ax.set_ylabel(ylabel)
-    axes[0][ncols - 1].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))
-    fig.suptitle(title)
+    handles: dict[str, Any] = {}
+    for ax in axes[0]:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            handles.setdefault(label, handle)
+    legend_below(fig, list(handles.values()), list(handles), ncols=len(handles))
+    fig.suptitle(title, fontsize=11)
     return save(fig, path)
 
 
@@ -56,10 +60,13 @@ def plot_stability_map(points: list[dict[str, Any]], curves: dict[str, tuple[np.
         ax.plot(*curve, color="k", label="derived limit (rigid vertical load)")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("macro step x suspension frequency, h omega [1]")
+        ax.set_xlabel("macro step times suspension frequency, h omega [1]")
         ax.set_title(f"{scheme} (zero-order hold)", fontsize=10)
         ax.grid(True, which="both", alpha=0.3)
     axes[0][0].set_ylabel("mass ratio (m1 + m2) / M_s [1]")
-    axes[0][-1].legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+    for ax in axes[0]:
+        plain_log_numbers(ax, "x")
+        plain_log_numbers(ax, "y")
+    legend_below(fig, *axes[0][-1].get_legend_handles_labels(), ncols=3)
     fig.suptitle("Added-mass stability of explicit coupling (damping ratio 0.05)")
     return save(fig, path)

@@ -9,7 +9,7 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .style import save
+from .style import legend_below, save
 
 
 def _deviation(phi: np.ndarray) -> np.ndarray:
@@ -96,6 +96,11 @@ def plot_upright_runs(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
     return save(fig, path)
 
 
+HEADROOM = 6.0
+"""The resonance curve's log axis reaches this factor above the largest amplitude: the band above the data holds the
+mode labels and the theory's crosses, clear of the curves."""
+
+
 def plot_resonance_curve(
     rows: Sequence[Mapping[str, Any]],
     modes: Sequence[float],
@@ -104,25 +109,33 @@ def plot_resonance_curve(
     path: str | Path,
 ) -> Path:
     """Steady-state amplitudes of both angles [rad] against the drive frequency [rad/s], the undamped
-    small-angle normal modes (dashed), the fitted peaks (dotted) and the damped linear response's peaks
-    (crosses at the top)."""
-    fig, ax = plt.subplots(figsize=(10.5, 5))
+    small-angle normal modes (dashed, labelled), the fitted peaks (dotted) and the damped linear response's peaks
+    (crosses), the labels and crosses in a band above the data (:data:`HEADROOM`); the legend under the axes."""
+    fig, ax = plt.subplots(figsize=(10.5, 5.2))
     rows = sorted(rows, key=lambda r: r["omega_rad_per_s"])
     w = np.array([r["omega_rad_per_s"] for r in rows])
+    top = 0.0
     for angle, color, label in (("phi1", "tab:blue", "upper rod phi1"), ("phi2", "tab:orange", "lower rod phi2")):
-        ax.semilogy(w, [r[f"{angle}_amplitude_rad"] for r in rows], "o-", ms=3, color=color, label=label)
+        amplitude = np.array([r[f"{angle}_amplitude_rad"] for r in rows])
+        ax.semilogy(w, amplitude, "o-", ms=3, color=color, label=f"{label}: simulated amplitude")
+        top = max(top, float(np.nanmax(amplitude)))
+    low = ax.get_ylim()[0]
+    ax.set_ylim(low, top * HEADROOM)
     for mode, name in zip(modes, ("slow", "fast")):
         ax.axvline(mode, color="k", ls="--", lw=0.8)
-        ax.annotate(f"{name} normal mode\n{mode:.3f} rad/s", (mode, 1.0), xycoords=("data", "axes fraction"),
-                    xytext=(4, -28), textcoords="offset points", fontsize=8)
+        ax.annotate(f"{name} normal mode {mode:.3f} rad/s", (mode, 0.985), xycoords=("data", "axes fraction"),
+                    xytext=(6, 0), textcoords="offset points", fontsize=8, va="top")
     for p in peaks:
         color = "tab:blue" if p["angle"] == "phi1" else "tab:orange"
         if np.isfinite(p["peak_rad_per_s"]):
             ax.axvline(p["peak_rad_per_s"], color=color, ls=":", lw=0.8)
-        ax.plot(p["damped_linear_peak_rad_per_s"], 0.97, "x", color=color, ms=7, transform=ax.get_xaxis_transform())
+        ax.plot(p["damped_linear_peak_rad_per_s"], 0.84, "x", color=color, ms=7, transform=ax.get_xaxis_transform())
+    ax.plot([], [], "k--", lw=0.8, label="undamped normal mode")
+    ax.plot([], [], ":", color="0.3", lw=0.8, label="fitted peak of the simulated curve (rod's colour)")
+    ax.plot([], [], "x", color="0.3", ms=7, label="peak of the damped linear theory (rod's colour)")
     ax.set_xlabel("drive angular frequency omega [rad/s]")
     ax.set_ylabel("steady-state amplitude [rad]")
-    ax.set_title(f"Resonance curve: pivot torque {torque * 1e3:g} mN m x sin(omega t), viscous pivot bearing"
-                 " (dotted: fitted peaks; x: damped linear theory)", fontsize=10)
-    ax.legend(fontsize=8, loc="upper right")
+    ax.set_title(f"Resonance under a pivot torque {torque * 1e3:g} mN m x sin(omega t), viscous pivot bearing",
+                 fontsize=10)
+    legend_below(fig, *ax.get_legend_handles_labels(), ncols=2, fontsize=8)
     return save(fig, path)

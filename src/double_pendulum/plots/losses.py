@@ -9,49 +9,69 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .style import running_mean, save
+from .style import legend_below, running_mean, save
 
 
 def plot_energy_fit(
     t: np.ndarray, e_measured: np.ndarray, sigma: np.ndarray, e_sim: np.ndarray, model: str, path: str | Path
 ) -> Path:
-    """Measured energy [J] with errors and the best model's simulated energy over time [s]; below, the
-    residual E_measured - E_simulated [mJ] per frame and its running mean over one swing (39 frames)."""
+    """Measured energy [J] with errors and a model's simulated energy over time [s] (``model``: its label in words);
+    below, the residual E_measured - E_simulated [mJ] per frame and its running mean over one swing (39 frames)."""
     fig, (ax, ax_r) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True, height_ratios=(2, 1))
     ax.errorbar(t, e_measured, yerr=sigma, fmt=".", ms=2, lw=0.4, alpha=0.5, color="C0", label="measured (camera)")
-    ax.plot(t, e_sim, color="C3", lw=1.6, label=f"simulated, best model: {model}")
+    ax.plot(t, e_sim, color="C3", lw=1.6, label=f"simulated: {model}")
     ax.set(ylabel="pendulum energy E [J]", title="Energy of the seed's pendulum: measured and simulated (FMU)")
-    ax.legend(loc="upper right", fontsize=9)
     ax.grid(alpha=0.3)
     d = (e_measured - e_sim) * 1e3
-    ax_r.plot(t, d, ".", ms=2, color="C0", alpha=0.5, label="per frame")
-    ax_r.plot(t, running_mean(d, 39), color="k", lw=1.2, label="running mean over one swing (1.3 s)")
+    ax_r.plot(t, d, ".", ms=2, color="C0", alpha=0.5, label="measured - simulated, per frame")
+    ax_r.plot(t, running_mean(d, 39), color="k", lw=1.2, label="its running mean over one swing (1.3 s)")
     ax_r.axhline(0.0, color="C3", lw=0.8)
     ax_r.set(xlabel="time after the start of the track t [s]", ylabel="measured - simulated [mJ]",
-             title="Residuals")  # fmt: skip
-    ax_r.legend(loc="lower right", fontsize=8, ncol=2)
+             title="Residuals: measured minus simulated energy")  # fmt: skip
     ax_r.grid(alpha=0.3)
+    handles, labels = ax.get_legend_handles_labels()
+    more = ax_r.get_legend_handles_labels()
+    legend_below(fig, [*handles, *more[0]], [*labels, *more[1]], ncols=2)
     return save(fig, path)
 
 
-def plot_loss_shares(rows: list[Mapping[str, Any]], path: str | Path) -> Path:
-    """Each model's shares of the dissipated work as stacked horizontal bars (best model on top), with dAIC
-    (and "not ranked" where its fit ended above a model nested in it)."""
-    labels = sorted({name for r in rows for name in r["shares"]})
-    fig, ax = plt.subplots(figsize=(10, 0.55 * len(rows) + 1.8))
+def plot_loss_shares(rows: list[Mapping[str, Any]], path: str | Path, *, supported_daic: float = 2.0) -> Path:
+    """Each model's shares of the dissipated work as stacked horizontal bars, the lowest AIC on top, each model
+    named in words (``model_in_words``) with its dAIC; a dashed line under the models within ``supported_daic`` of
+    the lowest (the record does not rank them). A model whose optimum is its nested limit (``delta_aic_at_best``)
+    has no bar, only what it reaches at best; one that did not converge otherwise is marked "not ranked"."""
+    labels = sorted({name for r in rows if "delta_aic_at_best" not in r for name in r["shares"]})
+    fig, ax = plt.subplots(figsize=(10, 0.55 * len(rows) + 2.0))
     y = np.arange(len(rows))[::-1]
     left = np.zeros(len(rows))
+    bars = [r if "delta_aic_at_best" not in r else {**r, "shares": {}} for r in rows]
     for k, label in enumerate(labels):
-        vals = np.array([r["shares"].get(label, 0.0) for r in rows])
+        vals = np.array([r["shares"].get(label, 0.0) for r in bars])
         ax.barh(y, vals, left=left, color=f"C{k}", label=label)
         for yi, li, v in zip(y, left, vals):
             if v > 0.06:
                 ax.text(li + v / 2, yi, f"{v:.0%}", ha="center", va="center", fontsize=8, color="white")
         left += vals
-    ax.set_yticks(y, [f"{r['model']}  (dAIC {r['delta_aic']:.0f}{'' if r.get('converged', True) else ', not ranked'})"
-                      for r in rows])
+    for yi, r in zip(y, rows):
+        if "delta_aic_at_best" in r:
+            ax.text(0.01, yi, f"no finite fit: at best as good as {r['best_is_limit_model_in_words']}",
+                    ha="left", va="center", fontsize=8, color="0.25")
+
+    def tick(r: Mapping[str, Any]) -> str:
+        name = r.get("model_in_words", r["model"])
+        if "delta_aic_at_best" in r:
+            return f"{name}  (dAIC at best {r['delta_aic_at_best']:.0f})"
+        if not r.get("converged", True):
+            return f"{name}  (not ranked)"
+        return f"{name}  (dAIC {r['delta_aic']:.1f})"
+
+    ax.set_yticks(y, [tick(r) for r in rows])
+    tied = sum(1 for r in rows if r.get("converged", True) and r["delta_aic"] < supported_daic)
+    if 0 < tied < len(rows):
+        ax.axhline(y[tied - 1] - 0.5, color="k", ls="--", lw=0.9)
     ax.set(xlim=(0, 1), xlabel="share of the energy dissipated over the record [1]",
-           title="Loss shares per model (best model on top)")  # fmt: skip
+           title=f"Share of each loss in each fitted model (lowest AIC on top; the {tied} above the dashed line\n"
+                 f"lie within dAIC {supported_daic:g} of it: the record does not rank them)")  # fmt: skip
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1 - 0.6 / len(rows)), ncol=3, fontsize=8)
     return save(fig, path)
 

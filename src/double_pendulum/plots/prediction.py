@@ -1,14 +1,23 @@
-"""The measured track against the simulation: coordinates and prediction errors."""
+"""The measured track against the simulation: coordinates and prediction errors, one colour per run in both."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .style import legend_below, legend_outside, save
+from .style import legend_below, save
+
+ERROR_FLOOR_M = 1e-5
+"""Errors [m] below this are drawn at it (the log axis has no zero)."""
+
+
+def run_colours(titles: Sequence[str]) -> dict[str, str]:
+    """One colour a run (``C0``, ``C1``, ... in the order of ``titles``), to pass to both figures of a scenario so
+    that a run has the same colour in each."""
+    return {title: f"C{i}" for i, title in enumerate(titles)}
 
 
 def plot_track_comparison(
@@ -18,45 +27,67 @@ def plot_track_comparison(
     path: str | Path,
     *,
     starts: Mapping[str, float] | None = None,
+    colours: Mapping[str, str] | None = None,
+    title: str = "bob coordinates: measured track and FMU predictions from the same start time",
 ) -> Path:
-    """Measured coordinates (dots) and simulated ones (lines) over time [s], one panel per coordinate [m]
-    (the seed's figs. 11-14); ``starts`` marks start times [s] by label. One legend under the panels."""
+    """Measured coordinates (dots) and simulated ones (lines, ``colours`` by run title) over time [s], one panel
+    per coordinate [m] (the seed's figs. 11-14); ``starts`` marks start times [s] by label. One legend under the
+    panels."""
     names = list(measured)
-    fig, axes = plt.subplots(len(names), 1, figsize=(11, 2.6 * len(names)), sharex=True, squeeze=False)
+    colours = colours or run_colours(list(runs))
+    fig, axes = plt.subplots(len(names), 1, figsize=(14, 2.6 * len(names)), sharex=True, squeeze=False)
     for ax, name in zip(axes[:, 0], names):
         ax.plot(t, measured[name], ".", color="k", ms=3, label="measured track")
         for label, (ts, coords) in runs.items():
-            ax.plot(ts, coords[name], lw=1.2, label=f"simulated: {label}")
+            ax.plot(ts, coords[name], lw=1.1, color=colours[label], label=f"simulated: {label}")
         for label, t0 in (starts or {}).items():
             ax.axvline(t0, color="0.5", ls=":", lw=0.8, label=label)
         bob = {"1": "upper", "2": "lower"}.get(name[-1:])
         ax.set(ylabel=f"{bob} bob {name} [m]" if bob else f"{name} [m]")
         ax.grid(alpha=0.3)
-    axes[0, 0].set_title("bob coordinates: measured track and FMU predictions from the same start time")
-    axes[-1, 0].set_xlabel("t [s]")
+    axes[0, 0].set_title(title)
+    axes[-1, 0].set_xlabel("time t [s]")
+    axes[-1, 0].set_xlim(float(np.min(t)) - 0.2, float(np.max(t)) + 0.2)
     legend_below(fig, *axes[0, 0].get_legend_handles_labels(), ncols=2)
     return save(fig, path)
 
 
 def plot_prediction_errors(
-    curves: Mapping[str, tuple[np.ndarray, np.ndarray]],
-    thresholds: tuple[float, ...] | list[float],
+    smoothed: Mapping[str, tuple[np.ndarray, np.ndarray]],
+    thresholds: Sequence[float],
     path: str | Path,
     *,
+    per_frame: tuple[str, np.ndarray, np.ndarray] | None = None,
+    spread: tuple[np.ndarray, np.ndarray] | None = None,
     floor: tuple[np.ndarray, np.ndarray] | None = None,
-    title: str = "distance between the simulated and the measured bob position",
+    colours: Mapping[str, str] | None = None,
+    dashed: Sequence[str] = (),
+    title: str = "distance between the simulated and the measured lower bob",
 ) -> Path:
-    """Position error [m] over time since the start [s], log scale, with horizontal ``thresholds`` [m];
-    ``floor`` (t, error) is drawn grey (e.g. the track's own deviation from a rigid rod)."""
+    """Position error [m] over time since the start [s], log scale: each run's smoothed error (``smoothed``, a line
+    in its colour of ``colours``, dashed for the runs named in ``dashed`` where runs lie on top of each other), one
+    run's per-frame error (``per_frame``: title, t, error; thin and pale, in that run's colour), the fit's
+    uncertainty ``spread`` (t, error) as a shaded band up to it, the track's own rod-length error ``floor``
+    (t, error) as grey dots and the ``thresholds`` [m] as black lines. The legend goes under the axes."""
+    colours = colours or run_colours(list(smoothed))
     fig, ax = plt.subplots(figsize=(11, 5.5))
-    for label, (t, err) in curves.items():
-        ax.semilogy(t, np.maximum(err, 1e-5), lw=1.1, label=label)
+    if spread is not None:
+        ax.fill_between(spread[0], ERROR_FLOOR_M, np.maximum(spread[1], ERROR_FLOOR_M), color="tab:olive", alpha=0.3,
+                        lw=0, label="fit's own uncertainty: median spread of runs drawn from its covariance")
     if floor is not None:
-        label = "track: | |r2 - r1| - l2 | (rod-length error)"
-        ax.semilogy(floor[0], np.maximum(floor[1], 1e-5), ".", color="0.6", ms=2, label=label)
+        ax.semilogy(floor[0], np.maximum(floor[1], ERROR_FLOOR_M), ".", color="0.45", ms=2,
+                    label="track's own error: | |r2 - r1| - l2 | (a rigid rod has none)")
+    if per_frame is not None:
+        name, t, err = per_frame
+        ax.semilogy(t, np.maximum(err, ERROR_FLOOR_M), lw=0.7, color=colours[name], alpha=0.5,
+                    label=f"{name}, per frame")
+    for label, (t, err) in smoothed.items():
+        ax.semilogy(t, np.maximum(err, ERROR_FLOOR_M), lw=1.4, color=colours[label], label=f"{label}, smoothed",
+                    ls="--" if label in dashed else "-")
     for th, ls in zip(thresholds, ("--", "-.", ":")):
-        ax.axhline(th, color="k", ls=ls, lw=0.9, label=f"{100 * th:g} cm")
-    ax.set(xlabel="time since the start t - t0 [s]", ylabel="position error [m]", title=title)
-    legend_outside(ax)
+        ax.axhline(th, color="k", ls=ls, lw=0.9, label=f"threshold {100 * th:g} cm")
+    ax.set_yscale("log")
+    ax.set(xlabel="time since the start t - t0 [s]", ylabel="position error of the lower bob [m]", title=title)
     ax.grid(alpha=0.3, which="both")
+    legend_below(fig, *ax.get_legend_handles_labels(), ncols=2, fontsize=8)
     return save(fig, path)

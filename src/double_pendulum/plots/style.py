@@ -122,3 +122,37 @@ def running_mean(values: np.ndarray, width: int) -> np.ndarray:
     width = max(1, int(width))
     kernel = np.ones(width)
     return np.convolve(values, kernel, mode="same") / np.convolve(np.ones_like(values), kernel, mode="same")
+
+
+def plain_log_numbers(ax: plt.Axes, axis: str = "y") -> None:
+    """Number a log axis of ``ax`` (``"x"`` or ``"y"``) in plain decimals (0.3, 0.5, 2), enough of them to read it.
+
+    Matplotlib numbers a log axis at its decades and, within less than a decade, only some minor ticks, as
+    "6x10^-1", leaving parts of the axis without a number. Call after the limits are set: within a decade every
+    digit 1 to 9 gets a number and the limits widen to the numbered values just outside them (so both ends are
+    numbered), within about two decades 1, 2 and 5 do, beyond that the decades alone."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: PLC0415
+
+    target = ax.yaxis if axis == "y" else ax.xaxis
+    lo, hi = sorted(ax.get_ylim() if axis == "y" else ax.get_xlim())
+    decades = np.log10(hi / lo) if lo > 0 else np.inf
+    if decades <= 1.2:
+        lo, hi = _digit_below(lo), _digit_above(hi)
+        (ax.set_ylim if axis == "y" else ax.set_xlim)(lo, hi)
+    subs = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0) if decades <= 1.2 else (1.0, 2.0, 5.0) if decades <= 2.5 \
+        else (1.0,)
+    target.set_major_locator(LogLocator(base=10.0, subs=subs))
+    target.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    target.set_minor_formatter(NullFormatter())
+
+
+def _digit_below(value: float) -> float:
+    """The largest d x 10^n (d = 1 .. 9) at most ``value`` (> 0)."""
+    scale = 10.0 ** np.floor(np.log10(value))
+    return float(np.floor(value / scale * (1 + 1e-12)) * scale)
+
+
+def _digit_above(value: float) -> float:
+    """The smallest d x 10^n (d = 1 .. 10) at least ``value`` (> 0)."""
+    scale = 10.0 ** np.floor(np.log10(value))
+    return float(np.ceil(value / scale * (1 - 1e-12)) * scale)

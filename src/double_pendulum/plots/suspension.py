@@ -50,12 +50,43 @@ def _panel_order(panels: Mapping[str, Mapping[str, np.ndarray]]) -> list[str]:
     return sorted(panels, key=lambda title: float(panels[title].get("m_s", 0.0)))
 
 
+MAP_MARGIN = 1.35
+"""Factor by which a map's axes reach beyond its grid in k and c (log axes): markers on the grid's edge (the
+resonant end of the iso-b curve lies on the lightest damping mapped) stay inside the axes; the margin shows
+the axes' grey background, labelled "not mapped"."""
+NOT_MAPPED = "0.88"
+"""Axes background of a map outside the mapped (k, c) range."""
+PIECE_FRACTION = 0.25
+"""Pieces of the linear-response contour shorter than this fraction of its longest piece are not drawn."""
+
+
 def _iso_b(ax: plt.Axes, k: np.ndarray, c: np.ndarray, b: np.ndarray, level: float, **style) -> bool:
     """Draw the iso-line b = ``level`` of ``b`` (shape (len(k), len(c))) if it crosses the panel."""
     if not np.nanmin(b) < level < np.nanmax(b):
         return False
     ax.contour(k, c, np.asarray(b).T, levels=[level], **style)
     return True
+
+
+def contour_pieces(k: np.ndarray, c: np.ndarray, b: np.ndarray, level: float,
+                   fraction: float = PIECE_FRACTION) -> list[np.ndarray]:
+    """The pieces (arrays of (k, c) points) of the iso-line b = ``level`` of ``b`` (shape (len(k), len(c))) whose
+    length in (log k, log c) is at least ``fraction`` of the longest piece's; none if the level is not crossed.
+
+    For the linear-response prediction: at light damping its suspension resonance picks out single lines of the
+    finite (Welch) force spectrum, and the iso-line breaks into short islands around them that belong to the
+    spectrum's resolution, not to the prediction's curve."""
+    if not np.nanmin(b) < level < np.nanmax(b):
+        return []
+    fig = plt.figure()  # a scratch figure: only the contour's paths are wanted
+    try:
+        cs = fig.add_subplot().contour(np.log(k), np.log(c), np.asarray(b).T, levels=[level])
+        pieces = [seg for seg in cs.allsegs[0] if len(seg) > 1]
+    finally:
+        plt.close(fig)
+    lengths = [float(np.sum(np.hypot(*np.diff(seg, axis=0).T))) for seg in pieces]
+    longest = max(lengths, default=0.0)
+    return [np.exp(seg) for seg, n in zip(pieces, lengths) if n >= fraction * longest]
 
 
 def _decay_panel(ax: plt.Axes, p: Mapping[str, np.ndarray], levels: Mapping[str, float], norm: Normalize):
@@ -70,11 +101,13 @@ def _decay_panel(ax: plt.Axes, p: Mapping[str, np.ndarray], levels: Mapping[str,
         ax.plot([], [], color="w", ls=ls, lw=1.6, path_effects=_OUTLINE, label=f"{label}: b = {level:.4f} 1/s")
     if "b_fine" in p and levels:
         first = next(iter(levels))
-        _iso_b(ax, p["k_fine"], p["c_fine"], p["b_fine"], levels[first], colors="r", linestyles=":", linewidths=1.4)
+        for piece in contour_pieces(p["k_fine"], p["c_fine"], p["b_fine"], levels[first]):
+            ax.plot(piece[:, 0], piece[:, 1], "r:", lw=1.4)
         ax.plot([], [], "r:", lw=1.4, label=f"{first}, linear-response prediction (fixed-pivot force spectrum)")
-    ax.set(xscale="log", yscale="log", xlabel="suspension stiffness k [N/m]")
-    ax.set_xlim(kd[0], kd[-1])
-    ax.set_ylim(cd[0], cd[-1])
+    ax.set(xscale="log", yscale="log", xlabel="suspension stiffness k [N/m]", facecolor=NOT_MAPPED)
+    ax.set_xlim(kd[0] / MAP_MARGIN, kd[-1] * MAP_MARGIN)
+    ax.set_ylim(cd[0] / MAP_MARGIN, cd[-1] * MAP_MARGIN)
+    ax.fill([], [], color=NOT_MAPPED, label="not mapped")
     for axis in (ax.xaxis, ax.yaxis):  # numbers at 1, 2 and 5 per decade: a map within one decade has some too
         axis.set_major_locator(LogLocator(base=10.0, subs=(1.0, 2.0, 5.0)))
         axis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))

@@ -8,7 +8,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .style import legend_below, legend_outside, save
+from .style import legend_below, legend_outside, plain_log_numbers, save
 
 
 def plot_angles(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
@@ -88,42 +88,71 @@ def plot_residuals(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
             ax.plot(zeros, np.zeros(zeros.size), "|", color="k", ms=10, mew=1.5, transform=ax.get_xaxis_transform(),
                     clip_on=False, label=None if marked else "residual exactly 0 (off the log scale)")
             marked = True
-        ax.set(xlabel="t [s]", title=label)
+        ax.set_xlabel("time t [s]")
+        ax.set_title(f"case: {label}", loc="left", fontsize=10)
         ax.grid(alpha=0.3, which="both")
     values = np.concatenate(nonzero) if nonzero else np.empty(0)
     if values.size:
         axes[0, 0].set_ylim(values.min() / 2.0, values.max() * 2.0)
-    fig.supylabel("relative energy residual |energy_residual| / E_total(0) [-]")
-    fig.suptitle(f"energy balance error of the {len(runs)} worst passing cases")
+    fig.supylabel("relative energy residual |energy_residual| / E_total(0) [1]")
+    fig.suptitle(f"Energy balance error of the {len(runs)} worst passing cases", fontsize=13)
+    fig.get_layout_engine().set(h_pad=0.12)  # room between the figure's title and the first case's
     if marked:
         legend_outside(next(ax for ax in axes[:, 0] if ax.get_legend_handles_labels()[0]))
     return save(fig, path)
 
 
-def plot_energy_per_mechanism(runs: Mapping[str, np.ndarray], path: str | Path) -> Path:
-    """E_total [J] over time [s] for each run, log scale (straight lines mean exponential decay)."""
+def plot_energy_per_mechanism(runs: Mapping[str, np.ndarray], path: str | Path, *, note: str = "") -> Path:
+    """E_total [J] over time [s] for each run, log scale (straight lines mean exponential decay), numbered in plain
+    decimals; ``note`` (e.g. which coefficients) goes under the title."""
     fig, ax = plt.subplots(figsize=(9, 5))
     for label, r in runs.items():
         ax.semilogy(r["time"], r["E_total"], label=label.replace("_", " "))
-    ax.set(xlabel="t [s]", ylabel="total energy E_total [J]",
-           title="energy of the pendulum and its suspension: each loss mechanism alone, and all together")
+    title = "energy of the pendulum and its suspension: each loss mechanism alone, and all together"
+    ax.set(xlabel="time t [s]", ylabel="total energy E_total [J] (log scale)",
+           title=title + (f"\n{note}" if note else ""))  # fmt: skip
+    plain_log_numbers(ax, "y")
     legend_outside(ax)
     ax.grid(alpha=0.3, which="both")
     return save(fig, path)
 
 
-def plot_energy_budget_stacked(result: np.ndarray, path: str | Path) -> Path:
-    """Where the energy went: stacked E_pendulum, E_suspension and each W_* [J] over time [s]."""
-    words = {"E_pendulum": "stored in the pendulum", "E_suspension": "stored in the suspension",
-             "W_air": "dissipated by air drag", "W_bearing": "dissipated in the bearings",
+STACK_VISIBLE = 0.005
+"""A band of the stacked budget narrower than this fraction of E_total(0) all the time is left out (and named in
+the figure as negligible)."""
+
+
+def plot_energy_budget_stacked(result: np.ndarray, path: str | Path, *, note: str = "") -> Path:
+    """Where the energy went [J] over time [s]: the energy stored in the pendulum and its suspension (one band: they
+    exchange energy at the suspension's frequency, faster than the output grid resolves, which drew a sawtooth
+    between two bands) and each mechanism's dissipated work W_* stacked on it, adding up to E_total(0). Bands that
+    stay below :data:`STACK_VISIBLE` of E_total(0) are not drawn and are named in the title's last line; ``note``
+    (e.g. which coefficients) goes under the title."""
+    words = {"W_air": "dissipated by air drag", "W_bearing": "dissipated in the bearings",
              "W_bearing_drag": "dissipated by the bearing drag torque",
-             "W_suspension": "dissipated in the suspension"}
-    names = {n: w for n, w in words.items() if n in (result.dtype.names or ())}
+             "W_suspension": "dissipated in the suspension's damper"}
+    fields = result.dtype.names or ()
+    e0 = float(result["E_total"][0])
+    stored = np.asarray(result["E_pendulum"]) + (np.asarray(result["E_suspension"]) if "E_suspension" in fields else 0)
+    bands = {"stored in the pendulum and its suspension (E_pendulum + E_suspension)": stored}
+    small = []
+    for name, word in words.items():
+        if name not in fields:
+            continue
+        if float(np.max(np.abs(result[name]))) < STACK_VISIBLE * e0:
+            small.append(name)
+        else:
+            bands[f"{word} ({name})"] = np.asarray(result[name])
     fig, ax = plt.subplots(figsize=(10, 5))
-    ax.stackplot(result["time"], *(result[n] for n in names),
-                 labels=[f"{word} ({name})" for name, word in names.items()], alpha=0.85)
-    ax.axhline(result["E_total"][0], color="k", lw=0.8, ls="--", label="E_total(0)")
-    ax.set(xlabel="t [s]", ylabel="energy [J]", title="where the energy went: stored and dissipated, all mechanisms on")
-    legend_outside(ax)
+    ax.stackplot(result["time"], *bands.values(), labels=list(bands), alpha=0.85)
+    ax.axhline(e0, color="k", lw=0.8, ls="--", label="E_total(0), the start energy")
+    lines = ["where the energy went: stored and dissipated, all mechanisms on"]
+    if note:
+        lines.append(note)
+    if small:
+        lines.append(f"not drawn (below {STACK_VISIBLE:.1%} of the start energy): " + ", ".join(small))
+    ax.set(xlabel="time t [s]", ylabel="energy [J]", title="\n".join(lines))
+    ax.set_ylim(0.0, 1.08 * e0)
+    legend_below(fig, *ax.get_legend_handles_labels(), ncols=2)
     ax.grid(alpha=0.3)
     return save(fig, path)

@@ -15,10 +15,11 @@ of the step before, so
 and (y, v) advance exactly under the held f_n: (y, v)_{n+1} = Phi(h) (y, v)_n + Gamma(h) f_n.
 With X_n = (y_n, v_n, f_n, f_{n-1}) this is X_{n+1} = G(mu, h omega, zeta) X_n: bounded iff the
 spectral radius rho(G) <= 1. For h omega -> 0, Phi -> I, Gamma -> 0 and the force recursion
-decouples: f_{n+1} = -mu f_{n-1}, eigenvalues z = +-i sqrt(mu): **unstable for mu > 1 at any
-macro step** (the classic added-mass instability: the lagged inertial force of a load heavier
-than its support over-corrects it every step, growing as sqrt(mu) per step). At finite h omega
-the spring and damper shift the limit (:func:`critical_mass_ratio`).
+decouples: f_{n+1} = -mu f_{n-1}, eigenvalues z = +-i sqrt(mu): unstable for mu > 1 in that limit
+(the classic added-mass instability: the lagged inertial force of a load heavier than its support
+over-corrects it every step, growing as sqrt(mu) per step). At finite h omega the spring and damper
+shift the limit (:func:`critical_mass_ratio`): here damping raises it above 1 at small and moderate
+h omega (:func:`limit_table`), while large, lightly damped steps lower it.
 
 With the exchange in sequence (``jacobi_sequential``: the force first, then the suspension's
 acceleration that follows from it, as fmpy's container FMU and libcosim do), the pendulum gets
@@ -27,7 +28,9 @@ A_n = (f_n - k y_n - c v_n) / M_s and
     f_{n+1} = -mu f_n + mu (k y_n + c v_n):
 
 one delay instead of two, X_n = (y_n, v_n, f_n), and for h omega -> 0 the eigenvalue z = -mu:
-the same limit mu < 1, but an unstable run grows as mu per step instead of sqrt(mu).
+the same limit mu < 1, but an unstable run grows as mu per step instead of sqrt(mu); here the spring and
+damper lower the limit below 1 at every finite h omega, so a load heavier than its support is unstable at
+every macro step.
 """
 
 from __future__ import annotations
@@ -95,3 +98,15 @@ def critical_mass_ratio(
         mid = math.sqrt(lo * hi)
         lo, hi = (lo, mid) if unstable(mid) else (mid, hi)
     return math.sqrt(lo * hi)
+
+
+DAMPING_RATIOS = (0.0, 0.2, 0.5)
+"""Damping ratios zeta of the suspension at which :func:`limit_table` states the derived limit beside the map's."""
+
+
+def limit_table(h_omegas: tuple[float, ...], scheme: str, zetas: tuple[float, ...] = DAMPING_RATIOS) -> dict:
+    """The derived limit mu_c (:func:`critical_mass_ratio`) of ``scheme`` at each damping ratio ``zetas`` and
+    ``h_omegas``, keyed ``zeta_<z>`` / ``h_omega_<h omega>``. With the force passed first (``jacobi_sequential``)
+    damping lowers mu_c below 1 at every h omega > 0; with both exchanged at once (``jacobi``) it raises it above 1,
+    so a load heavier than its support is not unstable at every macro step there."""
+    return {f"zeta_{z:g}": {f"h_omega_{hw:g}": critical_mass_ratio(hw, z, scheme) for hw in h_omegas} for z in zetas}

@@ -29,14 +29,12 @@ from typing import Any
 import numpy as np
 
 from ...model.parameters import SEED_RIGID_LINKS
-from ..track.measurement import FPS, Geometry, Reconstruction, Track, reconstruct
+from ..track.measurement import Geometry, Reconstruction, Track, reconstruct
 from .fit import (
-    AUTOCORRELATION_LAG_S,
-    MODELS,
     SEED_FIT,
     calibrate_error_model,
-    effective_sample_factor,
     fit_model,
+    record_correlation_factor,
 )
 
 ROD_MASS_UNCERTAINTY_KG = 0.03
@@ -44,10 +42,10 @@ ROD_MASS_UNCERTAINTY_KG = 0.03
 
 
 def exp_fit(t: np.ndarray, e: np.ndarray, sigma: np.ndarray | None) -> tuple[float, float, float, float]:
-    """(a [J], b [1/s], sigma_a, sigma_b) of E = a exp(b t); errors times sqrt(F) of the residuals."""
+    """(a [J], b [1/s], sigma_a, sigma_b) of E = a exp(b t); errors times sqrt(F) of the record
+    (:func:`~double_pendulum.analysis.decay.fit.record_correlation_factor`)."""
     fit = fit_model("exponential", t, e, sigma, absolute_sigma=sigma is not None)
-    resid = (e - MODELS["exponential"].func(t, *fit.params)) / (1.0 if sigma is None else sigma)
-    f = math.sqrt(effective_sample_factor(resid, round(AUTOCORRELATION_LAG_S * FPS)))
+    f = math.sqrt(record_correlation_factor(t, e, sigma))
     return fit.value("a"), fit.value("b"), fit.error("a") * f, fit.error("b") * f
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ...results_io import report_opening
 from ..track.measurement import FPS, SEED_TOTAL_MASS_KG, SG_POLYORDER, SG_WINDOW
 from .error_budget import budget_table
 from .fit import AUTOCORRELATION_LAG_S
@@ -112,9 +113,11 @@ def _fit_section(s: dict[str, Any]) -> str:
     return f"""## Exponential fit E = a exp(b t)
 
 a = {plus_minus(s["a_J"], s["a_J_stderr"])} J, b = {plus_minus(s["b_per_s"], s["b_per_s_stderr"], digits=5)} 1/s
-(standard errors of the fit). The residuals are correlated over a swing: the variance inflation
-factor 1 + 2 sum(rho_k) over {AUTOCORRELATION_LAG_S} s of lags is {s["autocorrelation_factor"]:.2f},
-which makes the errors a +- {s["a_J_stderr_autocorr"]:.4f} J, b +- {s["b_per_s_stderr_autocorr"]:.5f} 1/s.
+(standard errors of the fit). The residuals are correlated over a swing: the record's correlation factor
+F = 1 + 2 sum(rho_k) over {AUTOCORRELATION_LAG_S} s of lags of the residuals about the free-exponent law (the most
+flexible decay law here, so that its residuals hold the scatter, not a misfit of the decay's shape) is
+{s["autocorrelation_factor"]:.2f}, which makes the errors a +- {s["a_J_stderr_autocorr"]:.4f} J,
+b +- {s["b_per_s_stderr_autocorr"]:.5f} 1/s. The same F enters every error and every comparison of this report.
 
 The seed: a = {seed["a_J"]} J +- {100 * seed["a_rel_err"]:.2f} %, b = {seed["b_per_s"]} 1/s
 +- {100 * seed["b_rel_err"]:.2f} %. Difference in b: {seed["b_difference_per_s"]:+.5f} 1/s, that is
@@ -138,14 +141,20 @@ def _comparison_section(s: dict[str, Any]) -> str:
 
 {comparison_rows(s)}
 
-Best by AIC: {s["model_comparison"][0]["model"]}. The criteria count every frame as independent; with
-the correlation factor the differences are worth about 1/{s["autocorrelation_factor"]:.1f} of the
-printed values. The free exponent of dE/dt = -k E^p is p = {p:.2f} +- {sp:.2f} (+- {sp_corr:.2f} with
+Lowest AIC: {s["model_comparison"][0]["model"]}{_tie_text(s)}. The criteria divide chi2 by F =
+{s["autocorrelation_factor"]:.2f} (the frames count as n / F independent ones). The free exponent of
+dE/dt = -k E^p is p = {p:.2f} +- {sp:.2f} (+- {sp_corr:.2f} with
 the correlation): Coulomb friction has p = 1/2 ({(p - 0.5) / sp_corr:+.1f} sigma), losses proportional
 to the energy p = 1 ({(p - 1.0) / sp_corr:+.1f} sigma), quadratic drag (E ~ 1/(1 + t/tau)^2, the seed's
 alternative "inverse square of time") p = 3/2 ({(p - 1.5) / sp_corr:+.1f} sigma, dAIC =
 {rows["quadratic_drag"]["delta_aic"]:.0f}).
 """
+
+
+def _tie_text(s: dict[str, Any]) -> str:
+    """Which decay laws lie within dAIC 2 of the lowest (the record does not rank them)."""
+    tied = [r["model"] for r in s["model_comparison"][1:] if r["delta_aic"] < 2.0]
+    return f" ({', '.join(tied)} within dAIC 2 of it: the record does not rank them)" if tied else ""
 
 
 def _discussion_section(s: dict[str, Any]) -> str:
@@ -191,7 +200,7 @@ def _budget_section(s: dict[str, Any]) -> str:
     return f"""## Error budget of a and b
 
 The errors quoted above are statistical only. Re-doing the fit with one choice changed at a time
-(`src/double_pendulum/analysis/decay_error_budget.py`):
+(`src/double_pendulum/analysis/decay/error_budget.py`):
 
 {budget_table(bud)}
 
@@ -207,4 +216,39 @@ def report_text(summary: dict[str, Any]) -> str:
     sections = (_geometry_section, _energy_section, _fit_section, _budget_section, _comparison_section,
                 _discussion_section)
     body = "\n".join(section(summary) for section in sections)
-    return "# Energy decay of the seed pendulum (Table 1)\n\n" + body
+    return _opening(summary) + body
+
+
+def _opening(s: dict[str, Any]) -> str:
+    """Title, plain summary and the words used."""
+    bud = s["error_budget"]
+    rows = {r["model"]: r for r in s["model_comparison"]}
+    p = rows["power"]["params"]["p"]
+    sp = rows["power"]["stderr"]["p"] * math.sqrt(s["autocorrelation_factor"])
+    tied = [r["model"] for r in s["model_comparison"] if r["delta_aic"] < 2.0]
+    return report_opening("Energy decay of the seed pendulum (Table 1)", [
+        f"From the seed's camera track ({s['n_fit']} frames after the hand release) this report computes the "
+        "pendulum's energy frame by frame and fits how it decays.",
+        f"Fitted as E = a exp(b t) it decays at b = {s['b_per_s']:.4f} 1/s (the energy falls by about "
+        f"{100 * (1 - math.exp(s['b_per_s'])):.1f} % a second), close to the seed's -0.024 1/s.",
+        f"b is known to about {bud['total_b_relative']:.0%} ({bud['total_b_per_s']:.4f} 1/s), mostly because the "
+        "choice of weights and the first and second half of the record give different values; the statistical error "
+        f"alone is {s['b_per_s_stderr_autocorr']:.5f} 1/s.",
+        f"The decay is not exactly exponential: laws with a loss that grows less steeply with the energy fit as well "
+        f"or better ({', '.join(tied)} tie), and the free loss exponent is p = {p:.2f} +- {sp:.2f} (1 would be "
+        "exponential).",
+    ], {
+        "b": "the decay rate [1/s] of E = a exp(b t); a [J] the energy at t = 0",
+        "p": "the loss exponent of dE/dt = -k E^p: 0.5 for a constant friction torque (coulomb), 1 for an exponential "
+             "decay, 1.5 for air drag (quadratic_drag)",
+        "Savitzky-Golay": "a smoothing derivative: a local polynomial fitted over a few frames, for the rates",
+        "chi2": "the sum over the frames of ((fitted - measured energy) / the energy's error)^2",
+        "chi2_red": "the sum of squared residuals over their errors per degree of freedom; about 1 when the errors "
+                    "match the scatter",
+        "F": "the correlation factor: neighbouring frames' residuals are alike over about a swing, so the frames count "
+             "as n / F independent ones and statistical errors grow by sqrt(F)",
+        "AIC": "Akaike's information criterion chi2 / F + 2 k (k fitted numbers): lower is better; a difference dAIC "
+               "below 2 means the record does not tell two laws apart",
+        "BIC": "the Bayesian information criterion chi2 / F + k ln(n / F), which charges extra numbers more",
+        "Akaike weight": "exp(-dAIC / 2) over the sum of that for all laws: each law's relative support among these",
+    })

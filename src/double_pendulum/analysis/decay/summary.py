@@ -5,9 +5,10 @@ The exponential fit :math:`E = a\,e^{b t}` [J] of the reconstructed energy
 energies and weights, where the energy scatters, the geometry of the track and the derivative filters,
 and the comparison with the seed's fit :data:`~double_pendulum.analysis.decay.fit.SEED_FIT`.
 
-Fit errors are inflated for correlated residuals: :math:`\sigma_{corr} = \sigma \sqrt{f}` with the
-variance inflation factor :math:`f = 1 + 2 \sum_k \rho_k` over :data:`AUTOCORRELATION_LAG_S` of lags
-(:func:`~double_pendulum.analysis.decay.fit.effective_sample_factor`).
+Fit errors are inflated for correlated residuals: :math:`\sigma_{corr} = \sigma \sqrt{F}` with the
+record's variance inflation factor :math:`F = 1 + 2 \sum_k \rho_k` over :data:`AUTOCORRELATION_LAG_S` of lags
+of the residuals about the free-exponent decay law
+(:func:`~double_pendulum.analysis.decay.fit.record_correlation_factor`, the same F for every fit of a record).
 """
 
 from __future__ import annotations
@@ -27,13 +28,12 @@ from ..track.measurement import (
     savgol_derivative_coefficients,
 )
 from .fit import (
-    AUTOCORRELATION_LAG_S,
     MODELS,
     SEED_FIT,
     ErrorModel,
     FitResult,
-    effective_sample_factor,
     fit_model,
+    record_correlation_factor,
 )
 
 GAIN_CHECK_OMEGA = (10.0, 20.0, 25.0)
@@ -177,11 +177,11 @@ def fit_exponential(t: np.ndarray, e: np.ndarray, sigma: np.ndarray | None, abso
     """Fit E = a exp(b t) to energies ``e`` [J] at times ``t`` [s]: :func:`exponential_summary`.
 
     ``sigma`` [J]: errors (None: equal weights), ``absolute``: take them as true errors. The
-    autocorrelation factor comes from the residuals (e - fit) / sigma.
+    autocorrelation factor is the record's (:func:`~double_pendulum.analysis.decay.fit.record_correlation_factor`,
+    with the same errors).
     """
     fit = fit_model("exponential", t, e, sigma, absolute_sigma=absolute)
-    resid = (e - MODELS["exponential"].func(t, *fit.params)) / (1.0 if sigma is None else sigma)
-    return exponential_summary(fit, effective_sample_factor(resid, round(AUTOCORRELATION_LAG_S * FPS)))
+    return exponential_summary(fit, record_correlation_factor(t, e, sigma))
 
 
 def weighting_variants(rec: Reconstruction, m: np.ndarray) -> dict[str, Any]:

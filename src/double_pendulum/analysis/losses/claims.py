@@ -23,6 +23,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ...model.parameters import BearingParameters, PendulumParameters
+from .mechanisms import model_title
 
 SUPPORTED_DAIC = 2.0
 """Models within this AIC of the lowest are supported about as well by the data (Burnham & Anderson)."""
@@ -64,18 +65,67 @@ def supported_models(rows: Sequence[Mapping[str, Any]], daic: float = SUPPORTED_
     """The converged models within ``daic`` of the lowest AIC (the top model included), with their Akaike
     weights, loss shares, b_sim [1/s] and p_sim; the range of the air-drag share across them (None where no
     model in the set has air drag) and a sentence saying the record does not rank them."""
+    near = [r for r in rows if r["converged"] and r["delta_aic"] < daic]
     models = {r["model"]: {"delta_aic": r["delta_aic"], "akaike_weight": r["akaike_weight"], "shares": r["shares"],
                            "b_sim_per_s": r.get("b_sim_per_s"), "p_sim": r.get("p_sim")}
-              for r in rows if r["converged"] and r["delta_aic"] < daic}  # fmt: skip
+              for r in near if not r.get("reduces_to")}  # fmt: skip
+    reduced = {r["model"]: r["reduces_to"] for r in near if r.get("reduces_to")}
     air = [m["shares"][AIR_LABEL] for m in models.values() if AIR_LABEL in m["shares"]]
-    parts = "; ".join(f"{name} (delta AIC {m['delta_aic']:.2f}, weight {m['akaike_weight']:.2f}: "
+    if air and any(AIR_LABEL not in m["shares"] for m in models.values()):
+        air.append(0.0)  # a supported model without air drag
+    parts = "; ".join(f"{model_title(name)} (delta AIC {m['delta_aic']:.2f}, weight {m['akaike_weight']:.2f}: "
                       + ", ".join(f"{k} {x:.0%}" for k, x in m["shares"].items()) + ")"
                       for name, m in models.items())  # fmt: skip
-    text = (f"{len(models)} models lie within delta AIC {daic:g} of the lowest: {parts}. The energy record does "
+    same = "".join(f" {model_title(name)} fits no better than {model_title(other)}, which it contains (its extra "
+                   "mechanism fitted to nothing), so it is no candidate of its own." for name, other in reduced.items())
+    text = (f"{len(models)} models lie within delta AIC {daic:g} of the lowest: {parts}.{same} The energy record does "
             "not rank them, so none is the model and no split of the loss is measured: "
             + (f"the air-drag share ranges from {min(air):.0%} to {max(air):.0%} across them, depending on which "
-               "second mechanism is assumed." if air else "none of them has air drag."))
-    return {"daic": daic, "models": models, "air_share_range": [min(air), max(air)] if air else None, "text": text}
+               "mechanism is assumed beside it or instead of it." if air else "none of them has air drag."))
+    return {"daic": daic, "models": models, "reduced": reduced,
+            "air_share_range": [min(air), max(air)] if air else None, "text": text}
+
+
+def supported_from_factor(rows: Sequence[Mapping[str, Any]], factor: float, daic: float = SUPPORTED_DAIC,
+                          largest: float = 10.0) -> dict[str, float | None]:
+    """How the supported set depends on the residual-correlation factor F: for each converged model outside it,
+    the smallest F (up to ``largest``) at which it would lie within ``daic`` of the lowest AIC, None if none does.
+
+    AIC = chi2 / F + 2 k (:mod:`.fitting`): a larger F shrinks the chi2 differences against the parameter counts,
+    so models with fewer parameters join. The F used (``factor``) is the record's one estimate
+    (:func:`~double_pendulum.analysis.decay.fit.record_correlation_factor`); this says how far it is from changing
+    the answer, e.g. against the factor of another model's residuals."""
+    fitted = [(r["model"], r["chi2"], r["k"]) for r in rows if r["converged"]]
+    grid = [factor * (largest / factor) ** (i / 400) for i in range(401)] if largest > factor else []
+    out: dict[str, float | None] = {}
+    for model, chi2, k in fitted:
+        aic = {f: chi2 / f + 2 * k for f in grid}
+        if chi2 / factor + 2 * k - min(c / factor + 2 * q for _, c, q in fitted) < daic:
+            continue
+        out[model] = next((f for f in grid if aic[f] - min(c / f + 2 * q for _, c, q in fitted) < daic), None)
+    return out
+
+
+def suspension_bound(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any] | None:
+    """The suspension as the main loss, reported as a bound: the row of the model with air drag and the
+    suspension if its optimum is its nested limit (:func:`~.comparison.bound_entry`): delta AIC at best, the
+    limit model, where the fit stopped. None if no such model was fitted or it converged to a finite damping."""
+    row = next((r for r in rows if r["model"] == "air+suspension"), None)
+    if row is None or "delta_aic_at_best" not in row:
+        return None
+    return {"model": row["model"], "delta_aic_at_best": row["delta_aic_at_best"],
+            "model_in_words": model_title(row["model"]), "limit_in_words": model_title(row["best_is_limit_model"]),
+            "best_is_limit_model": row["best_is_limit_model"], "statement": row["bound"],
+            "stopped_at": {n: p["value"] for n, p in row["parameters"].items()},
+            "stopped_at_delta_aic": row["delta_aic"], "stopped_at_p_sim": row.get("p_sim")}  # fmt: skip
+
+
+def seed_friction_coefficient(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The load-proportional friction coefficient c_R [1] of each converged model that has it, against the seed's
+    ball-bearing values (:data:`SEED_C_R`): the value and its ratio to each end of the seed's range."""
+    return {r["model"]: {"c_R": r["parameters"]["c_R"]["value"],
+                         "over_seed": [r["parameters"]["c_R"]["value"] / c for c in SEED_C_R]}
+            for r in rows if r["converged"] and "c_R" in r["parameters"]}  # fmt: skip
 
 
 def b_sim_range(rows: Sequence[Mapping[str, Any]]) -> list[float] | None:

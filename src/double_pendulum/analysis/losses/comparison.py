@@ -11,17 +11,18 @@ from typing import Any
 
 import numpy as np
 
-from ...model.parameters import AirDragParameters
-from ..decay.fit import MODELS, effective_sample_factor, fit_model
+from ...model.parameters import AirDragParameters, BearingParameters
+from ..decay.fit import fit_model, record_correlation_factor
 from ..suspension.identification import decay_shape
 from .fitting import FitProblem, ModelFit, fit_loss_model
-from .mechanisms import LAG_FRAMES, MECHANISMS, contains, mechanisms_of, parameters_of
+from .mechanisms import MECHANISMS, OMEGA_REG, contains, mechanisms_of, model_title, model_values, parameters_of
 
 
-def common_factor(fits: Sequence[ModelFit]) -> float:
-    """Residual-correlation factor F of the best-fitting model (lowest chi2), used for all."""
-    best = min(fits, key=lambda f: f.chi2)
-    return effective_sample_factor(best.residuals, LAG_FRAMES)
+def common_factor(problem: FitProblem) -> float:
+    """Residual-correlation factor F of the measured record
+    (:func:`~double_pendulum.analysis.decay.fit.record_correlation_factor`: the residuals about the free-exponent
+    decay law), used for every model fitted to it, as ``energy_decay`` uses it for its decay laws."""
+    return record_correlation_factor(problem.t, problem.energy, problem.sigma)
 
 
 CONVERGENCE_TOLERANCE = 0.5
@@ -47,11 +48,54 @@ def not_ranked_because(model: str) -> str:
             f"{p.warm_scan[-1]:g} {p.unit}, then Gauss-Newton): the nested model is its limit {p.name} -> infinity")
 
 
+def limit_model(model: str) -> str | None:
+    """The model a model reaches in the limit of its scanned parameter going to infinity (``air+suspension``:
+    ``air``, the pivot held rigid by an infinitely stiff damper), or None if it has no such parameter."""
+    names = [m.name for m in mechanisms_of(model) if not any(p.warm_scan for p in m.parameters)]
+    return "+".join(names) if names and len(names) < len(mechanisms_of(model)) else None
+
+
+def bound_entry(fit: ModelFit, fits: Sequence[ModelFit], crit: Mapping[str, tuple[float, float]],
+                best_aic: float) -> dict[str, Any]:
+    """What a model that did not converge because its optimum is its nested limit (:func:`limit_model`) supports:
+    a bound, not a fit. Its best chi2 is the limit model's (no finite value of the scanned parameter did better),
+    so its AIC at best is the limit model's plus 2 per extra parameter: ``delta_aic_at_best``. Empty if the model
+    has no limit model among ``fits`` (a fit that merely stalled)."""
+    limit = limit_model(fit.model)
+    nested = next((f for f in fits if f.model == limit), None)
+    if nested is None:
+        return {}
+    scanned = next(p for p in parameters_of(fit.model) if p.warm_scan)
+    return {"best_is_limit_model": limit, "best_is_limit_model_in_words": model_title(limit),
+            "delta_aic_at_best": crit[limit][0] + 2.0 * (fit.k - nested.k) - best_aic,
+            "bound": f"no {scanned.name} tried ({scanned.warm_scan[0]:g} to {scanned.warm_scan[-1]:g} {scanned.unit},"
+                     f" then Gauss-Newton) fits better than its limit {scanned.name} -> infinity, "
+                     f"{model_title(limit)}: "
+                     f"its best is that limit, {scanned.name} has no finite estimate, and its delta AIC is at best "
+                     f"that model's plus 2 per extra parameter"}  # fmt: skip
+
+
+REDUCES_TOLERANCE = 0.05
+"""chi2 a converged model must gain over a model nested in it to be more than that model (:func:`reduces_to`): the
+fit's own resolution (:data:`.fitting.CHI2_TOLERANCE`)."""
+
+
+def reduces_to(fit: ModelFit, fits: Sequence[ModelFit], ok: Mapping[str, bool]) -> str | None:
+    """The smallest converged model nested in ``fit``'s that fits as well (chi2 within :data:`REDUCES_TOLERANCE`),
+    or None: a model that gains nothing over it has fitted its extra mechanism to nothing (air+viscous with its air
+    drag at the lower bound is viscous damping alone) and is no candidate of its own."""
+    same = [f for f in fits if f is not fit and ok[f.model] and contains(fit.model, f.model)
+            and f.chi2 <= fit.chi2 + REDUCES_TOLERANCE]  # fmt: skip
+    return min(same, key=lambda f: f.k).model if same else None
+
+
 def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, Any]]:
     """One row per model, sorted by the corrected AIC: parameters with errors, chi2, AIC, BIC, Akaike weight.
 
     Fits that did not converge (:func:`converged`) come last with Akaike weight 0: their chi2 is not
-    the model's minimum, so the comparison says nothing about them."""
+    the model's minimum, so the comparison says nothing about them; their parameters are where the fit stopped,
+    without standard errors (``null_means``), and a model whose optimum is its nested limit gets the bound of
+    :func:`bound_entry`."""
     crit = {f.model: f.criteria(factor) for f in fits}
     ok = {f.model: converged(f, fits) for f in fits}
     ordered = sorted(fits, key=lambda f: (not ok[f.model], crit[f.model][0]))
@@ -62,7 +106,8 @@ def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, A
     return [
         {
             "model": f.model,
-            "parameters": parameter_table(f, factor),
+            "model_in_words": model_title(f.model),
+            "parameters": parameter_table(f, factor, ok[f.model]),
             "chi2": f.chi2,
             "chi2_red": f.chi2 / (f.n - f.k),
             "n_frames": f.n,
@@ -73,7 +118,10 @@ def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, A
             "delta_bic": crit[f.model][1] - best_bic,
             "akaike_weight": float(w),
             "converged": ok[f.model],
-            **({} if ok[f.model] else {"not_ranked_because": not_ranked_because(f.model)}),
+            **({} if ok[f.model] else {"not_ranked_because": not_ranked_because(f.model),
+                                       **bound_entry(f, fits, crit, best_aic)}),
+            "reduces_to": reduces_to(f, fits, ok) if ok[f.model] else None,
+            "parameter_correlation": f.correlation(factor).tolist() if ok[f.model] else None,
             "energy_scale_kappa": f.kappa,
             "shares": f.extra.get("shares", {}),
             **f.extra.get("decay", {}),
@@ -84,11 +132,14 @@ def comparison_rows(fits: Sequence[ModelFit], factor: float) -> list[dict[str, A
     ]
 
 
-def parameter_table(fit: ModelFit, factor: float) -> dict[str, dict[str, Any]]:
-    """Value, standard error (with the correlation factor), unit and description of each parameter."""
+def parameter_table(fit: ModelFit, factor: float, converged: bool = True) -> dict[str, dict[str, Any]]:
+    """Value, standard error (with the correlation factor), unit and description of each parameter; a fit that
+    did not converge (``converged`` False) has its values where it stopped and no errors (None): the curvature
+    there is not that of an optimum."""
     err = fit.stderr(factor)
     return {
-        p.name: {"value": float(v), "stderr": float(e), "relative_error": float(e / v), "unit": p.unit,
+        p.name: {"value": float(v), "stderr": float(e) if converged else None,
+                 "relative_error": float(e / v) if converged else None, "unit": p.unit,
                  "description": p.description, "at_bound": bool(v <= p.bounds[0] * 1.001 or v >= p.bounds[1] / 1.001)}
         for p, v, e in zip(parameters_of(fit.model), fit.theta, err)
     }  # fmt: skip
@@ -96,15 +147,16 @@ def parameter_table(fit: ModelFit, factor: float) -> dict[str, dict[str, Any]]:
 
 def identifiability(fit: ModelFit, factor: float, max_rel_error: float = 0.5, max_corr: float = 0.95) -> dict[str, Any]:
     """Correlation matrix and a verdict per parameter: ``identified`` if its relative error (the
-    other parameters free) is below ``max_rel_error``; ``strongly_correlated`` names the parameters
-    it trades off against (|r| > ``max_corr``): the energy fixes their combination far better than
-    each alone, and the split of the loss between them is uncertain by their errors."""
+    other parameters free) is below ``max_rel_error`` and it trades off against no other parameter;
+    ``strongly_correlated`` names the parameters it trades off against (|r| > ``max_corr``): the energy fixes
+    their combination far better than each alone, so none of them is identified on its own, and the split of
+    the loss between them is uncertain by their errors."""
     corr = fit.correlation(factor)
     rel = fit.stderr(factor) / fit.theta
     names = fit.names
-    verdict = {name: bool(rel[i] < max_rel_error) for i, name in enumerate(names)}
     strong = {name: [names[j] for j in range(len(names)) if j != i and abs(corr[i, j]) > max_corr]
               for i, name in enumerate(names)}  # fmt: skip
+    verdict = {name: bool(rel[i] < max_rel_error and not strong[name]) for i, name in enumerate(names)}
     return {"parameters": names, "correlation": corr.tolist(), "identified": verdict, "strongly_correlated": strong}
 
 
@@ -210,26 +262,62 @@ def half_residuals(problem: FitProblem, e_sim: np.ndarray, kappa: float, factor:
     return out
 
 
-def decay_numbers(problem: FitProblem, e_meas: np.ndarray, e_sim: np.ndarray) -> dict[str, float]:
+def decay_numbers(problem: FitProblem, e_meas: np.ndarray, e_sim: np.ndarray, factor: float) -> dict[str, float]:
     """b [1/s] of E = a exp(b t) and p of dE/dt = -k E^p fitted to the measured and simulated energies
-    on the same frames with the same errors; p's error with the residual-correlation factor."""
+    on the same frames with the same errors; the errors of the measured b and p with the record's
+    residual-correlation factor ``factor`` (:func:`common_factor`)."""
     t, s = problem.t, problem.sigma
-    power = fit_model("power", t, e_meas, s)
-    r_pow = (e_meas - MODELS["power"].func(t, *power.params)) / s
-    f_pow = effective_sample_factor(r_pow, LAG_FRAMES)
     exp_m = fit_model("exponential", t, e_meas, s)
-    r_exp = (e_meas - MODELS["exponential"].func(t, *exp_m.params)) / s
-    f_exp = effective_sample_factor(r_exp, LAG_FRAMES)
-    shape_m = decay_shape(t, e_meas, s, f_pow)
+    shape_m = decay_shape(t, e_meas, s, factor)
     shape_s = decay_shape(t, e_sim, s)
     return {
         "b_measured_per_s": exp_m.value("b"),
-        "b_measured_stderr": exp_m.error("b") * math.sqrt(f_exp),
+        "b_measured_stderr": exp_m.error("b") * math.sqrt(factor),
         "b_sim_per_s": fit_model("exponential", t, e_sim, s).value("b"),
         "p_measured": shape_m["p"],
         "p_measured_stderr": shape_m["p_stderr"],
         "p_sim": shape_s["p"],
     }
+
+
+OMEGA_REG_DEFAULT = BearingParameters().omega_reg
+"""The FMU's default omega_reg [rad/s] (parameter ``omega_reg``)."""
+REGULARISATION_WIDTHS = (1e-1, OMEGA_REG, OMEGA_REG_DEFAULT)
+"""omega_reg [rad/s] compared by :func:`regularisation_effect`: 10 times the fits', the fits', the FMU's default."""
+REGULARISATION_REFERENCE = 1e-5
+"""omega_reg [rad/s] of the reference run of :func:`regularisation_effect` (a near-sign function)."""
+REGULARISATION_SETTINGS = {"rtol": 1e-10, "atol": 1e-12}
+"""Tolerances of those runs: integration errors far below the differences measured."""
+
+
+def regularisation_effect(problem: FitProblem, model: str, theta: Sequence[float]) -> dict[str, Any]:
+    """What the width omega_reg [rad/s] of the friction sign functions tanh(omega / omega_reg) changes: ``model`` at
+    ``theta`` run over the record at each width of :data:`REGULARISATION_WIDTHS` against
+    :data:`REGULARISATION_REFERENCE`; per width the largest angle difference [rad], the relative change of the joint
+    losses' work, the change of chi2 against the measured energy. Below |omega| ~ omega_reg the torque is
+    viscous instead of constant, so the loss missing is about tau omega_reg per unit time near each reversal."""
+    works = sorted({m.work for m in mechanisms_of(model)} - {"W_air"})
+    outputs = ("phi1", "phi2", "E_pendulum", *works)
+    values = model_values(model, theta)
+    runs = {w: problem.simulate({**values, **REGULARISATION_SETTINGS, "omega_reg": w}, outputs=outputs)
+            for w in (*REGULARISATION_WIDTHS, REGULARISATION_REFERENCE)}  # fmt: skip
+
+    def chi2(run: np.ndarray) -> float:
+        r, _ = problem.scaled_residuals(np.asarray(run["E_pendulum"])[problem.offsets])
+        return float(r @ r)
+
+    ref = runs[REGULARISATION_REFERENCE]
+    joint_work = sum(float(ref[w][-1]) for w in works)
+    def angle_difference(run: np.ndarray) -> float:
+        return float(max(np.max(np.abs(run[k] - ref[k])) for k in ("phi1", "phi2")))
+
+    rows = {f"{w:g}": {"max_angle_difference_rad": angle_difference(runs[w]),
+                       "joint_work_relative_change": sum(float(runs[w][x][-1]) for x in works) / joint_work - 1.0,
+                       "delta_chi2": chi2(runs[w]) - chi2(ref)}
+            for w in REGULARISATION_WIDTHS}  # fmt: skip
+    return {"model": model, "reference_omega_reg_rad_per_s": REGULARISATION_REFERENCE,
+            "fits_omega_reg_rad_per_s": OMEGA_REG, "fmu_default_omega_reg_rad_per_s": OMEGA_REG_DEFAULT,
+            "record_s": problem.duration, "by_omega_reg_rad_per_s": rows}  # fmt: skip
 
 
 def air_share_at_defaults(problem: FitProblem, measured_loss: float) -> dict[str, float]:

@@ -27,6 +27,7 @@ from .comparison import (
     profile_item,
     profile_items,
     profile_summary,
+    regularisation_effect,
     share_errors,
 )
 from .fitting import fit_models, problem_from_track, run_budget
@@ -39,9 +40,14 @@ from .mechanisms import (
     SUSPENSION_M,
     THOROUGH_MODELS,
     mechanisms_of,
+    model_title,
     model_values,
     shares,
 )
+
+REGULARISED_MODEL = "air+drag"
+"""The model whose sensitivity to the friction regularisation the summary reports (``regularisation``): its drag
+torque is the regularised law measured_vs_sim uses (viscous damping has no sign function to regularise)."""
 
 
 def measured_loss(md: MeasuredDecay) -> float:
@@ -90,15 +96,23 @@ def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     dominates = bool(label in best["shares"] and best["shares"][label] > 0.5)
     if dominates:
         share = best["shares"][label]
-        text = f"Yes: the top model ({best['model']}) loses {share:.0%} of its energy in the suspension."
+        text = (f"Yes: the model with the lowest AIC ({model_title(best['model'])}) loses {share:.0%} of its energy in "
+                "the suspension.")
     else:
         parts = ", ".join(f"{m}: {s:.0%} (delta AIC {next(r['delta_aic'] for r in rows if r['model'] == m):.1f})"
                           for m, s in with_susp.items())  # fmt: skip
         if label in best["shares"]:
-            text = f"No: the suspension carries {best['shares'][label]:.0%} of the loss in the top model"
+            text = (f"No: the suspension carries {best['shares'][label]:.0%} of the loss in the model with the lowest "
+                    "AIC")
         else:
-            text = f"No: the top model ({best['model']}) needs no suspension loss"
+            text = f"No: the model with the lowest AIC ({model_title(best['model'])}) has no suspension"
         text += f"; suspension share where it is fitted: {parts}." if parts else "."
+    bound = loss_claims.suspension_bound(rows)
+    if bound is not None:
+        text += (f" As the main loss ({bound['model_in_words']}, at the assumed k = {SUSPENSION_K:g} N/m and M_s = "
+                 f"{SUSPENSION_M:g} kg) the suspension has no finite optimum: {bound['statement']}; so it fits worse "
+                 f"than the lowest AIC by at least delta AIC {bound['delta_aic_at_best']:.0f}, at these k and M_s "
+                 "only (suspension_transfer maps others).")
     return {"suspension_dominates": dominates, "answer": text, "suspension_share_by_model": with_susp}
 
 
@@ -139,7 +153,7 @@ def identify_losses(
     max_workers = 1 if quick else max_workers  # one model: no worker processes to start
     with worker_pool(max_workers) as pool:
         fits, workers = fit_models(models, problem, max_workers, pool, short=not thorough, max_runs=run_budget(quick))
-        factor = common_factor(fits)
+        factor = common_factor(problem)
         rows = comparison_rows(fits, factor)
         best = next(f for f in fits if f.model == rows[0]["model"])
         if thorough:
@@ -151,9 +165,12 @@ def identify_losses(
     result = problem.simulate(model_values(best.model, best.theta), outputs=("E_pendulum", *works), runner=runner)
     e_sim = np.asarray(result["E_pendulum"])[problem.offsets]
     _, kappa = problem.scaled_residuals(e_sim)
-    numbers = decay_numbers(problem, problem.energy, e_sim)
+    numbers = decay_numbers(problem, problem.energy, e_sim, factor)
     halves = half_residuals(problem, e_sim, kappa, factor)
     loss = measured_loss(md)
+    drag_fit = next((f for f in fits if f.model == REGULARISED_MODEL), None)
+    regularisation = (None if quick or drag_fit is None
+                      else regularisation_effect(problem, drag_fit.model, drag_fit.theta))
     summary = {
         "scenario": "loss_identification",
         "source": "seed Table 1 (data/seed_table1.csv), rigid links SEED_RIGID_LINKS",
@@ -176,13 +193,18 @@ def identify_losses(
         "profile_likelihood": profile,
         "energy_scale_kappa": kappa,
         "correlation_factor_F": factor,
+        "correlation_factor_from": "the record's residuals about the free-exponent decay law dE/dt = -k E^p "
+                                   "(decay.fit.record_correlation_factor), the same F for every model",
+        "supported_from_factor": loss_claims.supported_from_factor(rows, factor),
         "residual_halves": halves,
         "goal": goal_checks(numbers, halves),
         "measured_loss_J": loss,
         "simulated_loss_J": float(sum(float(result[w][-1]) for w in works)),
         **suspension_answer(rows),
+        "suspension_as_main_loss": loss_claims.suspension_bound(rows),
         "supported_models": loss_claims.supported_models(rows),
         "b_sim_range_all_models_per_s": loss_claims.b_sim_range(rows),
+        "load_proportional_friction_against_seed": loss_claims.seed_friction_coefficient(rows),
         "drag_torque_against_seed_rolling_friction": next(
             (loss_claims.seed_rolling_friction(rec.params, r["parameters"]["tau_b"]["value"]) for r in rows
              if r["model"] == "air+drag"), None),
@@ -190,7 +212,18 @@ def identify_losses(
         "models": rows,
         "suspension_fixed": {"k_N_per_m": SUSPENSION_K, "M_s_kg": SUSPENSION_M},
         "omega_reg_rad_per_s": OMEGA_REG,
+        "regularisation": regularisation,
         "null_means": {"suspension_dominates": "not tested: no model with a suspension was fitted (quick mode)",
+                       "suspension_as_main_loss": "not fitted (quick mode), or air+suspension converged to a "
+                                                  "finite damping",
+                       "stderr": "models[...].parameters of a model that did not converge: values where its fit "
+                                 "stopped, no standard errors",
+                       "relative_error": "as stderr: a model that did not converge has no standard errors",
+                       "reduces_to": "the model fits better than every converged model nested in it (or it did not "
+                                     "converge)",
+                       "parameter_correlation": "a model that did not converge: no curvature of an optimum",
+                       "supported_from_factor": "a model that joins the supported set at no F up to 10",
+                       "regularisation": "not measured in the quick run",
                        "profile_likelihood": "empty: profiled with --thorough only (its intervals matched the "
                                              "curvature errors in the runs so far)"},
         "start_state": {k: problem.base[k] for k in ("phi1_0", "phi2_0", "omega1_0", "omega2_0")},

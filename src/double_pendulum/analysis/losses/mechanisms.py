@@ -14,8 +14,6 @@ from typing import Any
 import numpy as np
 
 from ...model.parameters import AirDragParameters
-from ..decay.fit import AUTOCORRELATION_LAG_S
-from ..track.measurement import FPS
 
 OMEGA_REG = 0.01
 """Regularisation speed [rad/s] of the friction sign functions in every loss model."""
@@ -34,8 +32,6 @@ SUSPENSION_K = 2e4
 """Fixed spring stiffness [N/m] of the suspension mechanism (the parameter default)."""
 SUSPENSION_M = 2.0
 """Fixed suspension mass [kg] of the suspension mechanism (the parameter default)."""
-LAG_FRAMES = round(AUTOCORRELATION_LAG_S * FPS)
-"""Lag window [frames] of the residual autocorrelation (one slow swing)."""
 RHO_AIR = AirDragParameters().rho_air
 
 
@@ -122,12 +118,16 @@ MECHANISMS: dict[str, Mechanism] = {
 FULL_MODELS: tuple[str, ...] = (
     "air",
     "drag",
+    "viscous",
+    "bearing",
     "air+drag",
     "air+bearing",
     "air+viscous",
     "air+suspension",
 )
-"""Models of the default identification: mechanisms joined by '+'."""
+"""Models of the default identification: mechanisms joined by '+': each loss of the pendulum alone (air drag, the
+drag torque, viscous joint damping, load-proportional friction), each bearing loss with air drag, and the
+suspension with air drag."""
 THOROUGH_MODELS: tuple[str, ...] = (
     *FULL_MODELS,
     "air+drag2",
@@ -187,3 +187,10 @@ def shares(result: np.ndarray, model: str) -> dict[str, float]:
     works = {m.label: float(result[m.work][-1]) for m in mechanisms_of(model)}
     total = sum(works.values())
     return {name: w / total for name, w in works.items()}
+
+
+def model_title(model: str) -> str:
+    """A model in words: its mechanisms' labels joined by " + " (``air+drag``: "air drag + bearing drag torque"),
+    a single one "... alone"."""
+    labels = [m.label for m in mechanisms_of(model)]
+    return labels[0] + " alone" if len(labels) == 1 else " + ".join(labels)

@@ -12,9 +12,13 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ...results_io import report_opening
+from .mechanisms import model_title
 
-def _pm(value: float, err: float) -> str:
-    return f"{value:.3g} +- {err:.2g}"
+
+def _pm(value: float, err: float | None) -> str:
+    """``value +- err``; a value without an error (a fit that stopped short of an optimum): "stopped at value"."""
+    return f"stopped at {value:.3g}" if err is None else f"{value:.3g} +- {err:.2g}"
 
 
 def _unit(unit: str) -> str:
@@ -23,19 +27,23 @@ def _unit(unit: str) -> str:
 
 
 def model_table(rows: list[Mapping[str, Any]]) -> str:
-    """Markdown table: model, parameters with errors, chi2_red, dAIC, dBIC, Akaike weight, shares."""
-    lines = ["| model | parameters | chi2_red | dAIC | dBIC | Akaike weight | b_sim [1/s] | p_sim | loss shares |",
-             "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
+    """Markdown table, one model a row in words: parameters with errors, dAIC, Akaike weight, p_sim, shares."""
+    lines = ["| model | parameters | dAIC | Akaike weight | p_sim | loss shares |", "|---|---|---|---|---|---|"]
     for r in rows:
         params = ", ".join(f"{n} = {_pm(p['value'], p['stderr'])}{_unit(p['unit'])}"
                            for n, p in r["parameters"].items())
         shares = ", ".join(f"{k} {v:.0%}" for k, v in r["shares"].items())
-        if r.get("fit_stopped", "converged") != "converged":
-            shares += f" (fit stopped: {r['fit_stopped']}, its chi2 may lie above the model's minimum)"
-        if not r.get("converged", True):
-            shares += f" (not ranked: {r['not_ranked_because']})"
-        lines.append(f"| {r['model']} | {params} | {r['chi2_red']:.3f} | {r['delta_aic']:.1f} | {r['delta_bic']:.1f} "
-                     f"| {r['akaike_weight']:.3f} | {r.get('b_sim_per_s', float('nan')):.5f} "
+        daic = f"{r['delta_aic']:.1f}"
+        if "delta_aic_at_best" in r:  # its optimum is its nested limit: a bound, not a fit
+            daic = f"at best {r['delta_aic_at_best']:.0f}"
+            shares = f"no finite fit: its best is {model_title(r['best_is_limit_model'])} (see below)"
+        elif not r.get("converged", True):
+            daic, shares = "not ranked", f"{shares} (not ranked: {r['not_ranked_because']})"
+        elif r.get("fit_stopped", "converged") != "converged":
+            shares += f" (fit stopped: {r['fit_stopped']}, its chi2 may lie a little above the model's minimum)"
+        if r.get("reduces_to"):
+            shares += f" (no better than {model_title(r['reduces_to'])}, which it contains)"
+        lines.append(f"| {model_title(r['model'])} (`{r['model']}`) | {params} | {daic} | {r['akaike_weight']:.2f} "
                      f"| {r.get('p_sim', float('nan')):.2f} | {shares} |")  # fmt: skip
     return "\n".join(lines)
 
@@ -51,13 +59,70 @@ def parameter_lines(s: Mapping[str, Any]) -> str:
             lo, hi = prof["interval_1sigma"]
             fmt = lambda v: "beyond the profiled range" if v is None else f"{v:.3g}"  # noqa: E731
             interval = f"; profile (delta chi2/F = 1): {fmt(lo)} .. {fmt(hi)}"
-        verdict = "identified" if ident[name] else "NOT identified (relative error above 50 %)"
         partners = s["identifiability"].get("strongly_correlated", {}).get(name)
         if partners:
-            verdict += f"; strongly correlated with {', '.join(partners)}: the energy fixes their combination"
+            verdict = (f"not identified on its own: it correlates with {', '.join(partners)} beyond 0.95, so the "
+                       "energy fixes their combination, not each")
+        elif ident[name]:
+            verdict = "identified (in this model: its value assumes this model's mechanisms)"
+        else:
+            verdict = "NOT identified (relative error above 50 %)"
         out.append(f"- {name} = {_pm(p['value'], p['stderr'])}{_unit(p['unit'])} ({p['description']}; "
                    f"{p['relative_error']:.0%} relative{interval}) -- {verdict}")  # fmt: skip
     return "\n".join(out)
+
+
+def _factor_text(s: Mapping[str, Any]) -> str:
+    """How far F is from changing which models tie (``supported_from_factor``)."""
+    joins = {m: f for m, f in s.get("supported_from_factor", {}).items() if f is not None}
+    if not joins:
+        return ""
+    parts = ", ".join(f"{model_title(m)} from F = {f:.1f}" for m, f in joins.items())
+    return (f"With a larger F the chi2 differences shrink against the charge per fitted number and models with fewer "
+            f"numbers join the tie: {parts} (F = {s['correlation_factor_F']:.2f} here).")
+
+
+def _pair_text(s: Mapping[str, Any], max_corr: float = 0.95) -> str:
+    """Within each supported pair of losses, whether the record fixes each loss or only their combination."""
+    parts = []
+    for r in s["models"]:
+        corr = r.get("parameter_correlation")
+        if r["model"] not in s["supported_models"]["models"] or not corr or len(corr) != 2:
+            continue
+        a, b = list(r["parameters"])
+        if abs(corr[0][1]) > max_corr:
+            parts.append(f"in {model_title(r['model'])} {a} and {b} correlate at r = {corr[0][1]:+.3f}")
+    if not parts:
+        return ""
+    return ("Within the pairs the record fixes only the combination, not each loss (neither is identified on its "
+            "own, so the shares above are the total loss restated under the assumed pair): " + "; ".join(parts) + ".")
+
+
+def _correlation_note(s: Mapping[str, Any]) -> str:
+    """What a strong correlation of the parameters means for the shares."""
+    if not any(s["identifiability"].get("strongly_correlated", {}).values()):
+        return ""
+    return (" Where two parameters correlate this strongly the energy fixes their combination, not each: the split "
+            "below is the total loss restated under this one assumed pair of mechanisms.")
+
+
+def _regularisation_text(s: Mapping[str, Any]) -> str:
+    """What the width of the friction sign function changes (``regularisation``), or nothing in a quick run."""
+    reg = s.get("regularisation")
+    if not reg:
+        return ""
+    rows = reg["by_omega_reg_rad_per_s"]
+    fit = rows[f"{reg['fits_omega_reg_rad_per_s']:g}"]
+    fmu = rows[f"{reg['fmu_default_omega_reg_rad_per_s']:g}"]
+    return f"""## The friction regularisation
+
+The friction torques switch sign with the joint's rotation through tanh(omega / omega_reg) instead of a sharp
+step. The fits run at omega_reg = {reg['fits_omega_reg_rad_per_s']:g} rad/s (the FMU's default is
+{reg['fmu_default_omega_reg_rad_per_s']:g} rad/s). Against a near-sharp {reg['reference_omega_reg_rad_per_s']:g} rad/s,
+{model_title(reg['model'])} at its fitted values over the record moves the angles by at most
+{fit['max_angle_difference_rad']:.1e} rad at the fits' width ({fmu['max_angle_difference_rad']:.1e} rad at the
+FMU's), its joint losses by {fit['joint_work_relative_change']:+.1e} (relative) and chi2 by
+{fit['delta_chi2']:+.1e}: far below what separates the models."""
 
 
 def correlation_text(s: Mapping[str, Any]) -> str:
@@ -65,7 +130,7 @@ def correlation_text(s: Mapping[str, Any]) -> str:
     ident = s["identifiability"]
     names, corr = ident["parameters"], ident["correlation"]
     if len(names) < 2:
-        return "one parameter: no correlations."
+        return "none (one parameter)"
     pairs = [f"{names[i]}-{names[j]}: {corr[i][j]:+.3f}" for i in range(len(names)) for j in range(i + 1, len(names))]
     return ", ".join(pairs)
 
@@ -96,12 +161,76 @@ def seed_friction_text(s: Mapping[str, Any]) -> str:
     if not d:
         return ""
     lo, hi = sorted(d["fitted_over_seed"])
-    return (f"The fitted drag torque, {1e3 * d['fitted_tau_b_N_m']:.2f} mN.m per joint, is {lo:.0f} to {hi:.0f} times"
+    c_r = "".join(f" In {model_title(m)} the load-proportional law needs c_R = {v['c_R']:.3f}, "
+                  f"{min(v['over_seed']):.0f} to {max(v['over_seed']):.0f} times the seed's {d['c_R'][0]:g} to "
+                  f"{d['c_R'][1]:g} for ball bearings."
+                  for m, v in s.get("load_proportional_friction_against_seed", {}).items())
+    return (f"in air drag + bearing drag torque the fitted drag torque, {1e3 * d['fitted_tau_b_N_m']:.2f} mN.m per "
+            f"joint, is {lo:.0f} to {hi:.0f} times"
             f" the seed's own rolling-friction estimate as a torque (c_R = {d['c_R'][0]:g} to {d['c_R'][1]:g} times"
             f" r_b = {1e3 * d['r_b_m']:g} mm times the pivot's load {d['pivot_load_N']:.2f} N:"
             f" {1e6 * d['torque_N_m'][0]:.0f} to {1e6 * d['torque_N_m'][1]:.0f} uN.m). Such a torque is plausible"
             " for sealed ball bearings (seals and grease, of the order of 1 N.mm); the seed names its bearings'"
-            " maker, not their type or seals, so this stays an assumption.")
+            " maker, not their type or seals, so this stays an assumption." + c_r)
+
+
+def _opening(s: Mapping[str, Any]) -> str:
+    """Title, plain summary and the words used."""
+    title = "Loss identification: which mechanisms drain the seed's pendulum?"
+    lost = (f"The camera track shows the pendulum losing {s['measured_loss_J']:.2f} J of energy over "
+            f"{s['record_s']:.0f} s. ")
+    if s["quick"]:
+        return report_opening(title, [
+            lost + "This quick run (a smoke test) fits one assumed pair of losses, air drag and a constant friction "
+            "torque in the joints, with one step of the fit, and compares nothing.",
+            "Its numbers only show that the scenario runs; the default run compares the candidate losses.",
+            "Nothing here is a result about the pendulum.",
+        ], _terms(s))
+    sup = s["supported_models"]
+    air = sup["air_share_range"]
+    names = "; ".join(model_title(m) for m in sup["models"])
+    sentences = [
+        lost + "Simulating the pendulum with different assumed losses (air drag, friction torques in the joints, a "
+        "damped springy pivot) and adjusting each loss's strength until the simulated energy follows the measured "
+        "one, this report asks which losses can explain it.",
+        f"{len(sup['models'])} of the {len(s['models'])} candidates follow the measurement about equally well "
+        f"({names}), so the record shows how fast the energy falls but not which losses cause it"
+        + (f": air drag's share of the loss can be anything from {air[0]:.0%} to {air[1]:.0%}." if air else "."),
+    ]
+    bound = s.get("suspension_as_main_loss")
+    if bound:
+        sentences.append(f"A damped springy pivot as the main loss, the seed's explanation, fits clearly worse at the "
+                         f"stiffness and mass assumed here ({s['suspension_fixed']['k_N_per_m']:g} N/m, "
+                         f"{s['suspension_fixed']['M_s_kg']:g} kg): no damping makes it fit better than a rigid pivot.")
+    sentences.append("How sure: every fit is judged on the same record it was fitted to, and the verdict "
+                     "that the candidates tie holds unless the frames' errors are far more correlated than the "
+                     "data indicate (see F below).")
+    return report_opening(title, sentences, _terms(s))
+
+
+def _terms(s: Mapping[str, Any]) -> dict[str, str]:
+    """The words the report uses, explained."""
+    return {
+        "chi2": "the sum over the frames of ((simulated - measured energy) / the energy's error)^2; smaller fits "
+                "better",
+        "F": f"the correlation factor, here {s['correlation_factor_F']:.2f}: the errors of neighbouring frames are "
+             "alike over about one swing, so the frames count as n / F independent ones (F from the measured energy's "
+             "scatter about a smooth decay law, the same F for every model)",
+        "AIC": "Akaike's information criterion, chi2 / F + 2 k for a model with k fitted numbers: lower is better, and "
+               "every extra fitted number costs 2",
+        "dAIC": "a model's AIC minus the lowest AIC; below 2 the record does not tell two models apart",
+        "BIC": "the Bayesian information criterion chi2 / F + k ln(n / F), which charges extra numbers more",
+        "Akaike weight": "exp(-dAIC / 2) over the sum of that for all models fitted: each model's relative support "
+                         "among these candidates, not the probability that it is true",
+        "kappa": "one scale factor on the simulated energy, fitted with every model (the camera's energy calibration); "
+                 "it changes neither b nor p",
+        "b": "the decay rate [1/s] of the energy fitted as E = a exp(b t)",
+        "p": "the loss exponent of dE/dt = -k E^p: 0.5 for a constant friction torque, 1 for viscous damping, 1.5 for "
+             "air drag; p_sim is a simulated model's",
+        "in-sample": "judged on the same data the model was fitted to, so agreement there is expected, not a test",
+        "Gauss-Newton": "the fitting method: from a start, repeated linearised least-squares steps",
+        "rtol": "the integrator's relative error tolerance per step",
+    }
 
 
 def report_text(s: Mapping[str, Any]) -> str:
@@ -112,26 +241,25 @@ def report_text(s: Mapping[str, Any]) -> str:
     err = s.get("top_model_shares_stderr", {})
     shares = ", ".join(f"{k} {v:.0%} +- {err.get(k, 0.0):.0%}" for k, v in s["top_model_shares"].items())
     b_range = s.get("b_sim_range_all_models_per_s")
-    b_text = (f" Every converged model, air drag alone included, gives b_sim from {b_range[0]:.4f} to"
+    b_text = (f"Every converged model, air drag alone included, gives b_sim from {b_range[0]:.4f} to"
               f" {b_range[1]:.4f} 1/s: b is what the fit matches, so agreement in b discriminates nothing, and the"
               " agreement in p is in-sample (p was fitted on the same record)." if b_range else "")
-    mode = (" (quick mode, a smoke run: air+drag alone, one Gauss-Newton step at rtol 1e-5, no comparison, no"
+    mode = (" (quick mode, a smoke run: air drag + bearing drag torque alone, one Gauss-Newton step at rtol 1e-5, no"
+            " comparison, no"
             " profiles; its errors are the curvature errors of that step)" if s["quick"] else
             " (thorough: with air+drag2, the three-mechanism models and the profile likelihood)"
             if s.get("thorough") else
             " (default run: one and two mechanisms; `--thorough` adds air+drag2, the three-mechanism models"
             " air+drag+bearing, air+drag+viscous and air+drag+suspension and the best model's profile likelihood,"
             " about 2.5 min more CPU)")
-    return f"""# Loss identification: which mechanisms drain the seed's pendulum?
+    return _opening(s) + f"""## Method
 
 The measured energy of the seed's pendulum (camera track, Table 1; rigid links with 70 g acrylic
 members, `SEED_RIGID_LINKS`) over the whole record ({s['record_s']:.1f} s, {s['n_frames']} frames
 from t0 = {s['t0_s']:.3f} s) is fitted by the simulated energy of the pendulum, started in the
 measured state, for combinations of loss mechanisms{mode}. The fit scales the simulated energy by a
 calibration kappa = {s['energy_scale_kappa']:.4f} (camera energy against model energy; it changes
-neither b nor p). The residuals are correlated over about a swing: variance factor
-F = {s['correlation_factor_F']:.2f} (n_eff = n/F); AIC = chi2/F + 2k, BIC = chi2/F + k ln(n/F), errors
-multiplied by sqrt(F).
+neither b nor p). Errors of fitted numbers are multiplied by sqrt(F). {_factor_text(s)}
 
 ## Models
 
@@ -143,18 +271,19 @@ multiplied by sqrt(F).
 
 {s['supported_models']['text']}
 
+{_pair_text(s)}
+
+How plausible the fitted friction is, against the seed's own estimate: {seed_friction_text(s)}
+
 {SEPARATING_MEASUREMENTS}
 
 {per_joint_text(s['models'])}
 
-## The top model by AIC: {s['top_model']} (not a verdict)
+## The lowest AIC: {model_title(s['top_model'])} (not a verdict: see above)
 
 {parameter_lines(s)}
 
-Correlations: {correlation_text(s)}. Where two parameters correlate this strongly the energy fixes their
-combination, not each: the split below is the total loss restated under this one assumed pair of mechanisms.
-
-{seed_friction_text(s)}
+Correlations: {correlation_text(s)}.{_correlation_note(s)}
 
 Shares of the dissipated work over the record, in this model: {shares}. The model dissipates
 {s['simulated_loss_J']:.3f} J; the measured exponential fit loses {s['measured_loss_J']:.3f} J over the same frames.
@@ -163,17 +292,20 @@ Shares of the dissipated work over the record, in this model: {shares}. The mode
 
 {"![profile likelihood](profiles.png)" if s['profile_likelihood'] else ""}
 
-## Does the top model follow the measured energy over all 21 s?
+## Does the model with the lowest AIC follow the measured energy over all {s['record_s']:.0f} s?
 
-Exponential and power-law fits to the measured and to the simulated energy (FMU run of the top model) on the
-same frames with the same errors:
+Exponential and power-law fits to the measured and to the simulated energy (FMU run of that model) on the
+same frames with the same errors (in-sample: the model was fitted to these frames):
 
 {goal_text(s)}
+
 {b_text}
 
 ## Does the suspension dominate the loss (the seed's question)?
 
 {s['answer']}
+
+{_regularisation_text(s)}
 
 ## Air drag
 

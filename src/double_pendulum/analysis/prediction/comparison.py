@@ -235,7 +235,7 @@ def identified_losses(rec: Reconstruction, window_s: float | None = None, *, qui
     md = identification.measured(rec, window_s)
     problem = fitting.problem_from_track(rec, md, quick=quick)
     fit = fitting.identified_fit(LOSS_MODEL, problem, quick=quick)
-    factor = comparison.common_factor([fit])
+    factor = comparison.common_factor(problem)
     pendulum = {k: problem.base[k] for k in ("l1", "l2", "m1", "m2", *SEED_RIGID_LINKS)}
     return IdentifiedLosses(
         model=LOSS_MODEL,
@@ -521,18 +521,21 @@ def simulated_coordinates(rec: Reconstruction, prediction: Prediction) -> tuple[
     return np.asarray(prediction.result["time"]), {n: moved[:, i] + origin[n] for i, n in enumerate(POSITION_OUTPUTS)}
 
 
-def error_curves(
-    predictions: Sequence[Prediction], spread: tuple[np.ndarray, np.ndarray]
-) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Curves (t [s] since t0, error [m]) for the error plot: each run's lower-bob error smoothed by
-    :func:`smoothed` (the last run's per-frame error drawn first, under its smoothed one), and the spread."""
-    curves: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-    for i, p in enumerate(predictions):
-        if i == len(predictions) - 1:
-            curves[f"{run_title(p.label)}: lower bob, per frame"] = (p.t, p.e2)
-        curves[f"{run_title(p.label)}: lower bob, smoothed"] = (p.t, smoothed(p.t, p.e2))
-    curves["fit's uncertainty: spread of runs drawn from its covariance (median)"] = spread
-    return curves
+@dataclass(frozen=True)
+class ErrorCurves:
+    """The curves of the error plot, times [s] since t0 and errors [m]: each run's lower-bob error smoothed by
+    :func:`smoothed` (by run title, in the runs' order), the main (last) run's per-frame error, the spread."""
+
+    smoothed: dict[str, tuple[np.ndarray, np.ndarray]]
+    per_frame: tuple[str, np.ndarray, np.ndarray]
+    spread: tuple[np.ndarray, np.ndarray]
+
+
+def error_curves(predictions: Sequence[Prediction], spread: tuple[np.ndarray, np.ndarray]) -> ErrorCurves:
+    """:class:`ErrorCurves` of ``predictions`` (the main run last) and the ensemble ``spread``."""
+    main = predictions[-1]
+    return ErrorCurves({run_title(p.label): (p.t, smoothed(p.t, p.e2)) for p in predictions},
+                       (run_title(main.label), main.t, main.e2), spread)
 
 
 def headline_entries(headlines: dict[str, dict[str, Any]]) -> dict[str, Any]:

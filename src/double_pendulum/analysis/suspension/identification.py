@@ -9,8 +9,9 @@ on (:data:`LOSSES`).
 Measured decay (:func:`measured_decay`). The camera energy after the hand release with the
 calibrated errors of :func:`~double_pendulum.analysis.decay.fit.calibrate_error_model`, fitted with
 E = a exp(b t) (``decay_fit`` model ``exponential``); the error of b is inflated by
-sqrt(F), F the residual-correlation factor of
-:func:`~double_pendulum.analysis.decay.fit.effective_sample_factor`. Every FMU run starts from the state the
+sqrt(F), F the record's residual-correlation factor
+(:func:`~double_pendulum.analysis.decay.fit.record_correlation_factor`, also the factor of the damping's error).
+Every FMU run starts from the state the
 pendulum was measured in after the release (fitted to the first :data:`START_FIT_FRAMES` frames by
 :func:`double_pendulum.analysis.track.start_state.fit_start_state`).
 
@@ -55,15 +56,8 @@ import numpy as np
 
 from ...fmu.runner import FmuRunner
 from ...model.parameters import SuspensionParameters
-from ..decay.fit import (
-    AUTOCORRELATION_LAG_S,
-    MODELS,
-    FitResult,
-    calibrate_error_model,
-    effective_sample_factor,
-    fit_model,
-)
-from ..track.measurement import FPS, FRAME_INTERVAL, Reconstruction, load_track, reconstruct
+from ..decay.fit import FitResult, calibrate_error_model, fit_model, record_correlation_factor
+from ..track.measurement import FRAME_INTERVAL, Reconstruction, load_track, reconstruct
 from ..track.start_state import StartStateFit, fit_start_state, track_window
 from .response import ForceSpectrum, pivot_force_spectrum
 
@@ -125,7 +119,8 @@ class FitFrames:
 class MeasuredDecay:
     """The measured energy after the release with calibrated errors and its exponential fit.
 
-    ``factor`` is the residual-correlation variance factor of :func:`effective_sample_factor`;
+    ``factor`` is the record's residual-correlation variance factor
+    (:func:`~double_pendulum.analysis.decay.fit.record_correlation_factor`, the same for every fit to it);
     ``b_err`` is the fit error of b inflated by sqrt(factor).
     """
 
@@ -157,8 +152,7 @@ def measured_decay(rec: Reconstruction, window_s: float | None = None) -> Measur
     t, e = rec.t[idx], rec.energy[idx]
     errors = calibrate_error_model(t, e, rec.sigma_energy[idx], rec.momentum[idx])
     fit = fit_model("exponential", t, e, errors.sigma)
-    resid = (e - MODELS["exponential"].func(t, *fit.params)) / errors.sigma
-    factor = effective_sample_factor(resid, round(AUTOCORRELATION_LAG_S * FPS))
+    factor = record_correlation_factor(t, e, errors.sigma)
     frames = FitFrames(float(rec.t[i0]), idx - i0, t, errors.sigma)
     return MeasuredDecay(rec, int(i0), frames, e, fit, factor)
 
@@ -330,15 +324,15 @@ def identify_damping(
 
     :math:`\chi^2(c) = \sum_i (E^{FMU}_i(c) - E_i)^2/\sigma_i^2` with the calibrated errors,
     minimised by :func:`least_squares_1d`;
-    :math:`\sigma_c^2 = F / (J^T J)` with J = d r / d c at the optimum and F the
-    residual-correlation factor (:func:`~double_pendulum.analysis.decay.fit.effective_sample_factor`).
+    :math:`\sigma_c^2 = F / (J^T J)` with J = d r / d c at the optimum and F the record's
+    residual-correlation factor (``md.factor``: :func:`~double_pendulum.analysis.decay.fit.record_correlation_factor`).
     """
 
     def residuals(c: float) -> np.ndarray:
         return energy_residuals(runner, md, base, suspension_values(k, c, m_s))
 
     gn = least_squares_1d(residuals, c_guess, rel_step=C_DIFF_STEP, rel_tol=rel_tol, bounds=C_BOUNDS)
-    factor = effective_sample_factor(gn.residuals, round(AUTOCORRELATION_LAG_S * FPS))
+    factor = md.factor
     s_c = 1.0 / math.sqrt(float(gn.jac @ gn.jac))
     return Identification(
         k=k,

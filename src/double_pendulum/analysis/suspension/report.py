@@ -16,6 +16,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from ...results_io import report_opening
 from .decay_map import k_of_key
 
 
@@ -32,8 +33,10 @@ def _measured_section(s: Mapping[str, Any]) -> str:
 
 The camera energy (``double_pendulum.analysis.track.measurement``, calibrated errors, {m["n_frames"]} frames from the
 end of the hand release at t = {m["window_s"][0]:.2f} s to t = {m["window_s"][1]:.2f} s): E = a exp(b t) with
-a = {m["a_J"]:.4f} J, **b = {m["b_per_s"]:.5f} +- {m["b_per_s_stderr_autocorr"]:.5f} 1/s** (error inflated by the
-residual correlation, factor {m["autocorrelation_factor"]:.2f}); the seed printed b = {m["seed_b_per_s"]} 1/s.
+a = {m["a_J"]:.4f} J, **b = {m["b_per_s"]:.5f} +- {m["b_per_s_stderr_autocorr"]:.5f} 1/s** (statistical: the fit
+error inflated by the residual correlation, factor F = {m["autocorrelation_factor"]:.2f}; total with the systematic
+errors of ``energy_decay``'s error budget: +- {m["b_per_s_total_error"]:.4f} 1/s); the seed printed
+b = {m["seed_b_per_s"]} 1/s.
 The free exponent of dE/dt = -k E^p is p = {shape["p"]:.2f} +- {shape["p_stderr"]:.2f}.
 
 Every run starts at t0 = {m["t0_s"]:.3f} s from the state fitted to the positions of the first
@@ -220,7 +223,9 @@ inflated by sqrt({i["autocorrelation_factor"]:.1f}) for the correlated residuals
 **What this c is.** It is conditional: on the assumed k and M_s (not measured), on the default air drag and
 rolling friction beside it (not fitted), and on a model the data reject: refitted, it gives
 b = {refit["b_E_pendulum_per_s"]:.4f} 1/s against the measured {s["measured"]["b_per_s"]:.4f} 1/s
-({refit["difference_in_measured_sigma"]:.1f} standard errors off) and a loss exponent p = {refit["p"]:.2f}
+({refit["difference_in_total_sigma"]:+.1f} times the total error of the measured b, statistical and systematic;
+{refit["difference_in_measured_sigma"]:+.1f} times its statistical error alone), which b alone does not reject,
+and a loss exponent p = {refit["p"]:.2f}
 against the measured {s["measured"]["decay_shape"]["p"]:.2f} +- {s["measured"]["decay_shape"]["p_stderr"]:.2f}.
 Equally good fits lie along a valley (below), so c is not an identified property of the stand. Along the
 linearised valley through the fitted point (d ln c / d ln k = {f["valley_slope_dlnc_dlnk"]:.1f}; not refitted):
@@ -275,7 +280,7 @@ def _refit_section(s: Mapping[str, Any]) -> str:
     rows = "\n".join(
         f"| {label} | {r['b_E_pendulum_per_s']:.5f} | {r['b_E_total_per_s']:.5f} "
         f"| {100 * r['relative_difference_to_measured']:+.1f} % "
-        f"| {r['difference_in_measured_sigma']:+.1f} | {r['p']:.2f} | {r['chi2']:.0f} |"
+        f"| {r['difference_in_total_sigma']:+.1f} | {r['p']:.2f} | {r['chi2']:.0f} |"
         for label, r in s["refit"].items()
     )
     windows = "\n".join(
@@ -294,7 +299,7 @@ def _refit_section(s: Mapping[str, Any]) -> str:
 The identified parameters run again through the FMU and b fitted on the same frames with the same
 errors (measured: b = {m["b_per_s"]:.5f} +- {m["b_per_s_stderr_autocorr"]:.5f} 1/s, p = {m["decay_shape"]["p"]:.2f}):
 
-| run | b of E_pendulum [1/s] | b of E_total [1/s] | vs measured | in measured sigma | p | chi2 |
+| run | b of E_pendulum [1/s] | b of E_total [1/s] | vs measured | in total errors | p | chi2 |
 |---|---|---|---|---|---|---|
 {rows}
 
@@ -388,11 +393,45 @@ def _flow_text(s: Mapping[str, Any]) -> str:
     return text + "."
 
 
+def _opening(s: Mapping[str, Any], quick: str) -> str:
+    """Title, plain summary and the words used."""
+    m, i, refit = s["measured"], s["identified"], s["refit"]["identified"]
+    b0 = s["refit"]["no suspension"]["b_E_pendulum_per_s"]
+    return report_opening(f"Can the pivot's suspension explain the measured energy decay?{quick}", [
+        f"The camera shows the pendulum's energy decaying at b = {m['b_per_s']:.4f} 1/s; air drag and bearing friction "
+        f"at the seed's own estimates account for only {abs(b0):.4f} 1/s of it, so this report asks whether a springy, "
+        "damped mount of the pivot could take the rest.",
+        "Maps of the decay rate over the mount's stiffness k and damping c show that many mounts reproduce the "
+        "measured rate, along a curve in (k, c), not one.",
+        f"Fitting c at an assumed k = {i['fixed']['k']:g} N/m and mass M_s = {i['fixed']['M_s']:g} kg gives "
+        f"c = {i['c_N_s_per_m']:.0f} N s/m, but that suspension makes the loss depend on the swing's size far more "
+        f"steeply than measured (loss exponent {refit['p']:.1f} against {m['decay_shape']['p']:.1f}), so it is a "
+        "point on a curve of a model the data reject, not a property of the stand.",
+        "How sure: k and M_s are assumed, not measured, and every fit is judged on the record it was fitted to.",
+    ], {
+        "b": "the decay rate [1/s] of the energy fitted as E = a exp(b t)",
+        "p": "the loss exponent of dE/dt = -k E^p: how steeply the loss grows with the energy",
+        "F": "the correlation factor: the errors of neighbouring frames are alike over about a swing, so the frames "
+             "count as n / F independent ones and every statistical error is multiplied by sqrt(F)",
+        "total error": "the statistical error of b and its systematic errors (velocity estimator, weights, halves of "
+                       "the record, rod mass, pivot) added in quadrature, from the energy_decay scenario",
+        "iso-b curve": "the (k, c) where the simulated decay rate equals the measured one",
+        "chi2": "the sum over the frames of ((simulated - measured energy) / the energy's error)^2",
+        "chi2_red": "chi2 per degree of freedom; about 1 when a model misses the data by their errors",
+        "linear response": "the suspension's loss predicted from the spectrum of the force the pendulum exerts on a "
+                           "fixed pivot, without simulating the coupled motion",
+        "rtol": "the integrator's relative error tolerance per step",
+        "Jacobian": "the derivatives of the fit's residuals with respect to its parameters",
+        "Fisher matrix": "J^T J of the fit's Jacobian: its eigenvalues say which combinations of (k, c, M_s) the "
+                         "energy fixes (large) and which it leaves free (small)",
+    })
+
+
 def report_text(summary: Mapping[str, Any]) -> str:
     """The Markdown report: every figure from ``summary``."""
     quick = " (quick run: small grid, first seconds only)" if summary["quick"] else ""
     b0 = summary["refit"]["no suspension"]["b_E_pendulum_per_s"]
-    head = f"""# Can the pivot's suspension explain the measured energy decay?{quick}
+    head = _opening(summary, quick) + f"""## Question
 
 Air drag and bearing friction at the seed's estimates take b = {b0:.4f} 1/s
 of the measured {summary["measured"]["b_per_s"]:.4f} 1/s. How much can a damped suspension of the pivot add, which
@@ -400,8 +439,8 @@ suspensions reproduce the measurement, and is that the explanation? Run time {su
 The fitted c is a fit parameter, not a measured property: conditional on an assumed k and M_s and on the
 default losses, of a model that reproduces neither b nor the decay's shape, along a valley of equally good
 fits (Identification), it drifts with the fit window (below), and
-``loss_identification`` finds that a suspension does not explain the decay's shape as well as a
-load-independent bearing drag torque with air drag (see its report).
+``loss_identification`` finds that, at these k and M_s, a suspension with air drag fits the decay's shape no
+better than a rigid pivot, where friction in the joints fits it well (see its report).
 
 """
     sections = (_measured_section, _map_section, _identification_section, _refit_section, _flow_section)

@@ -29,9 +29,10 @@ from .response import ForceSpectrum
 # --- summary entries -----------------------------------------------------------------------------
 
 
-def measured_summary(md: MeasuredDecay, seed_b: float) -> dict[str, Any]:
+def measured_summary(md: MeasuredDecay, seed_b: float, total_b_err: float) -> dict[str, Any]:
     """The measured decay E = a exp(b t) after the release: window, a [J], b [1/s] with its plain and
-    correlation-inflated errors, the seed's b ``seed_b`` [1/s] and the decay shape p of dE/dt = -k E^p."""
+    correlation-inflated errors and its total error ``total_b_err`` [1/s] (statistical and systematic, the
+    ``energy_decay`` error budget's), the seed's b ``seed_b`` [1/s] and the decay shape p of dE/dt = -k E^p."""
     return {
         "t0_s": md.frames.t0,
         "release_frame": md.i0,
@@ -42,17 +43,19 @@ def measured_summary(md: MeasuredDecay, seed_b: float) -> dict[str, Any]:
         "b_per_s_stderr": md.fit.error("b"),
         "b_per_s_stderr_autocorr": md.b_err,
         "autocorrelation_factor": md.factor,
+        "b_per_s_total_error": total_b_err,
         "seed_b_per_s": seed_b,
         "decay_shape": decay_shape(md.frames.t, md.energy, md.frames.sigma, md.factor),
     }
 
 
-def run_summary(md: MeasuredDecay, result: np.ndarray, reference_chi2: float) -> dict[str, Any]:
+def run_summary(md: MeasuredDecay, result: np.ndarray, reference_chi2: float, total_b_err: float) -> dict[str, Any]:
     r"""b (of E_pendulum and E_total) [1/s], p and chi2 of one FMU run on the fitted frames.
 
     With the normalised residuals :math:`r_i = (E^{FMU}_i - E_i)/\sigma_i`:
     :math:`\chi^2 = \sum r_i^2`, ``delta_chi2`` = chi2 - ``reference_chi2``; b is compared with the
-    measured b relatively and in units of the measured error.
+    measured b relatively, in units of its statistical error (``difference_in_measured_sigma``) and of its total
+    error ``total_b_err`` [1/s] (``difference_in_total_sigma``, statistical and systematic: the one to judge by).
     """
     energy = np.asarray(result["E_pendulum"])[md.frames.offsets]
     r = (energy - md.energy) / md.frames.sigma
@@ -62,6 +65,7 @@ def run_summary(md: MeasuredDecay, result: np.ndarray, reference_chi2: float) ->
         "b_E_total_per_s": simulated_decay_rate(result, md.frames, "E_total"),
         "relative_difference_to_measured": (b - md.b) / md.b,
         "difference_in_measured_sigma": (b - md.b) / md.b_err,
+        "difference_in_total_sigma": (b - md.b) / total_b_err,
         "p": decay_shape(md.frames.t, energy, md.frames.sigma)["p"],
         "chi2": float(r @ r),
         "delta_chi2": float(r @ r) - reference_chi2,
@@ -194,11 +198,13 @@ def predicted_cuts(
 
 
 def natural_frequency_marks(spectrum: ForceSpectrum, ident: Identification) -> dict[str, float]:
-    """The identified suspension's natural frequencies [rad/s], labelled, to mark in the force spectrum."""
+    """The suspension's natural frequencies [rad/s] at the assumed k and M_s of the fit ``ident`` (both assumed, not
+    measured), labelled, to mark in the force spectrum."""
     w_x, w_y = math.sqrt(ident.k / ident.m_s), math.sqrt(ident.k / (ident.m_s + spectrum.m12))
+    assumed = f"at the assumed k = {ident.k:g} N/m, M_s = {ident.m_s:g} kg"
     return {
-        f"identified omega_n,x = sqrt(k/M_s) = {w_x:.0f} rad/s": w_x,
-        f"identified omega_n,y = sqrt(k/(M_s+m1+m2)) = {w_y:.0f} rad/s": w_y,
+        f"horizontal omega_n,x = sqrt(k/M_s) = {w_x:.0f} rad/s {assumed}": w_x,
+        f"vertical omega_n,y = sqrt(k/(M_s+m1+m2)) = {w_y:.0f} rad/s {assumed}": w_y,
     }
 
 
@@ -209,7 +215,8 @@ SPECTRUM_SHOWN_FROM = 1.0
 def shown_force_spectra(spectrum: ForceSpectrum) -> tuple[np.ndarray, dict[str, np.ndarray]]:
     """omega [rad/s] from :data:`SPECTRUM_SHOWN_FROM` and the PSDs of F_x, F_y [N^2 s/rad] there."""
     shown = spectrum.omega >= SPECTRUM_SHOWN_FROM
-    return spectrum.omega[shown], {"F_x": spectrum.s_x[shown], "F_y": spectrum.s_y[shown]}
+    return spectrum.omega[shown], {"horizontal pivot force F_x": spectrum.s_x[shown],
+                                   "vertical pivot force F_y": spectrum.s_y[shown]}
 
 
 def energy_fit_inputs(md: MeasuredDecay, runs: Mapping[str, np.ndarray]) -> dict[str, Any]:

@@ -1,0 +1,55 @@
+"""Ctrl-C within a run: an interrupt Python cannot raise (in a finaliser or a weakref callback) leaves no traceback
+on stderr; any other unraisable exception is still reported. In a fresh interpreter (pytest has its own hook)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+SCRIPT = """
+import gc, sys, weakref
+from double_pendulum.analysis import interrupts
+
+class Raises:
+    def __init__(self, error):
+        self.error = error
+    def __del__(self):
+        raise self.error("from a finaliser")
+
+def collect(error):
+    Raises(error)
+    gc.collect()
+
+class Key:
+    pass
+
+def lost_in_a_weak_key_dictionary():
+    table = weakref.WeakKeyDictionary()
+    key = Key()
+    table[key] = 1
+    weakref.finalize(key, lambda: (_ for _ in ()).throw(KeyboardInterrupt("in a weakref callback")))
+    del key
+    gc.collect()
+
+if sys.argv[1] == "run":
+    with interrupts.handling_interrupts():
+        collect(KeyboardInterrupt)
+        lost_in_a_weak_key_dictionary()
+        collect(ValueError)
+else:
+    collect(KeyboardInterrupt)
+"""
+
+
+def _stderr(mode: str) -> str:
+    return subprocess.run([sys.executable, "-c", SCRIPT, mode], capture_output=True, text=True, timeout=60).stderr
+
+
+def test_an_interrupt_lost_in_a_finaliser_prints_no_traceback_while_the_run_handles_ctrl_c():
+    err = _stderr("run")
+    assert "KeyboardInterrupt" not in err and "in a weakref callback" not in err
+    assert "ValueError: from a finaliser" in err and "Exception ignored" in err  # real errors still show
+
+
+def test_outside_a_run_python_reports_it_as_usual():
+    assert "KeyboardInterrupt: from a finaliser" in _stderr("plain")
