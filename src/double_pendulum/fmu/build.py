@@ -40,12 +40,13 @@ import shutil
 import sys
 import tempfile
 import zipfile
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
+from typing import Any
 from xml.etree import ElementTree as ET
 
 from ..component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
-from . import bundle, elf_needs, loader
+from . import bundle, elf_needs, loader, presets
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
@@ -233,18 +234,21 @@ def _note(message: str) -> None:
 
 
 def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], bytes], fmi_version: int = 2,
-                defines: dict[str, str] | None = None) -> None:
+                defines: dict[str, str] | None = None, start_values: Mapping[str, Any] | None = None) -> None:
     """Rewrite the zip: the private layout of the bundled code, the completed modelDescription, bytecode,
     the loader (compiled with the FMU's GUID and ``defines``) and ``bundle.json``.
 
     ``complete`` completes the modelDescription. Precompiled bytecode spares every fresh extraction
     (fmpy extracts the FMU anew for each ``simulate_fmu`` call) the compilation of the bundled
-    sources at start-up.
+    sources at start-up. ``start_values`` (checked) become the FMU's defaults (:mod:`.presets`).
     """
     with zipfile.ZipFile(fmu) as src:
         files = {item.filename: src.read(item.filename) for item in src.infolist()}
     files, identity = bundle.bundled_entries(files, model_identifier, fmi_version)
-    files["modelDescription.xml"] = complete(files["modelDescription.xml"])
+    files["modelDescription.xml"] = presets.apply_start_values(complete(files["modelDescription.xml"]),
+                                                               start_values or {})
+    if start_values:
+        files[presets.PRESET_FILE] = presets.preset_file(start_values)
     platform = loader.PLATFORMS[fmi_version]
     binary = f"binaries/{platform}/{model_identifier}.so"
     loader_binary = None
@@ -279,16 +283,19 @@ def check_platform_binary(fmu: Path, model_identifier: str, fmi_version: int = 2
                                f"binary for this platform installed ({library}.builder.FmuBuilder.has_binary())?")
 
 
-def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL_IDENTIFIER) -> Path:
+def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL_IDENTIFIER,
+              start_values: Mapping[str, Any] | None = None) -> Path:
     """Build the FMU ``model_identifier`` at ``dest`` (a ``.fmu`` path or a folder) and return its path.
 
-    The FMU is first written to a temporary folder and moved into place at the end, so a failed
-    build never leaves a broken FMU behind.
+    ``start_values`` (parameters by name) are baked in as the FMU's defaults (:mod:`.presets`). The FMU
+    is first written to a temporary folder and moved into place at the end, so a failed build never
+    leaves a broken FMU behind.
     """
     from pythonfmu.builder import FmuBuilder
 
     if model_identifier not in INTERFACES:
         raise ValueError(f"unknown model identifier {model_identifier!r}; known: {', '.join(INTERFACES)}")
+    start_values = presets.checked_start_values(model_identifier, start_values)
     dest = Path(dest)
     fmu_path = dest if dest.suffix == ".fmu" else dest / f"{model_identifier}.fmu"
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
@@ -304,7 +311,8 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
                 canSerializeFMUstate=True,
             )
         rewrite_fmu(Path(built), model_identifier, functools.partial(complete_model_description,
-                                                                     model_identifier=model_identifier))
+                                                                     model_identifier=model_identifier),
+                    start_values=start_values)
         check_platform_binary(Path(built), model_identifier)
         shutil.move(str(built), fmu_path)
     return fmu_path
