@@ -236,7 +236,8 @@ def _note(message: str) -> None:
 def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], bytes], fmi_version: int = 2,
                 defines: dict[str, str] | None = None, start_values: Mapping[str, Any] | None = None) -> None:
     """Rewrite the zip: the private layout of the bundled code, the completed modelDescription, bytecode,
-    the loader (compiled with the FMU's GUID and ``defines``) and ``bundle.json``.
+    the loader (compiled with the FMU's GUID and ``defines``), ``bundle.json``, and what a tool shows of
+    the FMU (documentation, icon, terminals: :mod:`.presentation`).
 
     ``complete`` completes the modelDescription. Precompiled bytecode spares every fresh extraction
     (fmpy extracts the FMU anew for each ``simulate_fmu`` call) the compilation of the bundled
@@ -262,6 +263,9 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
         files[binary] = loader_binary
         files[f"resources/{loader.CONFIG_NAME}"] = loader.python_record().encode()
     files[BUNDLE_FILE] = json.dumps({"id": identity, "guard": loader_binary is not None}).encode()
+    from .presentation import presentation_files  # here: matplotlib and numpy only when building
+
+    files.update(presentation_files(model_identifier, fmi_version, files, start_values))
     tmp = fmu.with_suffix(".fmu.tmp")
     with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
         for name, data in files.items():
@@ -346,7 +350,7 @@ def build_systems(
     fmus = (Path(pendulum_fmu), folder / "Suspension.fmu")
     return [
         write_ssp(folder / "PendulumOnSuspension.ssp", *fmus, values, macro_step=macro_step),
-        write_container(folder / "PendulumOnSuspension.fmu", *fmus, values, macro_step=macro_step),
+        write_container(folder / "PendulumOnSuspension.fmu", *fmus, values, macro_step=macro_step, documented=True),
     ]
 
 
