@@ -141,7 +141,7 @@ def _cases() -> tuple[ReferenceCase, ...]:
                       PENDULUM_OUTPUTS, CHAOTIC_TEXT),
         ReferenceCase("DoublePendulumFriction", "2.0", "cs", "DoublePendulum", FRICTION, 5.0, 0.01,
                       FRICTION_OUTPUTS, FRICTION_TEXT),
-        ReferenceCase("Suspension", "2.0", "cs", "Suspension", {}, 1.0, 0.001, SUSPENSION_OUTPUTS,
+        ReferenceCase("Suspension", "2.0", "cs", "Suspension", {}, 1.0, 0.002, SUSPENSION_OUTPUTS,
                       "the FMU as `double-pendulum build` writes it, loaded through its inputs (_in.csv): 2 N "
                       "sideways from 0.1 s to 0.4 s, 3 N more down from 0.6 s to 0.8 s (10 ms ramps), on top of "
                       "the static load", knots(load_pulses()), LOAD_PULSES[0], TIGHT),
