@@ -105,15 +105,20 @@ static int read_input_table(const char *path, input_table *table) {
     return table->rows && table->n_rows > 0;
 }
 
-/* The table's values at time `t` into `values` (one per column). */
+/* The table's values at time `t` into `values` (one per column), in fmpy's arithmetic (Input.interpolate:
+ * w0 = (t1 - t) / (t1 - t0), v = w0 v0 + (1 - w0) v1). */
 static void interpolate_inputs(const input_table *table, double t, double *values) {
     size_t width = 1 + table->n_columns, k = 0;
     const double *rows = table->rows;
-    while (k + 1 < table->n_rows && rows[(k + 1) * width] <= t) k++;
-    const double *a = rows + k * width, *b = k + 1 < table->n_rows ? a + width : a;
-    double share = b[0] > a[0] && t > a[0] ? (t - a[0]) / (b[0] - a[0]) : 0.0;
-    if (share > 1.0) share = 1.0;
-    for (size_t c = 0; c < table->n_columns; c++) values[c] = a[1 + c] + share * (b[1 + c] - a[1 + c]);
+    while (k < table->n_rows && rows[k * width] < t) k++; /* the first row at or after t */
+    if (k == 0 || k == table->n_rows) {                  /* hold the first or the last row */
+        const double *held = rows + (k == 0 ? 0 : table->n_rows - 1) * width;
+        for (size_t c = 0; c < table->n_columns; c++) values[c] = held[1 + c];
+        return;
+    }
+    const double *a = rows + (k - 1) * width, *b = rows + k * width;
+    double w0 = (b[0] - t) / (b[0] - a[0]), w1 = 1 - w0;
+    for (size_t c = 0; c < table->n_columns; c++) values[c] = w0 * a[1 + c] + w1 * b[1 + c];
 }
 
 /* Return 5 from the calling function if an FMI call fails (a status above Warning). */
