@@ -3,7 +3,8 @@
 The Cross-Check rules (v4.1, 9.1.2) ask every exported FMU to run in the checker without error, with the
 folder's ``_in.csv`` where it has inputs. The checker (FMI 1.0 and 2.0 only) instantiates the FMU
 with its defaults, sets every column of the input file before the experiment and again before every
-step, simulates to ``-s`` with steps of ``-h`` and writes the outputs (``-o``) and its log (``-e``),
+step, simulates to ``-s`` with steps of ``-h`` and writes the outputs (``-o``; at every step with ``-n 0``, else
+at most 500 rows, skipping some) and its log (``-e``),
 which ends with a summary of the warnings and errors the FMU and the checker reported.
 
 The checker is not part of the project: :func:`find_checker` looks for it in
@@ -59,8 +60,8 @@ def run_checker(checker: str | Path, folder: str | Path, case: ReferenceCase, ou
     folder, out = Path(folder), Path(out)
     out.mkdir(parents=True, exist_ok=True)
     log, result = out / f"{case.model}_cc.log", out / f"{case.model}_cc.csv"
-    command = [str(checker), "-l", "3", "-e", str(log), "-o", str(result), "-c", ",", "-s", f"{case.stop_time:g}",
-               "-h", f"{case.step_size:g}"]
+    command = [str(checker), "-l", "3", "-e", str(log), "-o", str(result), "-c", ",", "-n", "0",
+               "-s", f"{case.stop_time:g}", "-h", f"{case.step_size:g}"]
     if input_names(case):
         command += ["-i", str(folder / f"{case.model}_in.csv")]
     done = subprocess.run([*command, str(folder / f"{case.model}.fmu")], capture_output=True, text=True,

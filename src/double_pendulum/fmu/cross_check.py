@@ -43,7 +43,7 @@ def model_dir(root: str | Path, case: ReferenceCase) -> Path:
 def checker_command(case: ReferenceCase, checker: str = "fmuCheck.linux64") -> str:
     """How the FMI Compliance Checker runs the case (from the model's folder; the rules' section 9.1.2)."""
     inputs = f" -i {case.model}_in.csv" if input_names(case) else ""
-    return (f"{checker} -e {case.model}_cc.log{inputs} -o {case.model}_cc.csv -c , -s {case.stop_time:g} "
+    return (f"{checker} -e {case.model}_cc.log{inputs} -o {case.model}_cc.csv -c , -n 0 -s {case.stop_time:g} "
             f"-h {case.step_size:g} {case.model}.fmu")
 
 
