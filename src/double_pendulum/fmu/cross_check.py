@@ -50,8 +50,11 @@ def checker_command(case: ReferenceCase, checker: str = "fmuCheck.linux64") -> s
 def readme(case: ReferenceCase, record: Mapping[str, Any]) -> str:
     """``ReadMe.md`` of the case's folder: what it tests, how the reference was made, how to run it."""
     made = record.get("made_with", {})
-    start = ", ".join(f"{k} = {v}" for k, v in record.get("run_start_values", {}).items())
+    start = ", ".join(f"{k} = {v}" for k, v in record.get("run_start_values", {}).items()) or "none (its defaults)"
     baked = ", ".join(f"{k} = {v}" for k, v in case.baked.items())
+    difference = record.get("max_abs_difference_to_cs_at_rtol_1e-12")
+    floor = (f" CVode's largest difference to the FMU's own integrator at rtol 1e-12 (Co-Simulation): "
+             f"{difference:.2g}." if difference is not None else "")
     files = [f"`{case.model}.fmu`", f"`{case.model}_ref.csv`", f"`{case.model}_ref.opt`"]
     if input_names(case):
         files.append(f"`{case.model}_in.csv` (every input of the FMU; linear between its rows)")
@@ -81,10 +84,11 @@ Files: {", ".join(files)}.
 
 ## Reference result
 
-{record.get("solver", "")}, start values set for the run: {start or "none"}. Made with double-pendulum-fmu
-{made.get("double-pendulum-fmu", "")}, fmpy {made.get("fmpy", "")}, Python {made.get("python", "")} on
-{made.get("platform", "")} by `{record.get("script", "data/reference/fmu/make_fmu_references.py")}`; columns: the
-time and {len(case.outputs)} outputs.
+Run in fmpy, {record.get("solver", "")}; start values set for the run: {start}.{floor}
+Made with double-pendulum-fmu {made.get("double-pendulum-fmu", "")}, fmpy
+{made.get("fmpy", "")}, Python {made.get("python", "")} on {made.get("platform", "")} by
+`{record.get("script", "data/reference/fmu/make_fmu_references.py")}`. Columns: the time and {len(case.outputs)}
+outputs. fmpy's `fmpy.cross_check.validate_result` judges an import against it.
 
 ## Compliance Checker
 
