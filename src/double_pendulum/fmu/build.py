@@ -23,7 +23,10 @@ modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the buil
   building CPython in ``resources/python.cfg``;
 * writes ``resources/bundle.json`` (a hash of the bundled code, and whether the guard is the
   binary), which makes the FMU import its bundled code under private names
-  (``fmu_src/slave_common.py``).
+  (``fmu_src/slave_common.py``);
+* bakes in the start values it is given (:mod:`double_pendulum.fmu.presets`);
+* adds what a tool shows of the FMU: ``documentation/``, the icon and ``terminalsAndIcons/``
+  (:mod:`double_pendulum.fmu.presentation`).
 
 The FMU needs nothing installed where it runs: only a CPython >= 3.11 and its standard library.
 Every FMU written is checked to hold a binary for this platform.
