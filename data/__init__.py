@@ -1,7 +1,8 @@
 """The project's data, shipped inside the package as ``double_pendulum.data``.
 
-``seed_table1.csv`` is the seed report's measured track (Table 1) and ``reference/`` holds
-reference trajectories; see ``README.md`` beside this file. The ``.py`` scripts here regenerate
+``seed_table1.csv`` is the seed report's measured track (Table 1), ``reference/`` holds
+reference trajectories and ``reference/fmu/`` the FMUs' reference results; see ``README.md`` beside
+this file. The ``.py`` scripts here regenerate
 them and are not imported by the package.
 """
 

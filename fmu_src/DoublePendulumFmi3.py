@@ -63,7 +63,7 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
         # the tolerance of a Model Exchange host: the co-simulation's own default rtol
         rtol = _cosimulation.default_parameter_values()["rtol"]
         self.default_experiment = DefaultExperiment(**_interface.default_experiment, tolerance=rtol)
-        self._sim = self.make_component()
+        self._sim = self.new_component()
         self._states: PendulumStates | None = None  # from fmi3ExitInitializationMode on
         self._model_exchange_used = False
         self.register_variable(Float64("time", causality=Causality.independent, variability=Variability.continuous,

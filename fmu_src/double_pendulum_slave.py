@@ -47,7 +47,7 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self._sim = self.make_component()
+        self._sim = self.new_component()
         for var in self.interface.variables():
             self._register(var)
         # the hot paths of fmi2SetReal and fmi2GetReal (see set_real, get_real)

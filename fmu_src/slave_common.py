@@ -29,6 +29,7 @@ from types import ModuleType
 
 RESOURCES = Path(__file__).resolve().parent.parent  # in a built FMU: this package's folder is in resources/
 BUNDLE_FILE = "bundle.json"  # written by the build (double_pendulum.fmu.build)
+PRESET_FILE = "start_values.json"  # start values baked in by the build (double_pendulum.fmu.presets)
 STDERR_SWITCH = "DOUBLE_PENDULUM_FMU_STDERR"  # "0": errors go to the FMI log only
 PRIVATE_MARK = "_dp_fmu_"  # every private module name starts with it
 
@@ -101,6 +102,18 @@ def leave_host_as_found(resources: str | None) -> None:
     folder = os.path.normpath(resources or RESOURCES)  # the library inserts the string it was given
     if any(entry == folder or os.path.normpath(entry) == folder for entry in sys.path if entry):
         sys.path[:] = [entry for entry in sys.path if not entry or os.path.normpath(entry) != folder]
+
+
+def baked_start_values(resources: str | None) -> dict:
+    """The start values the build baked into this FMU (``resources/start_values.json``), ``{}`` for none.
+
+    Read from the instance's own resources folder at every instantiation and reset: FMUs of one bundle
+    share their modules, not their start values.
+    """
+    try:
+        return json.loads((Path(resources or RESOURCES) / PRESET_FILE).read_text())
+    except FileNotFoundError:
+        return {}
 
 
 class _StoredRepr(type):
@@ -196,6 +209,13 @@ class ComponentMapping:
 
     def make_component(self):
         raise NotImplementedError
+
+    def new_component(self):
+        """A fresh component with the start values baked into this FMU (:func:`baked_start_values`)."""
+        component = self.make_component()
+        for name, value in baked_start_values(self.resources).items():
+            component.set(name, value)
+        return component
 
     def _output(self, name: str) -> float:
         """Output ``name``; before initialisation from the parameters and inputs set so far.

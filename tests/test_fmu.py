@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import subprocess
 import sys
 import sysconfig
@@ -293,3 +294,16 @@ def test_without_a_c_compiler_the_build_says_so_once_and_keeps_pythonfmus_binary
     with zipfile.ZipFile(fmi3) as z:  # the FMI 3 FMU alike, with pythonfmu3's binary
         binaries = [n for n in z.namelist() if n.startswith("binaries/x86_64-linux/")]
         assert binaries == ["binaries/x86_64-linux/DoublePendulum.so"] and z.read(binaries[0]) == plain3
+
+
+def test_a_newer_build_module_makes_the_fmu_stale(fmu_path, tmp_path, monkeypatch):
+    """The FMU holds what the build's own modules write (documentation, icon, terminals): a change to one
+    of them, not only to the bundled code, means the FMU must be built again."""
+    from double_pendulum.fmu import build
+
+    assert build.fmu_is_current(fmu_path)
+    newer = tmp_path / "documentation.py"
+    newer.write_text("")
+    os.utime(newer, (fmu_path.stat().st_mtime + 60,) * 2)
+    monkeypatch.setattr(build, "build_sources", lambda: [newer])
+    assert not build.fmu_is_current(fmu_path)

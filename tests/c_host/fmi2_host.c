@@ -7,7 +7,10 @@
  * mode), runs STEPS doSteps of STEP_SIZE from t = 0 (inputs set before each), reads the outputs,
  * terminates and frees the instance, and unloads the library.
  * ARGs: r:VR=VALUE (Real start value), b:VR=0|1 (Boolean), s:VR=TEXT (String), i:VR=VALUE (Real
- * input set before every doStep), o:VR (Real read at the end, printed as "VR VALUE" with 17 digits).
+ * input set before every doStep), f:PATH (an input table, host_common.h: its inputs interpolated at each
+ * communication point and set in initialisation mode and before every doStep, as the FMI Compliance
+ * Checker and fmpy set an _in.csv), o:VR (Real read at the end, printed as "VR VALUE" with 17 digits),
+ * O:VR (Real read at every communication point from the start, printed as "row T VALUE ..." lines).
  * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE". At the end the host prints
  * "startup-cpu-seconds T" (the process's CPU time from loading the library to the end of the first
  * doStep) and "host-unchanged 1" if its environment and its signal handlers are as they were before
@@ -78,10 +81,11 @@ int main(int argc, char **argv) {
         return 4;
     }
 
-    fmi2ValueReference inputs[MAX_ARGS], outputs[MAX_ARGS];
-    fmi2Real input_values[MAX_ARGS];
-    size_t n_inputs = 0, n_outputs = 0;
-    for (int k = 6; k < argc && n_inputs < MAX_ARGS && n_outputs < MAX_ARGS; k++) {
+    fmi2ValueReference inputs[MAX_ARGS], outputs[MAX_ARGS], recorded[MAX_ARGS];
+    fmi2Real input_values[MAX_ARGS], table_values[MAX_ARGS], row[MAX_ARGS];
+    size_t n_inputs = 0, n_outputs = 0, n_recorded = 0;
+    static input_table table;
+    for (int k = 6; k < argc && n_inputs < MAX_ARGS && n_outputs < MAX_ARGS && n_recorded < MAX_ARGS; k++) {
         host_argument a;
         if (!parse_argument(argv[k], &a) || a.kind == 'j') {
             fprintf(stderr, "bad argument %s\n", argv[k]);
@@ -90,20 +94,42 @@ int main(int argc, char **argv) {
         fmi2ValueReference vr = a.vr;
         fmi2Boolean boolean = atoi(a.text) ? fmi2True : fmi2False;
         if (a.kind == 'o') outputs[n_outputs++] = vr;
+        else if (a.kind == 'O') recorded[n_recorded++] = vr;
+        else if (a.kind == 'f' && !read_input_table(a.text, &table)) {
+            fprintf(stderr, "cannot read the input table %s\n", a.text);
+            return 2;
+        }
+        else if (a.kind == 'f') continue;
         else if (a.kind == 'r') CHECK(set_real(c, &vr, 1, &a.real));
         else if (a.kind == 'b') CHECK(set_boolean(c, &vr, 1, &boolean));
         else if (a.kind == 's') CHECK(set_string(c, &vr, 1, &a.text));
         else inputs[n_inputs] = vr, input_values[n_inputs++] = a.real;
     }
 
+#define SET_TABLE(t)                                                                                             \
+    if (table.n_columns) {                                                                                        \
+        interpolate_inputs(&table, (t), table_values);                                                            \
+        CHECK(set_real(c, table.vr, table.n_columns, table_values));                                              \
+    }
+#define RECORD(t)                                                                                                \
+    if (n_recorded) {                                                                                             \
+        CHECK(get_real(c, recorded, n_recorded, row));                                                            \
+        printf("row %.17g", (t));                                                                                 \
+        for (size_t r = 0; r < n_recorded; r++) printf(" %.17g", row[r]);                                         \
+        printf("\n");                                                                                             \
+    }
     CHECK(setup(c, fmi2False, 0.0, 0.0, fmi2True, steps * step_size));
     CHECK(enter(c));
     if (n_inputs) CHECK(set_real(c, inputs, n_inputs, input_values));
+    SET_TABLE(0.0);
     CHECK(exit_init(c));
+    RECORD(0.0);
     for (long k = 0; k < steps; k++) { /* communication points k h, as fmpy's simulate_fmu steps */
         if (n_inputs) CHECK(set_real(c, inputs, n_inputs, input_values));
+        SET_TABLE(k * step_size);
         CHECK(do_step(c, k * step_size, (k + 1) * step_size - k * step_size, fmi2True));
         if (k == 0) clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &first_step);
+        RECORD((k + 1) * step_size);
     }
     fmi2Real values[MAX_ARGS];
     if (n_outputs) CHECK(get_real(c, outputs, n_outputs, values));

@@ -19,7 +19,10 @@
  * true and lastSuccessfulTime = NaN in fmi3DoStep.
  * ARGs: r:VR=VALUE (Float64 start value), b:VR=0|1 (Boolean), s:VR=TEXT (String), i:VR=VALUE (input,
  * continuous: set before every evaluation), j:VR=VALUE@T (that input jumps to VALUE at the step end
- * nearest T, in Event Mode), o:VR (Float64 read at the end, printed as "VR VALUE" with 17 digits).
+ * nearest T, in Event Mode), f:PATH (an input table, host_common.h: interpolated at each evaluation under
+ * Model Exchange, at each communication point under Co-Simulation), o:VR (Float64 read at the end,
+ * printed as "VR VALUE" with 17 digits), O:VR (Float64 read at every step's end from the start, printed
+ * as "row T VALUE ..." lines).
  * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE". At the end it prints "events N",
  * "event-iterations N", "derivative-evaluations N" and "host-unchanged 1" if its environment and
  * signal handlers are as before it loaded the FMU. Exit status: 0 on success, 2 bad usage, 3 library
@@ -53,6 +56,30 @@ static fmi3ValueReference inputs[MAX_ARGS], jumps[MAX_ARGS];
 static fmi3Float64 input_values[MAX_ARGS], jump_values[MAX_ARGS], jump_times[MAX_ARGS];
 static size_t n_inputs, n_jumps;
 static long evaluations;
+static input_table table;
+static fmi3Float64 table_values[MAX_ARGS];
+static fmi3ValueReference recorded[MAX_ARGS];
+static size_t n_recorded;
+
+/* Set the input table's values at time t (nothing without a table). */
+static fmi3Status set_table(fmi3Instance c, double t) {
+    FUNCTION(fmi3SetFloat64);
+    if (!table.n_columns) return fmi3OK;
+    interpolate_inputs(&table, t, table_values);
+    return fmi3SetFloat64(c, table.vr, table.n_columns, table_values, table.n_columns);
+}
+
+/* Print the recorded outputs at time t as a "row" line (nothing without O: arguments). */
+static fmi3Status record_row(fmi3Instance c, double t) {
+    FUNCTION(fmi3GetFloat64);
+    fmi3Float64 row[MAX_ARGS];
+    if (!n_recorded) return fmi3OK;
+    fmi3Status status = fmi3GetFloat64(c, recorded, n_recorded, row, n_recorded);
+    printf("row %.17g", t);
+    for (size_t r = 0; r < n_recorded; r++) printf(" %.17g", row[r]);
+    printf("\n");
+    return status;
+}
 
 /* der(x) at (t, x): fmi3SetTime, inputs, fmi3SetContinuousStates, fmi3GetContinuousStateDerivatives
  * (dx NULL: only set time, inputs and states). */
@@ -63,6 +90,7 @@ static fmi3Status derivatives(fmi3Instance c, fmi3Float64 t, const fmi3Float64 x
     FUNCTION(fmi3GetContinuousStateDerivatives);
     fmi3Status status = fmi3SetTime(c, t);
     if (status <= fmi3Warning && n_inputs) status = fmi3SetFloat64(c, inputs, n_inputs, input_values, n_inputs);
+    if (status <= fmi3Warning) status = set_table(c, t);
     if (status <= fmi3Warning) status = fmi3SetContinuousStates(c, x, n);
     if (status <= fmi3Warning && dx) {
         status = fmi3GetContinuousStateDerivatives(c, dx, n);
@@ -114,6 +142,7 @@ static int run_model_exchange(fmi3Instance c, int rk4, long steps, double h, lon
     CHECK(fmi3EnterContinuousTimeMode(c));
     CHECK(fmi3GetContinuousStates(c, x, n));
     if (nz) CHECK(fmi3GetEventIndicators(c, z, nz));
+    CHECK(record_row(c, 0.0));
     for (long step = 0; step < steps; step++) {
         double t = step * h, t_end = (step + 1) * h;
         CHECK(derivatives(c, t, x, k1, n));
@@ -154,6 +183,7 @@ static int run_model_exchange(fmi3Instance c, int rk4, long steps, double h, lon
             CHECK(fmi3EnterContinuousTimeMode(c));
         }
         if (nz) CHECK(fmi3GetEventIndicators(c, z, nz));
+        CHECK(record_row(c, t_end));
     }
     return 0;
 }
@@ -161,8 +191,10 @@ static int run_model_exchange(fmi3Instance c, int rk4, long steps, double h, lon
 static int run_co_simulation(fmi3Instance c, long steps, double h) {
     FUNCTION(fmi3DoStep);
     FUNCTION(fmi3SetFloat64);
+    CHECK(record_row(c, 0.0));
     for (long step = 0; step < steps; step++) {
         if (n_inputs) CHECK(fmi3SetFloat64(c, inputs, n_inputs, input_values, n_inputs));
+        CHECK(set_table(c, step * h));
         fmi3Boolean event = fmi3True, terminate = fmi3True, early = fmi3True;
         fmi3Float64 reached = NAN;
         CHECK(fmi3DoStep(c, step * h, (step + 1) * h - step * h, fmi3True, &event, &terminate, &early, &reached));
@@ -171,6 +203,7 @@ static int run_co_simulation(fmi3Instance c, long steps, double h) {
                     step * h, (int)early, (int)terminate, reached);
             return 5;
         }
+        CHECK(record_row(c, (step + 1) * h));
     }
     return 0;
 }
@@ -225,6 +258,12 @@ int main(int argc, char **argv) {
         fmi3ValueReference vr = a.vr;
         fmi3Boolean boolean = atoi(a.text) ? fmi3True : fmi3False;
         if (a.kind == 'o') outputs[n_outputs++] = vr;
+        else if (a.kind == 'O' && n_recorded < MAX_ARGS) recorded[n_recorded++] = vr;
+        else if (a.kind == 'f' && !read_input_table(a.text, &table)) {
+            fprintf(stderr, "cannot read the input table %s\n", a.text);
+            return 2;
+        }
+        else if (a.kind == 'f') continue;
         else if (a.kind == 'r') CHECK(fmi3SetFloat64(c, &vr, 1, &a.real, 1));
         else if (a.kind == 'b') CHECK(fmi3SetBoolean(c, &vr, 1, &boolean, 1));
         else if (a.kind == 's') CHECK(fmi3SetString(c, &vr, 1, &a.text, 1));
@@ -234,6 +273,7 @@ int main(int argc, char **argv) {
 
     CHECK(fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3True, steps * h));
     if (n_inputs) CHECK(fmi3SetFloat64(c, inputs, n_inputs, input_values, n_inputs));
+    CHECK(set_table(c, 0.0));
     CHECK(fmi3ExitInitializationMode(c));
     long events = 0, iterations = 0;
     int status = cs ? run_co_simulation(c, steps, h) : run_model_exchange(c, rk4, steps, h, &events, &iterations);

@@ -41,6 +41,7 @@ class FmuVariable(NamedTuple):
     unit: str  # FMI unit string, "" for none
     description: str
     start: Any  # start value for parameters and inputs, None for outputs
+    rule: str = ""  # a parameter's validity rule (double_pendulum.model.parameters.spec): "positive", ...
 
 
 def _fmi_type(rule: str) -> str:
@@ -67,11 +68,13 @@ def _variables(
             f.metadata["unit"],
             described(f.metadata["description"], f.metadata["unit"]),
             f.default,
+            f.metadata["rule"],
         )
         for f in parameters
     ]
     variables += [
-        FmuVariable(q.name, "Real", "input", q.unit, described(q.description, q.unit), input_start.get(q.name, 0.0))
+        FmuVariable(q.name, "Real", "input", q.unit, described(q.description, q.unit), input_start.get(q.name, 0.0),
+                    "finite")
         for q in inputs
     ]
     variables += [

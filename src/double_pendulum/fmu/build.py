@@ -23,7 +23,10 @@ modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the buil
   building CPython in ``resources/python.cfg``;
 * writes ``resources/bundle.json`` (a hash of the bundled code, and whether the guard is the
   binary), which makes the FMU import its bundled code under private names
-  (``fmu_src/slave_common.py``).
+  (``fmu_src/slave_common.py``);
+* bakes in the start values it is given (:mod:`double_pendulum.fmu.presets`);
+* adds what a tool shows of the FMU: ``documentation/``, the icon and ``terminalsAndIcons/``
+  (:mod:`double_pendulum.fmu.presentation`).
 
 The FMU needs nothing installed where it runs: only a CPython >= 3.11 and its standard library.
 Every FMU written is checked to hold a binary for this platform.
@@ -40,12 +43,13 @@ import shutil
 import sys
 import tempfile
 import zipfile
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
+from typing import Any
 from xml.etree import ElementTree as ET
 
 from ..component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
-from . import bundle, elf_needs, loader
+from . import bundle, elf_needs, loader, presets
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
@@ -233,18 +237,22 @@ def _note(message: str) -> None:
 
 
 def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], bytes], fmi_version: int = 2,
-                defines: dict[str, str] | None = None) -> None:
+                defines: dict[str, str] | None = None, start_values: Mapping[str, Any] | None = None) -> None:
     """Rewrite the zip: the private layout of the bundled code, the completed modelDescription, bytecode,
-    the loader (compiled with the FMU's GUID and ``defines``) and ``bundle.json``.
+    the loader (compiled with the FMU's GUID and ``defines``), ``bundle.json``, and what a tool shows of
+    the FMU (documentation, icon, terminals: :mod:`.presentation`).
 
     ``complete`` completes the modelDescription. Precompiled bytecode spares every fresh extraction
     (fmpy extracts the FMU anew for each ``simulate_fmu`` call) the compilation of the bundled
-    sources at start-up.
+    sources at start-up. ``start_values`` (checked) become the FMU's defaults (:mod:`.presets`).
     """
     with zipfile.ZipFile(fmu) as src:
         files = {item.filename: src.read(item.filename) for item in src.infolist()}
     files, identity = bundle.bundled_entries(files, model_identifier, fmi_version)
-    files["modelDescription.xml"] = complete(files["modelDescription.xml"])
+    files["modelDescription.xml"] = presets.apply_start_values(complete(files["modelDescription.xml"]),
+                                                               start_values or {})
+    if start_values:
+        files[presets.PRESET_FILE] = presets.preset_file(start_values)
     platform = loader.PLATFORMS[fmi_version]
     binary = f"binaries/{platform}/{model_identifier}.so"
     loader_binary = None
@@ -258,6 +266,9 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
         files[binary] = loader_binary
         files[f"resources/{loader.CONFIG_NAME}"] = loader.python_record().encode()
     files[BUNDLE_FILE] = json.dumps({"id": identity, "guard": loader_binary is not None}).encode()
+    from .presentation import presentation_files  # here: matplotlib and numpy only when building
+
+    files.update(presentation_files(model_identifier, fmi_version, files, start_values))
     tmp = fmu.with_suffix(".fmu.tmp")
     with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
         for name, data in files.items():
@@ -279,16 +290,19 @@ def check_platform_binary(fmu: Path, model_identifier: str, fmi_version: int = 2
                                f"binary for this platform installed ({library}.builder.FmuBuilder.has_binary())?")
 
 
-def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL_IDENTIFIER) -> Path:
+def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL_IDENTIFIER,
+              start_values: Mapping[str, Any] | None = None) -> Path:
     """Build the FMU ``model_identifier`` at ``dest`` (a ``.fmu`` path or a folder) and return its path.
 
-    The FMU is first written to a temporary folder and moved into place at the end, so a failed
-    build never leaves a broken FMU behind.
+    ``start_values`` (parameters by name) are baked in as the FMU's defaults (:mod:`.presets`). The FMU
+    is first written to a temporary folder and moved into place at the end, so a failed build never
+    leaves a broken FMU behind.
     """
     from pythonfmu.builder import FmuBuilder
 
     if model_identifier not in INTERFACES:
         raise ValueError(f"unknown model identifier {model_identifier!r}; known: {', '.join(INTERFACES)}")
+    start_values = presets.checked_start_values(model_identifier, start_values)
     dest = Path(dest)
     fmu_path = dest if dest.suffix == ".fmu" else dest / f"{model_identifier}.fmu"
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
@@ -304,7 +318,8 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
                 canSerializeFMUstate=True,
             )
         rewrite_fmu(Path(built), model_identifier, functools.partial(complete_model_description,
-                                                                     model_identifier=model_identifier))
+                                                                     model_identifier=model_identifier),
+                    start_values=start_values)
         check_platform_binary(Path(built), model_identifier)
         shutil.move(str(built), fmu_path)
     return fmu_path
@@ -338,8 +353,20 @@ def build_systems(
     fmus = (Path(pendulum_fmu), folder / "Suspension.fmu")
     return [
         write_ssp(folder / "PendulumOnSuspension.ssp", *fmus, values, macro_step=macro_step),
-        write_container(folder / "PendulumOnSuspension.fmu", *fmus, values, macro_step=macro_step),
+        write_container(folder / "PendulumOnSuspension.fmu", *fmus, values, macro_step=macro_step, documented=True),
     ]
+
+
+# The modules that write what the FMU holds besides the bundled code (its layout, documentation, icon,
+# terminals, baked start values): a change to one of them makes the built FMUs stale too.
+BUILD_MODULES = ("build", "build_fmi3", "bundle", "presets", "presentation", "documentation", "doc_plot",
+                 "docstring_html", "icons", "terminals", "tex_html", "elf_needs", "loader")
+
+
+def build_sources() -> list[Path]:
+    """The build's own modules (:data:`BUILD_MODULES`)."""
+    folder = Path(__file__).resolve().parent
+    return [folder / f"{name}.py" for name in BUILD_MODULES]
 
 
 def fmu_is_current(fmu_path: str | Path, model_identifier: str = MODEL_IDENTIFIER) -> bool:
@@ -348,5 +375,5 @@ def fmu_is_current(fmu_path: str | Path, model_identifier: str = MODEL_IDENTIFIE
     if not fmu_path.is_file():
         return False
     built = fmu_path.stat().st_mtime
-    sources = [*adapter_sources(2), *runtime_sources(), *loader.loader_sources(2)]
+    sources = [*adapter_sources(2), *runtime_sources(), *loader.loader_sources(2), *build_sources()]
     return all(src.stat().st_mtime <= built for src in sources)

@@ -19,12 +19,14 @@ from __future__ import annotations
 
 import shutil
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 from xml.etree import ElementTree as ET
 
 from ..component.model_exchange import STATES
 from ..component.variables import INTERFACES, MODEL_IDENTIFIER
-from . import bundle
+from . import bundle, presets
 from .build import (
     _copy_runtime,
     builder_imports_forgotten,
@@ -77,14 +79,16 @@ def complete_model_description_fmi3(xml_text: bytes) -> bytes:
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH) -> Path:
+def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH, start_values: Mapping[str, Any] | None = None) -> Path:
     """Build the FMI 3.0 ``DoublePendulum`` FMU at ``dest`` (a ``.fmu`` path or a folder); return its path.
 
-    Written to a temporary folder first and moved into place at the end, so a failed build never
-    leaves a broken FMU behind.
+    ``start_values`` (parameters by name) are baked in as the FMU's defaults (:mod:`.presets`). Written to
+    a temporary folder first and moved into place at the end, so a failed build never leaves a broken FMU
+    behind.
     """
     from pythonfmu3.builder import FmuBuilder
 
+    start_values = presets.checked_start_values(MODEL_IDENTIFIER, start_values)
     dest = Path(dest)
     fmu_path = dest if dest.suffix == ".fmu" else dest / f"{MODEL_IDENTIFIER}.fmu"
     fmu_path.parent.mkdir(parents=True, exist_ok=True)
@@ -102,7 +106,7 @@ def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH) -> Path:
                 needsCompletedIntegratorStep=False,
             ))
         rewrite_fmu(built, MODEL_IDENTIFIER, complete_model_description_fmi3, fmi_version=3,
-                    defines={"N_CONTINUOUS_STATES": str(len(STATES))})
+                    defines={"N_CONTINUOUS_STATES": str(len(STATES))}, start_values=start_values)
         check_platform_binary(built, MODEL_IDENTIFIER, fmi_version=3)
         shutil.move(str(built), fmu_path)
     return fmu_path

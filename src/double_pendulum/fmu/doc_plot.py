@@ -1,0 +1,109 @@
+"""The result plot of an FMU's documentation: its default run, computed and drawn at build.
+
+Each FMU's ``documentation/result.png`` shows what the FMU computes from its own defaults (the start
+values baked into the build included) over its default experiment, as Reference-FMUs' documentation
+shows an fmusim run. It is computed in-process with the component the FMU runs (the same numbers as
+the FMU, ``tests/test_fmu.py``); the pendulum on its suspension with the coupling the container steps
+(:func:`double_pendulum.fmu.coupling.run_coupled`, ``jacobi_sequential``, its macro step). The
+Suspension's defaults leave it at rest, so its plot applies a load step (:data:`SUSPENSION_STEP`).
+
+Plots are kept per process, keyed by everything they show (a build writes several FMUs of one
+scene; the test session builds the set several times).
+"""
+
+from __future__ import annotations
+
+import functools
+import io
+import json
+from collections.abc import Mapping
+from typing import Any
+
+from ..component.suspension import INPUT_START
+from . import presets
+from .simulate import communication_points
+
+SUSPENSION_STEP = {"F_x": 1.0, "F_y": INPUT_START["F_y"] - 1.0}
+"""The Suspension plot's load [N]: 1 N horizontally and 1 N down on top of the static load, from t = 0."""
+PLOTTED = {
+    "DoublePendulum": (("phi1", "phi2"), ("omega1", "omega2")),
+    "Suspension": (("x", "y"), ("E_suspension", "W_suspension", "W_in")),
+    "PendulumOnSuspension": (("DoublePendulum.phi1", "DoublePendulum.phi2"), ("Suspension.x", "Suspension.y")),
+}
+
+
+def unit_of(name: str) -> str:
+    """The unit of a plotted output (``Suspension.x``: m)."""
+    base = name.rpartition(".")[2]
+    if base[:2] in ("E_", "W_"):
+        return "J"
+    return {"phi": "rad", "ome": "rad/s"}.get(base[:3], "m")
+
+
+def run(model: str, start_values: Mapping[str, Any], stop_time: float, interval: float) -> dict[str, list[float]]:
+    """The model's default run from ``start_values`` to ``stop_time`` [s], every ``interval`` [s]:
+    ``time`` and the outputs of :data:`PLOTTED`, as lists."""
+    if model == "PendulumOnSuspension":
+        return _coupled(start_values, stop_time, interval)
+    component = presets.COMPONENTS[model]()
+    for name, value in start_values.items():
+        component.set(name, value)
+    if model == "Suspension":
+        for name, value in SUSPENSION_STEP.items():
+            component.set_input(name, value)
+    component.initialise()
+    names = [n for group in PLOTTED[model] for n in group]
+    rows = {"time": [component.time], **{n: [component.outputs[n]] for n in names}}
+    for current, step in communication_points(0.0, stop_time, interval):
+        component.do_step(current, step)
+        rows["time"].append(component.time)
+        for name in names:
+            rows[name].append(component.outputs[name])
+    return rows
+
+
+def _coupled(values: Mapping[str, Any], stop_time: float, macro_step: float) -> dict[str, list[float]]:
+    """The container's components as it couples them: ``values`` are the container's (``DoublePendulum.x``)."""
+    from .coupling import run_coupled
+
+    components = {name: presets.COMPONENTS[name]() for name in ("DoublePendulum", "Suspension")}
+    for name, value in values.items():
+        owner, _, parameter = name.partition(".")
+        components[owner].set(parameter, value)
+    for component in components.values():
+        component.initialise()
+    rows = run_coupled(components["DoublePendulum"], components["Suspension"], stop_time=stop_time,
+                       macro_step=macro_step, scheme="jacobi_sequential", pendulum_outputs=("phi1", "phi2"),
+                       suspension_outputs=("x", "y"))
+    return {"time": rows["time"].tolist(), "DoublePendulum.phi1": rows["phi1"].tolist(),
+            "DoublePendulum.phi2": rows["phi2"].tolist(), "Suspension.x": rows["x"].tolist(),
+            "Suspension.y": rows["y"].tolist()}
+
+
+def result_plot(model: str, start_values: Mapping[str, Any], stop_time: float, interval: float) -> bytes:
+    """The PNG of :func:`run` (kept per process for the same arguments)."""
+    return _plot(model, json.dumps(dict(start_values), sort_keys=True), float(stop_time), float(interval))
+
+
+@functools.lru_cache(maxsize=32)
+def _plot(model: str, start_values: str, stop_time: float, interval: float) -> bytes:
+    from matplotlib.figure import Figure
+
+    rows = run(model, json.loads(start_values), stop_time, interval)
+    time = rows["time"]
+    fig = Figure(figsize=(7.0, 4.2), layout="constrained")
+    axes = fig.subplots(2, 1, sharex=True)
+    for ax, group in zip(axes, PLOTTED[model]):
+        shown = [n for n in group if any(rows[n])]
+        for name in shown:
+            ax.plot(time, rows[name], label=name, linewidth=1.0)
+        ax.set_ylabel(" / ".join(dict.fromkeys(f"[{unit_of(n)}]" for n in shown)))
+        ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncols=max(len(shown), 1),
+                  frameon=False, borderaxespad=0.1)
+        ax.ticklabel_format(axis="y", useOffset=False)
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=100)
+    return buffer.getvalue()
+

@@ -1,0 +1,238 @@
+"""``documentation/index.html`` of an FMU, generated at build from the sources the package documents itself with.
+
+Nothing here is a second copy of the documentation: the page is assembled from
+
+* the FMU's own ``modelDescription.xml`` (name, description, interfaces, GUID, default experiment, the
+  variable table with units and start values) and the validity rules of the interface's parameters
+  (:mod:`double_pendulum.component.variables`: the "valid values" column);
+* the model's module docstrings (the equations, :data:`MODEL_SOURCES`), rendered by
+  :mod:`double_pendulum.fmu.docstring_html`;
+* the parameter groups' docstrings and switches (:data:`SWITCH_GROUPS`: the switches of a scene);
+* the FMU's binaries, read for what each needs of the target machine
+  (:mod:`double_pendulum.fmu.elf_needs`), the CPython recorded at build and the loader's docstring (how
+  the FMU finds its Python, :mod:`double_pendulum.fmu.loader`);
+* the result plot ``result.png`` of the FMU's default run (:mod:`double_pendulum.fmu.doc_plot`).
+
+The page is plain HTML with its style inline and no script, so the simple HTML views of FMI tools show
+it as a browser does.
+"""
+
+from __future__ import annotations
+
+import html
+import importlib
+import json
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import fields
+from xml.etree import ElementTree as ET
+
+from .. import __version__
+from ..component.variables import INTERFACES
+from ..model.parameters import AirDragParameters, BearingParameters, SuspensionParameters
+from . import elf_needs, presets
+from .docstring_html import docstring_html, inline_html, summary
+
+MODEL_SOURCES: dict[str, tuple[str, ...]] = {
+    "DoublePendulum": ("model.dynamics", "model.links", "model.kinematics", "model.forces", "model.inputs"),
+    "DoublePendulumFmi3": ("model.dynamics", "model.links", "model.kinematics", "model.forces", "model.inputs",
+                           "component.model_exchange"),
+    "Suspension": ("model.suspension", "component.suspension"),
+    "PendulumOnSuspension": ("fmu.container",),
+}
+"""The modules (under ``double_pendulum``) whose docstrings are the page's "The model" section."""
+SWITCH_GROUPS = {"DoublePendulum": (AirDragParameters, BearingParameters, SuspensionParameters)}
+RULES = {"positive": "> 0", "nonnegative": "≥ 0", "finite": "finite", "bool": "true, false", "str": "text"}
+RESULT_PLOT = "documentation/result.png"
+STYLE = """
+body { font-family: Helvetica, Arial, sans-serif; margin: 2em; color: #1b1f23; line-height: 1.45; }
+div.container { max-width: 960px; margin: auto; }
+h1, h2 { border-bottom: 1px solid #eaecef; padding-bottom: .3em; }
+h3 { margin-top: 1.6em; }
+p.lead { font-size: 1.1em; }
+code { background-color: #f3f4f6; padding: 0 .2em; border-radius: 3px; font-size: 90%; }
+pre { background-color: #f6f8fa; border-radius: 3px; font-size: 85%; padding: 12px; overflow: auto; }
+table { border-collapse: collapse; border-spacing: 0; margin: 1em 0; }
+th, td { font-size: 0.88em; border: 1px solid #dfe2e5; padding: 4px 9px; text-align: left; vertical-align: top; }
+th { background-color: #f6f8fa; }
+td.number { text-align: right; white-space: nowrap; }
+div.equation { font-family: 'Times New Roman', Times, serif; font-size: 1.15em; margin: .8em 2em; }
+span.math { font-family: 'Times New Roman', Times, serif; font-size: 1.08em; white-space: nowrap; }
+figure { margin: 1em 0; }
+figcaption { font-size: 0.9em; color: #57606a; }
+footer { margin-top: 3em; font-size: 0.8em; color: #57606a; }
+"""
+
+
+def _module_doc(name: str) -> str:
+    return importlib.import_module(f"{__package__.rpartition('.')[0]}.{name}").__doc__ or ""
+
+
+def model_section(sources: Sequence[str]) -> str:
+    """"The model": each source module's summary as a heading, its docstring as the text."""
+    parts = []
+    for name in sources:
+        doc = _module_doc(name)
+        parts.append(f"<h3>{inline_html(summary(doc))}</h3>\n{docstring_html(doc)}")
+    return "\n".join(parts)
+
+
+def switches_section(groups: Sequence[type]) -> str:
+    """"The switches of a scene": per parameter group, its docstring and its Boolean switches."""
+    parts = []
+    for group in groups:
+        doc = group.__doc__ or ""
+        switches = [f for f in fields(group) if f.metadata["rule"] == "bool"]
+        others = [f.name for f in fields(group) if f.metadata["rule"] != "bool"]
+        items = "\n".join(f"<li><code>{f.name}</code> (start {presets.literal(f.default)}): "
+                          f"{inline_html(f.metadata['description'])}</li>" for f in switches)
+        parts.append(f"<h3>{inline_html(summary(doc))}</h3>\n{docstring_html(doc)}\n<ul>\n{items}\n</ul>\n"
+                     f"<p>Parameters: {', '.join(f'<code>{n}</code>' for n in others)}.</p>")
+    return "\n".join(parts)
+
+
+def _rules(model: str, names: Sequence[str]) -> dict[str, str]:
+    """The valid values of each variable, from the interface's rules (the container's by component)."""
+    by_model = {m: {v.name: v.rule for v in INTERFACES[m].variables()} for m in INTERFACES}
+    rules = {}
+    for name in names:
+        owner, _, variable = name.rpartition(".")
+        rule = by_model.get(owner or model, {}).get(variable, "")
+        rules[name] = RULES.get(rule, "")
+    return rules
+
+
+def variables_table(root: ET.Element, model: str) -> str:
+    """The modelDescription's variables: name, causality, variability, type, start, unit, valid values."""
+    fmi3 = root.get("fmiVersion", "").startswith("3")
+    rows = []
+    variables = list(root.find("ModelVariables"))
+    rules = _rules(model, [v.get("name") for v in variables])
+    for variable in variables:
+        if fmi3:
+            kind, start = variable.tag, variable.get("start")
+            if kind == "String" and variable.find("Start") is not None:
+                start = variable.find("Start").get("value")
+            unit = variable.get("unit", "")
+        else:
+            typed = next(iter(variable))
+            kind, start, unit = typed.tag, typed.get("start"), typed.get("unit", "")
+        name = variable.get("name")
+        cells = [f"<code>{html.escape(name)}</code>", variable.get("causality", "local"),
+                 variable.get("variability", "continuous"), kind]
+        rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells)
+                    + f'<td class="number">{html.escape(start or "")}</td><td>{html.escape(unit)}</td>'
+                    f"<td>{html.escape(rules[name])}</td>"
+                    f"<td>{html.escape(variable.get('description') or '')}</td></tr>")
+    head = "".join(f"<th>{h}</th>" for h in ("name", "causality", "variability", "type", "start", "unit",
+                                             "valid values", "description"))
+    return f"<table>\n<thead><tr>{head}</tr></thead>\n<tbody>\n" + "\n".join(rows) + "\n</tbody>\n</table>"
+
+
+def about_table(root: ET.Element, start_values: Mapping[str, object]) -> str:
+    """Facts of the FMU: FMI version, interfaces, identifiers, tool, default experiment, baked start values."""
+    interfaces = [e for e in root if e.tag in ("ModelExchange", "CoSimulation")]
+    experiment = root.find("DefaultExperiment")
+    rows = [("FMI version", root.get("fmiVersion")),
+            ("interfaces", ", ".join(f"{e.tag} (model identifier <code>{e.get('modelIdentifier')}</code>)"
+                                     for e in interfaces)),
+            ("GUID" if root.get("guid") else "instantiation token",
+             f"<code>{html.escape(root.get('guid') or root.get('instantiationToken') or '')}</code>"),
+            ("generated by", html.escape(f"{root.get('generationTool')}, double-pendulum-fmu {__version__}"))]
+    if root.get("version") or root.get("license"):
+        facts = filter(None, (root.get("version"), root.get("license")))
+        rows.append(("version, licence", html.escape(", ".join(facts))))
+    if experiment is not None:
+        rows.append(("default experiment", ", ".join(f"{k} {html.escape(v)}" for k, v in experiment.attrib.items())))
+    if start_values:
+        rows.append(("start values of this build", html.escape(presets.describe(start_values))))
+    return "<table>\n" + "\n".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in rows) + "\n</table>"
+
+
+def _role(name: str, guarded: bool) -> str:
+    """What a binary of the FMU is, by its file name (``guarded``: the build compiled the loader)."""
+    file = name.rpartition("/")[2]
+    if file.startswith("container_fmu"):
+        return "fmpy's container binary (no Python)"
+    if file.startswith("libpythonfmu"):
+        return "the FMI library's binary (pythonfmu), behind the guard"
+    if file.endswith(".so") and not guarded:
+        return "pythonfmu's plain library: runs only in a Python host (built without a C compiler)"
+    if file.endswith(".so"):
+        return "the loader and guard: starts a CPython >= 3.11 with a shared libpython (below)"
+    if file.endswith(".dll"):
+        return "pythonfmu's binary for Windows: links python3.dll, a CPython >= 3.11 must be on the DLL search path"
+    return "binary for macOS"
+
+
+def _guarded(binary: str, bundles: Mapping[str, dict]) -> bool:
+    """Whether the FMU (or the container's component) holding ``binary`` has the loader as its binary."""
+    prefix = binary.rpartition("binaries/")[0]
+    return bool(bundles.get(prefix, {}).get("guard", True))
+
+
+def _needs(data: bytes) -> str:
+    return html.escape(elf_needs.describe(data)) if data[:4] == b"\x7fELF" else ""
+
+
+def machine_section(files: Mapping[str, bytes], model: str) -> str:
+    """What a target machine needs: every binary in the FMU (a container's components too), the CPython
+    the build recorded, and how the loader finds a Python (its docstring)."""
+    rows = []
+    bundles = {name.rpartition("resources/")[0]: json.loads(data) for name, data in files.items()
+               if name.endswith("resources/bundle.json")}
+    for name in sorted(files):
+        parts = name.split("/")
+        if "binaries" in parts and name.endswith((".so", ".dll", ".dylib")):
+            role = _role(name, _guarded(name, bundles))
+            rows.append(f"<tr><td><code>{html.escape(name)}</code></td><td>{html.escape(role)}</td>"
+                        f"<td>{_needs(files[name])}</td></tr>")
+    record = [f for f in sorted(files) if f.endswith("resources/python.cfg")]
+    recorded = ""
+    if record:
+        lines = [line for line in files[record[0]].decode().splitlines() if line and not line.startswith("#")]
+        recorded = (f"<p>The CPython this FMU was built with (<code>{html.escape(record[0])}</code>):</p>\n"
+                    f"<pre>{html.escape(chr(10).join(lines))}</pre>")
+    intro = ("<p>The container's own binary (fmpy's <code>container_fmu</code>) needs no Python; its two FMUs, "
+             "under <code>resources/</code>, do:</p>" if model == "PendulumOnSuspension" else "")
+    loader_doc = _module_doc("fmu.loader")
+    head = "<thead><tr><th>binary</th><th>what it is</th><th>needs of the system</th></tr></thead>"
+    return (f"{intro}\n<table>\n{head}\n<tbody>\n"
+            + "\n".join(rows) + f"\n</tbody>\n</table>\n{recorded}\n"
+            f"<h3>{inline_html(summary(loader_doc))}</h3>\n{docstring_html(loader_doc)}")
+
+
+def index_html(model: str, model_description: bytes, files: Mapping[str, bytes],
+               start_values: Mapping[str, object], plot_caption: str) -> str:
+    """The page of one FMU: ``model`` names its kind (a key of :data:`MODEL_SOURCES`), ``files`` are the FMU's
+    other files (binaries, ``python.cfg``), ``start_values`` those baked into the build."""
+    root = ET.fromstring(model_description)
+    kind = model if model in MODEL_SOURCES else "DoublePendulum"
+    base = "DoublePendulum" if kind == "DoublePendulumFmi3" else kind
+    title = html.escape(root.get("modelName", base))
+    sections = [
+        f"<h1>{title}</h1>\n<p class=\"lead\">{html.escape(root.get('description', ''))}</p>",
+        about_table(root, start_values),
+        f"<h2>Result</h2>\n<figure><img src=\"{RESULT_PLOT.rpartition('/')[2]}\" alt=\"result plot\" width=\"700\">"
+        f"<figcaption>{plot_caption}</figcaption></figure>",
+        f"<h2>The model</h2>\n{model_section(MODEL_SOURCES[kind])}",
+    ]
+    if base == "PendulumOnSuspension":
+        sections.append("<p>The two FMUs inside have their own documentation: "
+                        + ", ".join(f'<a href="../resources/{n}/documentation/index.html">{n}</a>'
+                                    for n in ("DoublePendulum", "Suspension")) + ".</p>")
+    if base in SWITCH_GROUPS:
+        sections.append(f"<h2>The switches of a scene</h2>\n{switches_section(SWITCH_GROUPS[base])}")
+    sections += [f"<h2>Variables</h2>\n{variables_table(root, base)}",
+                 f"<h2>What a target machine needs</h2>\n{machine_section(files, base)}",
+                 f"<footer>Generated by double-pendulum-fmu {__version__} from the package's docstrings and this "
+                 "FMU's modelDescription.xml.</footer>"]
+    body = "\n\n".join(sections)
+    return (f"<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{title}</title>\n"
+            f"<style>{STYLE}</style>\n</head>\n<body>\n<div class=\"container\">\n{body}\n</div>\n</body>\n</html>\n")
+
+
+def untranslated_markup(page: str) -> list[str]:
+    """reST or TeX the page shows raw (roles, double back-quotes, backslash commands); empty when clean."""
+    text = re.sub(r"<pre>.*?</pre>", "", page, flags=re.S)
+    return re.findall(r":\w+:`|``|\\[A-Za-z]+", text)

@@ -1,0 +1,94 @@
+"""What a tool shows of an FMU, added to every FMU the build writes: documentation, icon and terminals.
+
+:func:`presentation_files` gives the files, by their path in the FMU:
+
+* ``documentation/index.html`` and ``documentation/result.png`` (:mod:`double_pendulum.fmu.documentation`,
+  :mod:`double_pendulum.fmu.doc_plot`);
+* the icon: ``model.png`` (FMI 2.0) and ``terminalsAndIcons/icon.png`` (FMI 3.0, and FMI 2.0.4's
+  back-port), :mod:`double_pendulum.fmu.icons`;
+* ``terminalsAndIcons/terminalsAndIcons.xml`` with the terminals of the FMU's variables and their
+  pictures (:mod:`double_pendulum.fmu.terminals`).
+
+The build adds them in :func:`double_pendulum.fmu.build.rewrite_fmu` (DoublePendulum, Suspension, the
+FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.container.write_container` (the container).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+from xml.etree import ElementTree as ET
+
+from . import doc_plot, documentation, icons, terminals
+
+CONTAINER = "PendulumOnSuspension"
+CONTAINER_PLOT_TIME = 2.0  # [s] of the container's result plot (its default experiment runs 10 s)
+
+
+def _typed(kind: str, text: str | None) -> Any:
+    if kind == "Boolean":
+        return text == "true"
+    if kind == "String":
+        return text
+    return float(text)
+
+
+def _parameter_starts(root: ET.Element) -> dict[str, Any]:
+    """The container's parameters and their start values (it holds the scene as its starts)."""
+    starts = {}
+    for variable in root.find("ModelVariables"):
+        if variable.get("causality") == "parameter":
+            typed = next(iter(variable))
+            starts[variable.get("name")] = _typed(typed.tag, typed.get("start"))
+    return starts
+
+
+def _plot_case(model: str, fmi_version: int, root: ET.Element,
+               start_values: Mapping[str, Any]) -> tuple[dict, float, float, str]:
+    """Start values, stop time [s], interval [s] and caption of the result plot."""
+    experiment = root.find("DefaultExperiment")
+    stop, step = float(experiment.get("stopTime")), float(experiment.get("stepSize"))
+    if model == CONTAINER:
+        stop = min(stop, CONTAINER_PLOT_TIME)
+        caption = (f"The two FMUs coupled as the container couples them (the force passed first, inputs held over "
+                   f"each macro step of {step:g} s), from the container's start values, over {stop:g} s; computed "
+                   "at build in-process with the components the FMUs run.")
+        return _parameter_starts(root), stop, step, caption
+    inputs = "no inputs"
+    if model == "Suspension":
+        inputs = (f"the inputs F_x = {doc_plot.SUSPENSION_STEP['F_x']:g} N and F_y = F_static_y - 1 N from t = 0 "
+                  "(a load step: at its default inputs the mass stays at rest)")
+    caption = (f"The FMU's default run: its start values (the table below), {stop:g} s, a communication point "
+               f"every {step:g} s, {inputs}. Computed at build with the component the FMU runs, which gives the "
+               "FMU's numbers" + (" (under Model Exchange, a host's solver gives them to its tolerance)."
+                                  if fmi_version == 3 else "."))
+    return dict(start_values), stop, step, caption
+
+
+def presentation_files(model: str, fmi_version: int, files: Mapping[str, bytes],
+                       start_values: Mapping[str, Any] | None = None) -> dict[str, bytes]:
+    """The documentation, icon and terminal files of an FMU whose other files are ``files``.
+
+    ``model``: ``DoublePendulum``, ``Suspension`` or ``PendulumOnSuspension`` (the container);
+    ``start_values``: those baked into the build (:mod:`double_pendulum.fmu.presets`).
+    """
+    start_values = dict(start_values or {})
+    md = files["modelDescription.xml"]
+    root = ET.fromstring(md)
+    page_kind = "DoublePendulumFmi3" if (model, fmi_version) == ("DoublePendulum", 3) else model
+    plot_values, stop, step, caption = _plot_case(model, fmi_version, root, start_values)
+    out = {
+        documentation.RESULT_PLOT: doc_plot.result_plot(model, plot_values, stop, step),
+        "documentation/index.html": documentation.index_html(page_kind, md, files, start_values, caption).encode(),
+        "terminalsAndIcons/icon.png": icons.icon(model),
+    }
+    if fmi_version == 2:
+        out["model.png"] = icons.icon(model)
+    names = [v.get("name") for v in root.find("ModelVariables")]
+    found = [t for prefix in (("DoublePendulum.", "Suspension.") if model == CONTAINER else ("",))
+             for t in terminals.terminals_for(names, prefix)]
+    out[terminals.FILE] = terminals.terminals_xml(found)
+    for path in sorted(terminals.icon_files(found)):
+        out[path] = icons.terminal_icon(path.rpartition("/")[2].removesuffix(".png"))
+    return out
+

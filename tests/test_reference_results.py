@@ -1,0 +1,170 @@
+"""The committed reference results (data/reference/fmu/, double_pendulum.fmu.reference_cases): freshly built
+FMUs reproduce them in fmpy and in the project's C hosts (tests/c_host, no Python in them), and the
+committed inputs and options are what the case definitions write.
+
+Stated tolerances, per output column, relative to the column's largest magnitude (at least 1):
+fmpy and the C hosts under Co-Simulation run the same FMU code on the same communication grid,
+REPRODUCE = 1e-9 (they agree to rounding; the margin covers another machine's libm through 3 s of
+chaos); the C host's Model Exchange integrates with its own RK4 at a quarter of a millisecond against
+CVode at rtol 1e-12 (RK4_ME): 1e-6 for the free swing, 1e-4 for the chaotic case, 1e-3 with friction,
+where the regularised friction torque switches within about omega_reg / (angular acceleration), 1e-4 s,
+as the pendulum leaves rest: a fixed-step RK4 steps over it (1e-6 rad/s after 10 ms, grown to 4.6e-4
+relative over 5 s, the same at 0.125 ms steps), CVode resolves it. Each test prints what it measured.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from double_pendulum.data import data_path
+
+from double_pendulum.fmu import loader
+from double_pendulum.fmu.reference_cases import CASES, ReferenceCase, fmu_file, input_names
+from double_pendulum.fmu.reference_runs import (
+    RECORD,
+    build_case_fmus,
+    input_csv,
+    opt_text,
+    read_reference,
+    reference_run,
+)
+
+pytestmark = pytest.mark.filterwarnings("ignore:Please import:DeprecationWarning")  # fmpy's scipy.ndimage.filters
+REFERENCES = Path(str(data_path("reference/fmu")))
+REPRODUCE = 1e-9
+RK4_ME = {"DoublePendulumChaotic": 1e-4, "DoublePendulumFriction": 1e-3}
+RK4_ME_DEFAULT = 1e-6
+ME_SUBSTEPS = 40  # RK4 steps of the C host per output interval (0.25 ms at 10 ms)
+HOST_SOURCES = {"2.0": "fmi2_host.c", "3.0": "fmi3_host.c"}
+
+
+def case_id(case: ReferenceCase) -> str:
+    return case.folder.as_posix()
+
+
+@pytest.fixture(scope="module")
+def fmus(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    return build_case_fmus(tmp_path_factory.mktemp("cases"))
+
+
+def deviation(result, reference, names) -> float:
+    """The largest difference over ``names``, each relative to its column's largest magnitude (at least 1)."""
+    return max(float(np.max(np.abs(np.asarray(result[n]) - reference[n])) / max(1.0, np.max(np.abs(reference[n]))))
+               for n in names)
+
+
+@pytest.mark.parametrize("case", CASES, ids=case_id)
+def test_the_committed_inputs_and_options_are_the_cases(case):
+    folder = REFERENCES / case.folder
+    assert (folder / f"{case.model}_ref.opt").read_text() == opt_text(case)
+    inputs = folder / f"{case.model}_in.csv"
+    assert (inputs.read_text() if inputs.is_file() else None) == input_csv(case)
+    reference = read_reference(REFERENCES, case)
+    assert reference.dtype.names == ("time", *case.outputs) and len(case.outputs) <= 10
+    assert reference["time"][0] == 0.0 and reference["time"][-1] == pytest.approx(case.stop_time)
+    record = json.loads((REFERENCES / RECORD).read_text())["cases"][case_id(case)]
+    assert record["baked_start_values"] == dict(case.baked) and record["run_start_values"] == dict(case.reference_start)
+
+
+def test_every_variant_has_at_least_three_models():
+    """The Cross-Check asks for three FMUs per platform and FMI variant."""
+    variants = {}
+    for case in CASES:
+        variants.setdefault((case.fmi_version, case.fmi_type), []).append(case.model)
+    assert set(variants) == {("2.0", "cs"), ("3.0", "cs"), ("3.0", "me")}
+    assert all(len(models) >= 3 for models in variants.values())
+
+
+@pytest.mark.parametrize("case", CASES, ids=case_id)
+def test_fmpy_reproduces_the_reference(fmus, case):
+    reference = read_reference(REFERENCES, case)
+    result = reference_run(case, fmus[fmu_file(case)])
+    assert result["time"].tolist() == pytest.approx(reference["time"].tolist(), abs=1e-12)
+    got = deviation(result, reference, case.outputs)
+    print(f"fmpy {case_id(case)}: largest relative difference {got:.2g}")
+    assert got <= REPRODUCE
+
+
+# ------------------------------------------------------------------------------------------- the C hosts
+def _shared_libpython_here() -> bool:
+    record = dict(line.split("=", 1) for line in loader.python_record().splitlines() if "=" in line)
+    return bool(record["library"]) and Path(record["library"]).is_file()
+
+
+needs_c_host = [
+    pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the C loader and the C hosts are for Linux"),
+    pytest.mark.skipif(loader.c_compiler() is None, reason="no C compiler ($CC, cc, gcc or clang) for the C hosts"),
+    pytest.mark.skipif(not _shared_libpython_here(), reason="this Python has no shared libpython, which the FMU "
+                       "needs in a host without Python"),
+]
+
+
+@pytest.fixture(scope="module")
+def hosts(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    folder = tmp_path_factory.mktemp("hosts")
+    out = {}
+    for version, source in HOST_SOURCES.items():
+        path = folder / source.removesuffix(".c")
+        subprocess.run([*loader.c_compiler(), "-O2", f"-I{loader.fmi_headers()}", "-o", str(path),
+                        str(Path(__file__).parent / "c_host" / source), "-ldl", "-lm"], check=True, capture_output=True)
+        out[version] = path
+    return out
+
+
+def host_run(host: Path, case: ReferenceCase, fmu: Path, tmp_path: Path) -> np.ndarray:
+    """Run ``case`` in the C host: its FMU extracted, the reference run's start values, the case's inputs as an
+    input table by value reference, every output recorded at every step."""
+    from fmpy import extract, read_model_description
+
+    folder = Path(extract(str(fmu), str(tmp_path / "fmu")))
+    md = read_model_description(str(fmu))
+    variables = {v.name: v for v in md.modelVariables}
+    args = []
+    for name, value in case.reference_start.items():
+        kind = {"Boolean": "b", "String": "s"}.get(variables[name].type, "r")
+        args.append(f"{kind}:{variables[name].valueReference}={int(value) if kind == 'b' else value}")
+    text = input_csv(case)
+    if text is not None:
+        header, _, rows = text.partition("\n")
+        table = tmp_path / "inputs.csv"
+        vrs = [str(variables[n].valueReference) for n in input_names(case)]
+        table.write_text(",".join(["time", *vrs]) + "\n" + rows)
+        args.append(f"f:{table}")
+    args += [f"O:{variables[n].valueReference}" for n in case.outputs]
+    me = case.fmi_type == "me"
+    substeps = ME_SUBSTEPS if me else 1
+    steps = round(case.stop_time / case.step_size) * substeps
+    h = repr(case.step_size / substeps)
+    identifier = (md.coSimulation or md.modelExchange).modelIdentifier
+    if case.fmi_version == "2.0":
+        command = [str(host), str(folder), identifier, md.guid, str(steps), h, *args]
+    else:
+        command = [str(host), str(folder), identifier, md.guid, "rk4" if me else "cs", str(steps), h, *args]
+    done = subprocess.run(command, capture_output=True, text=True, env={"PATH": "/usr/bin:/bin", "HOME": str(tmp_path)},
+                          cwd=tmp_path, timeout=600)
+    assert done.returncode == 0, f"exit {done.returncode}\n{done.stdout[-2000:]}\n{done.stderr[-2000:]}"
+    rows = np.array([[float(v) for v in line.split()[1:]] for line in done.stdout.splitlines()
+                     if line.startswith("row ")])[::substeps]
+    return np.rec.fromarrays(rows.T, names=["time", *case.outputs])
+
+
+@needs_c_host[0]
+@needs_c_host[1]
+@needs_c_host[2]
+@pytest.mark.parametrize("case", CASES, ids=case_id)
+def test_the_c_host_reproduces_the_reference(hosts, fmus, case, tmp_path):
+    reference = read_reference(REFERENCES, case)
+    result = host_run(hosts[case.fmi_version], case, fmus[fmu_file(case)], tmp_path)
+    assert result["time"].tolist() == pytest.approx(reference["time"].tolist(), abs=1e-9)
+    tolerance = RK4_ME.get(case.model, RK4_ME_DEFAULT) if case.fmi_type == "me" else REPRODUCE
+    got = deviation(result, reference, case.outputs)
+    print(f"C host {case_id(case)}: largest relative difference {got:.2g} (allowed {tolerance:g})")
+    assert got <= tolerance
+    from fmpy.cross_check import validate_result
+
+    assert validate_result(result, reference, 0.0, case.stop_time) is None  # the cross-check's comparison
