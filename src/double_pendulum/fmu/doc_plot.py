@@ -20,6 +20,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..component.suspension import INPUT_START
+from ..component.variables import INTERFACES
 from . import presets
 from .simulate import communication_points
 
@@ -32,12 +33,20 @@ PLOTTED = {
 }
 
 
+QUANTITY = {"rad": "angle", "rad/s": "angular velocity", "m": "position", "J": "energy"}
+
+
 def unit_of(name: str) -> str:
-    """The unit of a plotted output (``Suspension.x``: m)."""
-    base = name.rpartition(".")[2]
-    if base[:2] in ("E_", "W_"):
-        return "J"
-    return {"phi": "rad", "ome": "rad/s"}.get(base[:3], "m")
+    """The unit of a plotted output (``Suspension.x``: m), as its FMU's interface gives it."""
+    owner, _, base = name.rpartition(".")
+    interfaces = [INTERFACES[owner]] if owner else list(INTERFACES.values())
+    return next(v.unit for interface in interfaces for v in interface.variables() if v.name == base)
+
+
+def axis_label(names: list[str]) -> str:
+    """A y-axis label in words with the unit: ``angle [rad]``."""
+    units = list(dict.fromkeys(unit_of(n) for n in names))
+    return " / ".join(f"{QUANTITY.get(unit, 'value')} [{unit}]" for unit in units)
 
 
 def run(model: str, start_values: Mapping[str, Any], stop_time: float, interval: float) -> dict[str, list[float]]:
@@ -97,7 +106,7 @@ def _plot(model: str, start_values: str, stop_time: float, interval: float) -> b
         shown = [n for n in group if any(rows[n])]
         for name in shown:
             ax.plot(time, rows[name], label=name, linewidth=1.0)
-        ax.set_ylabel(" / ".join(dict.fromkeys(f"[{unit_of(n)}]" for n in shown)))
+        ax.set_ylabel(axis_label(shown))
         ax.legend(loc="lower right", bbox_to_anchor=(1.0, 1.0), fontsize=8, ncols=max(len(shown), 1),
                   frameon=False, borderaxespad=0.1)
         ax.ticklabel_format(axis="y", useOffset=False)
