@@ -61,4 +61,4 @@ READS_FITS_OF: dict[str, str] = {"measured_vs_sim": "loss_identification"}
 """Scenarios that read a fit another scenario caches on disk, by the name of that one: ``measured_vs_sim`` reads
 ``loss_identification``'s air+drag fit of the same mode (on a cold cache, without it, it fits it itself: about 7 s
 more CPU in a quick run). ``run all --quick`` runs each in the process of the one it reads from, after it
-(:func:`double_pendulum.scenario_pool.balanced_groups`); :data:`SCENARIOS` lists each after it too."""
+(:func:`double_pendulum.runs.pool.balanced_groups`); :data:`SCENARIOS` lists each after it too."""

@@ -28,12 +28,12 @@ from double_pendulum.analysis.chaos import flips, lyapunov_study, phase_space, p
 from double_pendulum.analysis.chaos.ensemble import initial_states, pendulum_field, rod_field
 from double_pendulum.analysis.chaos.lyapunov import LyapunovResult, lyapunov_benettin, lyapunov_two_trajectory
 from double_pendulum.analysis.chaos.plan import FULL, QUICK, THOROUGH, H, Plan, precision
-from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.sweep import default_workers, parallel_map, run_sweep, where_runs
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.model.parameters import AirDragParameters, BearingParameters, PendulumParameters
 from double_pendulum.model.vector_field import ModelConfig
-from double_pendulum.results_io import write_json, write_results_csv
+from double_pendulum.runs.progress import step
+from double_pendulum.runs.results_io import write_json, write_results_csv
 
 DESCRIPTION = "sensitivity to the start (seed 4.1): ensembles, predictability, Lyapunov exponents, flip map"
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from double_pendulum import plots
 from double_pendulum.fmu.runner import FmuRunner
-from double_pendulum.results_io import write_json, write_results_csv
+from double_pendulum.runs.results_io import write_json, write_results_csv
 
 DESCRIPTION = "frictionless swing from a regular (small-angle) and a chaotic (2 rad) start"
 

@@ -104,7 +104,7 @@ from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, Reconstru
 from double_pendulum.analysis.track.start_state import STATE_NAMES
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.model.parameters import PendulumParameters
-from double_pendulum.results_io import write_json, write_results_csv, write_text
+from double_pendulum.runs.results_io import write_json, write_results_csv, write_text
 
 DESCRIPTION = ("FMU prediction of the measured track from t0 = 0.8 s: the seed's start and least-squares starts "
                "(with geometry), identified losses")

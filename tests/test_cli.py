@@ -14,7 +14,7 @@ from double_pendulum.scenarios import SCENARIOS
 
 import double_pendulum
 from double_pendulum.cli import default_fmu_path, fmu_set, fmu_set_is_current, main, run_scenario
-from double_pendulum.results_io import read_results_csv
+from double_pendulum.runs.results_io import read_results_csv
 
 
 def test_list_names_the_scenarios(capsys):

@@ -27,10 +27,10 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from . import __version__
-from .analysis.interrupts import acknowledge, handling_interrupts, interrupted
 from .component.variables import INTERFACES
 from .fmu.build import DEFAULT_FMU_PATH, build_all
-from .scenario_lines import failed_line, header_line, wrote_line
+from .runs.interrupts import acknowledge, handling_interrupts, interrupted
+from .runs.lines import failed_line, header_line, wrote_line
 from .scenarios import SCENARIOS
 
 PROG = "double-pendulum"
@@ -295,7 +295,8 @@ def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: 
 
 def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path, jobs: int) -> list[str]:
     """Build the FMU if needed, then run the scenarios in child processes, ``jobs`` at a time."""
-    from .scenario_pool import run_in_children
+    from .runs.pool import Costs, run_in_children
+    from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF
 
     _load_fmu(args.fmu, args.rebuild).close()  # build once here, and fail early on an unusable FMU
     if args.quick:
@@ -304,7 +305,8 @@ def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path
     else:
         print(f"running {len(names)} scenarios, {jobs} at a time in their own processes, the longest first",
               flush=True)
-    return run_in_children(names, out, Path(args.fmu), quick=args.quick, thorough=args.thorough, jobs=jobs)
+    costs = Costs(EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF)
+    return run_in_children(names, out, Path(args.fmu), costs, quick=args.quick, thorough=args.thorough, jobs=jobs)
 
 
 @contextlib.contextmanager
@@ -340,7 +342,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     out = _writable_folder(args.out)
     if args.fmu is None:
         args.fmu = str(default_fmu_path(out))
-    from .analysis.sweep import default_workers  # one scenario per core this process may use
+    from .runs.workers import default_workers  # one scenario per core this process may use
 
     jobs = min(len(names), args.jobs or default_workers())
     start, cpu_start = time.perf_counter(), _cpu_seconds()
