@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
+import datetime
 import importlib
 import importlib.util
 import inspect
@@ -333,6 +334,23 @@ def private_tempdir() -> Iterator[Path]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def _run_command(args: argparse.Namespace) -> str:
+    """The ``run`` command line as the page shows it."""
+    flags = [flag for flag, on in (("--quick", args.quick), ("--thorough", args.thorough)) if on]
+    return " ".join([PROG, "run", *args.scenarios, *flags, "--out", args.out])
+
+
+def write_run_page(out: Path, args: argparse.Namespace, names: tuple[str, ...], failed: list[str],
+                   started: datetime.datetime, wall_s: float, cpu_s: float) -> Path:  # fmt: skip
+    """Write ``out/index.html``, the page of this run (:mod:`double_pendulum.runs.page`)."""
+    from .runs.page import RunInfo, write_index
+    from .scenarios import READING_ORDER, page
+
+    mode = "quick" if args.quick else "thorough" if args.thorough else "default"
+    run = RunInfo(started, __version__, mode, wall_s, cpu_s, _run_command(args), names, tuple(failed))
+    return write_index(out, run, [page(name, scenario_description(name)) for name in READING_ORDER])
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     names = _check_scenarios(args.scenarios)
     if args.quick and args.thorough:
@@ -345,12 +363,16 @@ def cmd_run(args: argparse.Namespace) -> int:
     from .runs.workers import default_workers  # one scenario per core this process may use
 
     jobs = min(len(names), args.jobs or default_workers())
-    start, cpu_start = time.perf_counter(), _cpu_seconds()
+    started, start, cpu_start = datetime.datetime.now(datetime.UTC), time.perf_counter(), _cpu_seconds()
     with private_tempdir():
         failed = _run_in_children(names, args, out, jobs) if jobs > 1 else _run_in_this_process(names, args, out)
+    wall_s, cpu_s = time.perf_counter() - start, _cpu_seconds() - cpu_start
     if len(names) > 1 and args.index is None:  # a child of run_in_children leaves the sum to its parent
         print(f"{len(names) - len(failed)} of {len(names)} scenarios wrote {out} in "
-              f"{time.perf_counter() - start:.1f} s (CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
+              f"{wall_s:.1f} s (CPU {cpu_s:.1f} s)", flush=True)
+    if args.index is None:  # the page of the whole run, by the process that ran it all
+        index = write_run_page(out, args, names, failed, started, wall_s, cpu_s)
+        print(f"the whole run on one page: {index}", flush=True)
     if failed and args.index is None:
         print(f"{len(failed)} of {len(names)} scenarios failed: {', '.join(failed)}", file=sys.stderr)
     return 1 if failed else 0
