@@ -378,6 +378,46 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
+def _positive(option: str, value: float) -> float:
+    """``value`` of ``option`` if it is a positive finite number, else a CliError."""
+    if not (0.0 < value < float("inf")):
+        raise CliError(f"{option} must be a positive number of seconds, got {value:g}")
+    return value
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    """Run a case of one's own through the FMU (:mod:`double_pendulum.case`): CSV, figure, animation, summary."""
+    from fmpy import read_model_description
+
+    from .case import Case, run_case
+    from .fmu.start_values import StartValueError, parse_start_values
+
+    if args.me and args.fmi != "3":
+        raise CliError("--me needs --fmi 3: the FMI 2.0 FMU is co-simulation only")
+    stop, step = _positive("--stop", args.stop), _positive("--step", args.step)
+    if step > stop:
+        raise CliError(f"--step {step:g} s is longer than the run (--stop {stop:g} s)")
+    out = _writable_folder(args.out)
+    fmu2 = Path(args.fmu) if args.fmu is not None else default_fmu_path(out)
+    with private_tempdir():
+        _load_fmu(str(fmu2), args.rebuild).close()  # builds the FMUs if they are missing or stale
+        fmu = fmu2 if args.fmi == "2" else fmu2.parent / "fmi3" / fmu2.name
+        try:
+            values = parse_start_values(args.set, read_model_description(str(fmu)))
+        except StartValueError as error:
+            raise CliError(str(error)) from None
+        case = Case(fmu, values, stop, step, "ModelExchange" if args.me else "CoSimulation")
+        print(f"simulating {case.words()} through {fmu} with fmpy ...", flush=True)
+        outcome = run_case(case, out, animate=not args.no_animation)
+    names = ", ".join(path.name for path in outcome.files)
+    if outcome.message is not None:
+        print(f"{PROG}: the FMU stopped the run at t = {outcome.summary.get('end_time_s', 0.0):g} s: "
+              f"{outcome.message} (wrote {names} in {out})", file=sys.stderr)
+        return 1
+    print(f"wrote {names} in {out} ({outcome.summary['rows']} rows, {outcome.summary['wall_time_s']:.1f} s)")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser: plain-text help, the scenarios listed under ``run --help``."""
     parser = argparse.ArgumentParser(
@@ -430,6 +470,33 @@ def build_parser() -> argparse.ArgumentParser:
     p_run.add_argument("--index", default=None, help=argparse.SUPPRESS)
     p_run.set_defaults(func=cmd_run)
 
+    p_sim = sub.add_parser(
+        "simulate",
+        help="run a case of your own through the FMU with fmpy: CSV, figure, animation, summary",
+        description="Run the FMU once with fmpy, from the start values you give, and write simulation.csv\n"
+        "(units in the column names), simulation.png (angles, energies and their budget, the bobs' paths),\n"
+        "simulation.gif (the pendulum in real time) and summary.json (with the fmpy call that gives the\n"
+        "same numbers) into OUT.",
+        epilog="example:\n  double-pendulum simulate --set phi1_0=2 --set air_drag=true --stop 20 --out my_case\n"
+        "parameters and their units: double-pendulum variables",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p_sim.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                       help="start value of a parameter of the FMU, by its FMU name (repeatable)")
+    p_sim.add_argument("--stop", type=float, default=10.0, metavar="SECONDS", help="stop time (default: 10)")
+    p_sim.add_argument("--step", type=float, default=0.01, metavar="SECONDS",
+                       help="output interval, also the co-simulation step (default: 0.01)")
+    p_sim.add_argument("--fmi", choices=("2", "3"), default="2", help="FMI version of the FMU (default: 2)")
+    p_sim.add_argument("--me", action="store_true",
+                       help="model exchange (with --fmi 3): fmpy integrates the FMU with its own solver")
+    p_sim.add_argument("--out", default="results/simulate", help="output folder (default: results/simulate)")
+    p_sim.add_argument("--fmu", default=None,
+                       help="the FMI 2.0 FMU, built with the others next to it if missing or older than the sources "
+                       "(--fmi 3 uses fmi3/ next to it; default as for run)")
+    p_sim.add_argument("--rebuild", action="store_true", help="rebuild the FMUs first")
+    p_sim.add_argument("--no-animation", action="store_true", help="write no simulation.gif")
+    p_sim.set_defaults(func=cmd_simulate)
+
     p_list = sub.add_parser("list", help="list the scenarios", description="List the scenarios.")
     p_list.set_defaults(func=cmd_list)
 
@@ -452,8 +519,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"{PROG}: interrupted; finished scenarios are kept, unfinished ones are discarded",
-              file=sys.stderr)
+        kept = ("nothing was written" if args.command == "simulate"
+                else "finished scenarios are kept, unfinished ones are discarded")
+        print(f"{PROG}: interrupted; {kept}", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader of stdout went away: say nothing more there
         _stdout_to_devnull()
