@@ -80,6 +80,8 @@ def test_a_failed_scenario_and_an_earlier_run_s_folder_are_said_so(tmp_path):
     assert "This scenario failed in this run." in text and 'href="b.failed/"' in text
     assert "0 of 1 scenarios wrote their results" in text
     assert "From earlier runs in this folder" in text and 'href="c/summary.json"' in text
+    (tmp_path / "c" / "summary.json").write_text("{ half written")  # whatever a scenario left, the page is written
+    assert "Its summary.json cannot be read" in page_html(tmp_path, _run(["c"]), pages)
 
 
 @pytest.fixture(scope="module")

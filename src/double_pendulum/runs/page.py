@@ -217,7 +217,10 @@ def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
     summary_path = folder / "summary.json"
     if not summary_path.is_file():
         return head + "</section>"
-    summary = json.loads(summary_path.read_text(encoding="utf-8"))
+    try:
+        summary = json.loads(summary_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:  # the page is written whatever a scenario left
+        return head + f'<p class="failed">Its summary.json cannot be read ({html.escape(str(error))}).</p></section>'
     written = datetime.fromtimestamp(summary_path.stat().st_mtime).strftime("%Y-%m-%d %H:%M")
     parts = [head, f'<p class="mode">{_mode(summary)}, written {written}</p>']
     text = in_short(folder, summary)
