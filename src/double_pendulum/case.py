@@ -33,7 +33,7 @@ from .fmu.runner import FmuRunError, FmuRunner
 from .fmu.start_values import value_text
 from .plots import animate_swings, swing
 from .plots.case import plot_case
-from .runs.interrupts import interrupted
+from .runs.interrupts import acknowledge, interrupted
 from .runs.results_io import read_results_csv, write_json, write_results_csv
 
 MAX_ANIMATION_S = 30.0
@@ -161,5 +161,8 @@ def run_case(case: Case, out: Path, *, animate: bool = True) -> Outcome:
             else:
                 (out / name).unlink(missing_ok=True)
         return Outcome(written, summary, message)
+    except KeyboardInterrupt:
+        acknowledge()  # the run stops here: a repeated interrupt must not cut the clean-up below short
+        raise
     finally:
         shutil.rmtree(staging, ignore_errors=True)
