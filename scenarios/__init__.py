@@ -3,7 +3,13 @@
 A scenario module has ``DESCRIPTION`` (one line) and ``run(runner, out_dir, *, quick=False) ->
 dict`` (the summary, also written to ``out_dir/summary.json``). ``quick`` shortens the run for
 smoke tests. Each scenario enables only the model parts it needs.
+
+This package's own module holds what the command line needs to know of them without importing them: their
+names (:data:`SCENARIOS`), their costs for ``run all`` (:data:`EXPECTED_CPU_S`, :data:`EXPECTED_QUICK_CPU_S`,
+:data:`READS_FITS_OF`) and what the run's page shows of each (:data:`PAGES`, in :data:`READING_ORDER`).
 """
+
+from double_pendulum.runs.page import Headline, ScenarioPage
 
 SCENARIOS: tuple[str, ...] = (
     "cosimulation",
@@ -21,7 +27,7 @@ SCENARIOS: tuple[str, ...] = (
 
 EXPECTED_CPU_S: dict[str, float] = {
     "cosimulation": 19.6,
-    "free_swing": 2.1,
+    "free_swing": 4.0,
     "friction_budget": 5.2,
     "energy_decay": 1.1,
     "loss_identification": 62.0,
@@ -35,13 +41,14 @@ EXPECTED_CPU_S: dict[str, float] = {
 """CPU time [s] of each scenario's default run, as last measured (first run of ``run all`` on a fresh clone,
 2 cores, one worker process each, 2026-12-02, after the faster driven component and solvers; loss_identification
 measured again after it came to fit eight models from eleven starts: 83 s under another job's load, which made the
-others 1.3 to 1.4 times their entries here, so about 62 s on the quiet machine): ``run all``
+others 1.3 to 1.4 times their entries here, so about 62 s on the quiet machine; free_swing measured again with its
+third run and its animation: 5.0 s beside other jobs): ``run all``
 starts the longest first, packs the small ones into shared children and weights its progress bar by them;
 nothing else depends on them."""
 
 EXPECTED_QUICK_CPU_S: dict[str, float] = {
     "cosimulation": 5.2,
-    "free_swing": 2.2,
+    "free_swing": 2.6,
     "friction_budget": 1.7,
     "energy_decay": 1.6,
     "loss_identification": 7.0,
@@ -61,4 +68,149 @@ READS_FITS_OF: dict[str, str] = {"measured_vs_sim": "loss_identification"}
 """Scenarios that read a fit another scenario caches on disk, by the name of that one: ``measured_vs_sim`` reads
 ``loss_identification``'s air+drag fit of the same mode (on a cold cache, without it, it fits it itself: about 7 s
 more CPU in a quick run). ``run all --quick`` runs each in the process of the one it reads from, after it
-(:func:`double_pendulum.scenario_pool.balanced_groups`); :data:`SCENARIOS` lists each after it too."""
+(:func:`double_pendulum.runs.pool.balanced_groups`); :data:`SCENARIOS` lists each after it too."""
+
+
+READING_ORDER: tuple[str, ...] = (
+    "measured_vs_sim",
+    "free_swing",
+    "chaos",
+    "energy_decay",
+    "loss_identification",
+    "friction_budget",
+    "suspension_transfer",
+    "base_excitation",
+    "cosimulation",
+    "work_precision",
+    "stability",
+)
+"""The order of the scenarios on the run's page (``index.html``): the pendulum against its measurement first,
+then chaos, the losses, the driven and coupled pendulum, the solvers."""
+
+HEADLINES: dict[str, tuple[Headline, ...]] = {
+    "measured_vs_sim": (
+        Headline("lower bob within 5 cm of the track (smoothed over 0.25 s), start and camera geometry fitted",
+                 "horizon_5cm_s", unit="s after t0", note="horizon_statement"),
+        Headline("the same, frame by frame: first more than 5 cm off after",
+                 "horizons_raw_s/lsq_geometry_identified/lower_bob_5cm_s", unit="s"),
+        Headline("started the seed's way (its start, no friction): within 5 cm for",
+                 "horizons_smoothed_s/seed_start_frictionless/lower_bob_5cm_s", unit="s"),
+        Headline("air drag factor of the identified losses (1: the default drag)",
+                 "model/loss_parameters/air_factor/value", "model/loss_parameters/air_factor/stderr"),
+        Headline("bearing drag torque of the identified losses", "model/loss_parameters/tau_b/value*1000",
+                 "model/loss_parameters/tau_b/stderr*1000", "mN m"),
+        Headline("the motion at the measured energy", "regime/verdict"),
+    ),
+    "free_swing": (
+        Headline("two chaotic starts 1e-5 rad apart: lower bobs 1 cm apart after",
+                 "twin_starts/lower_bobs_1cm_apart_at_s", unit="s"),
+        Headline("turns of the lower rod from the chaotic start", "runs/chaotic/flips_rod2"),
+        Headline("largest relative change of the energy, chaotic start (no friction: should be 0)",
+                 "runs/chaotic/max_relative_energy_drift"),
+    ),
+    "chaos": (
+        Headline("largest Lyapunov exponent (a small difference grows e-fold every 1/lambda)",
+                 "lyapunov/lyapunov_per_s", "lyapunov/lyapunov_sem_per_s", "1/s"),
+        Headline("three releases within 5 mm: lower bobs 1 cm apart after", "fmu_runs/releases_part_by_1cm_at_s",
+                 unit="s"),
+        Headline("releases within 5 mm: their spread exceeds 1 cm after", "predictability/horizon_1cm_at_5mm_s",
+                 unit="s"),
+        Headline("start angles from which a rod turns over (flip map)", "flip_map/fraction_flipped*100", unit="%"),
+    ),
+    "energy_decay": (
+        Headline("decay rate b of the measured energy, E = a exp(b t)", "b_per_s", "error_budget/total_b_per_s",
+                 "1/s"),
+        Headline("energy a at the release", "a_J", "error_budget/total_a_J", "J"),
+        Headline("the seed's decay rate", "seed/b_per_s", unit="1/s"),
+    ),
+    "loss_identification": (
+        Headline("air drag's share of the loss, over the models that fit about equally well",
+                 "supported_models/air_share_range*100", unit="%"),
+        Headline("decay rate of the measured energy", "b_measured_per_s", "b_measured_stderr", "1/s"),
+        Headline("loss exponent p of the measured energy (1: exponential decay)", "p_measured",
+                 "p_measured_stderr"),
+        Headline("the model with the lowest AIC", "top_model"),
+    ),
+    "friction_budget": (
+        Headline("energy lost, all mechanisms on", "runs/all/lost_fraction*100", unit="%"),
+        Headline("the suspension's share of the loss", "share_of_loss_all_on/suspension*100", unit="%"),
+        Headline("air drag's share of the loss", "share_of_loss_all_on/air_drag*100", unit="%"),
+        Headline("bearing friction's share of the loss", "share_of_loss_all_on/bearing_friction*100", unit="%"),
+        Headline("decay rate, all mechanisms on", "decay_rate_b_per_s/all",
+                 "runs/all/exponential_fit/b_per_s_stderr", "1/s"),
+    ),
+    "suspension_transfer": (
+        Headline("decay rate of the measured energy", "measured/b_per_s", "measured/b_per_s_total_error", "1/s"),
+        Headline("suspension damping c fitted at the assumed k = 20000 N/m and M_s = 2 kg (conditional)",
+                 "identified/c_N_s_per_m", "identified/c_stderr", "N s/m"),
+        Headline("loss exponent p of the measured energy", "measured/decay_shape/p", "measured/decay_shape/p_stderr"),
+        Headline("loss exponent p with that suspension", "refit/identified/p"),
+    ),
+    "base_excitation": (
+        Headline("Kapitza: amplitude that holds the single pendulum upright at 50 rad/s",
+                 "kapitza_threshold_amplitude_m*1000", "kapitza_threshold_uncertainty_m*1000", "mm"),
+        Headline("Acheson: points of the stability map where simulation and theory agree",
+                 "acheson_agreement_fraction*100", unit="%"),
+        Headline("resonance peaks against the damped linear theory: largest relative error",
+                 "resonance_max_abs_relative_error*100", unit="%"),
+    ),
+    "cosimulation": (
+        Headline("plain exchange (Jacobi), regular start: order of the angle error in the macro step",
+                 "order_angles/regular / default / jacobi"),
+        Headline("iterative master (states saved and restored), regular start: order",
+                 "order_angles/regular / default / iterative"),
+        Headline("cheapest way to an angle error of 1e-4 rad, regular start",
+                 "cheapest_to_1e-4_rad/regular / default/method"),
+    ),
+    "work_precision": (
+        Headline("configurations run (solvers, tolerances, steps)", "configurations"),
+        Headline("fastest to an error of 1e-6, regular case", "best_per_band/regular/max_error_le_1e-6/solver"),
+        Headline("its CPU time", "best_per_band/regular/max_error_le_1e-6/cpu_time_s", unit="s"),
+    ),
+    "stability": (
+        Headline("hard cases run", "cases"),
+        Headline("cases that met their pass criterion", "passed"),
+    ),
+}
+"""The headline figures the run's page shows of each scenario: paths into its ``summary.json``
+(:class:`~double_pendulum.runs.page.Headline`), the numbers as the scenario wrote them."""
+
+FIGURES: dict[str, tuple[tuple[str, str], ...]] = {
+    "measured_vs_sim": (
+        ("measured_vs_sim.gif", "the camera's two markers and the FMU's pendulum overlaid, in real time"),
+        ("lower_bob_paths.png", "the lower bob's measured and simulated paths in the x-y plane"),
+        ("prediction_error.png", "how far the simulated lower bob is from the measured one, over time"),
+    ),
+    "free_swing": (
+        ("twin_starts.gif", "two chaotic starts a hair's breadth apart stay together, then part (real time)"),
+        ("traces.png", "the paths of the bobs from the small and the large start"),
+    ),
+    "chaos": (
+        ("release_traces.png", "three releases within the seed's 5 mm, as its photographs show them"),
+        ("predictability.png", "how long the pendulum stays predictable, by the start's uncertainty"),
+        ("flip_map.png", "the time until a rod first turns over, by the start angles"),
+    ),
+    "energy_decay": (("energy_decay.png", "the measured energy over time and the decay laws fitted to it"),),
+    "loss_identification": (
+        ("energy_fit.png", "the measured energy and the loss models fitted to it"),
+        ("loss_shares.png", "each model's split of the loss among the mechanisms"),
+    ),
+    "friction_budget": (("energy_budget_stacked.png", "where the energy went, all mechanisms on"),),
+    "suspension_transfer": (("decay_rate_map.png", "the decay rate over the suspension's stiffness and damping"),),
+    "base_excitation": (
+        ("kapitza_threshold.png", "Kapitza's pendulum: the shaking that holds it upright"),
+        ("acheson_map.png", "Acheson's inverted double pendulum: where shaking holds it upright"),
+    ),
+    "cosimulation": (
+        ("error_vs_macro_step.png", "the coupling error of each master against the macro step"),
+        ("stability_map.png", "where plain exchange blows up"),
+    ),
+    "work_precision": (("work_precision_regular.png", "error against CPU time for every solver, regular case"),),
+    "stability": (("worst_residuals.png", "the energy balance of the hardest passing cases"),),
+}
+"""The key figures and animations the run's page shows of each scenario (file name, caption), in order."""
+
+
+def page(name: str, description: str) -> ScenarioPage:
+    """What the run's page shows of scenario ``name`` (``description``: its one line)."""
+    return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()))

@@ -30,7 +30,7 @@ from double_pendulum.analysis.excitation.drive import TORQUE_OUTPUTS, run_cases,
 from double_pendulum.analysis.excitation.theory import held_floquet_exponent
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.plots import excitation as fig
-from double_pendulum.results_io import write_json, write_results_csv, write_table_csv, write_text
+from double_pendulum.runs.results_io import write_json, write_results_csv, write_table_csv, write_text
 
 DESCRIPTION = "pivot vibration and torque through the inputs: Kapitza threshold, Acheson's upright map, resonance"
 

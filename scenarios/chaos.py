@@ -5,12 +5,10 @@ known to about 5 mm), the lower rod hanging; three long-exposure traces agreed f
 The release angle is not stated: here the upper rod starts at 2.0 rad (the upper bob 12 cm above the
 pivot, high enough for the chaotic traces of its figs. 4-6), the lower rod hanging, at rest.
 
-Outputs in ``results/chaos/`` (CSVs, plots, ``summary.json`` with ``lyapunov_per_s``): FMU runs of the
-nominal and three drawn releases; ensembles and predictability horizons; Lyapunov exponents (convergence,
-two-trajectory check, step halving with ``--thorough``, spectrum, against the energy, with friction); the
-flip-time map and Poincare sections. The analysis: :mod:`double_pendulum.analysis.chaos`.
-
-Cost and the sizes of the runs: :mod:`double_pendulum.analysis.chaos.plan`.
+Outputs in ``results/chaos/`` (CSVs, plots, ``summary.json`` with ``lyapunov_per_s`` and ``in_short``): FMU runs
+of the nominal and three drawn releases; ensembles and predictability horizons; Lyapunov exponents (convergence,
+two-trajectory check, step halving with ``--thorough``, spectrum, against the energy, with friction); the flip-time
+map and Poincare sections. The analysis: :mod:`double_pendulum.analysis.chaos`; costs and sizes in its ``plan``.
 """
 
 from __future__ import annotations
@@ -26,14 +24,15 @@ import numpy as np
 from double_pendulum import plots
 from double_pendulum.analysis.chaos import flips, lyapunov_study, phase_space, predictability, releases
 from double_pendulum.analysis.chaos.ensemble import initial_states, pendulum_field, rod_field
+from double_pendulum.analysis.chaos.in_short import in_short
 from double_pendulum.analysis.chaos.lyapunov import LyapunovResult, lyapunov_benettin, lyapunov_two_trajectory
 from double_pendulum.analysis.chaos.plan import FULL, QUICK, THOROUGH, H, Plan, precision
-from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.sweep import default_workers, parallel_map, run_sweep, where_runs
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.model.parameters import AirDragParameters, BearingParameters, PendulumParameters
 from double_pendulum.model.vector_field import ModelConfig
-from double_pendulum.results_io import write_json, write_results_csv
+from double_pendulum.runs.progress import step
+from double_pendulum.runs.results_io import write_json, write_results_csv
 
 DESCRIPTION = "sensitivity to the start (seed 4.1): ensembles, predictability, Lyapunov exponents, flip map"
 
@@ -244,7 +243,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     step(f"flip map: {plan.flip_n} x {plan.flip_n} releases")
     summary["flip_map"] = flip_map(out, plan, params)
     summary["poincare"] = done["poincare"]
-    summary["precision"] = precision(plan, summary)
+    summary["precision"], summary["in_short"] = precision(plan, summary), in_short(summary)
     summary["wall_time_s"] = time.perf_counter() - start
     write_json(out / "summary.json", summary)
     return summary

@@ -35,7 +35,7 @@ from double_pendulum.analysis.sweep import parallel_map
 from double_pendulum.fmu.build import build_fmu
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.plots import coupling as plots
-from double_pendulum.results_io import write_json, write_table_csv, write_text
+from double_pendulum.runs.results_io import write_json, write_table_csv, write_text
 
 MAP_SCHEMES = ("jacobi", "jacobi_sequential")
 DESCRIPTION = "pendulum on suspension split into two FMUs: coupling error, energy and added-mass stability"

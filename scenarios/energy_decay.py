@@ -48,7 +48,7 @@ from double_pendulum.analysis.decay.summary import (
     weighting_variants,
 )
 from double_pendulum.analysis.track.measurement import SEED_TOTAL_MASS_KG, Reconstruction, load_track, reconstruct
-from double_pendulum.results_io import write_json, write_results_csv, write_text
+from double_pendulum.runs.results_io import write_json, write_results_csv, write_text
 
 __all__ = ["DESCRIPTION", "SEED_FIT", "SEED_TOTAL_MASS_KG", "report_text", "run"]
 # SEED_FIT and SEED_TOTAL_MASS_KG live in the analysis package; re-exported for older imports.

@@ -25,10 +25,10 @@ import numpy as np
 
 from double_pendulum import plots
 from double_pendulum.analysis.decay.fit import fit_model
-from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.sweep import runner_map, timed_simulate, where_runs
 from double_pendulum.fmu.runner import FmuRunner
-from double_pendulum.results_io import write_json, write_results_csv
+from double_pendulum.runs.progress import step
+from double_pendulum.runs.results_io import write_json, write_results_csv
 
 DESCRIPTION = "energy budget of air drag, bearing friction and suspension, each alone and all together"
 
@@ -64,6 +64,23 @@ def _decay_rate(result: np.ndarray) -> dict[str, float]:
         "b_per_s": fit.value("b"),
         "b_per_s_stderr": fit.error("b"),
     }
+
+
+def _in_short(summary: dict, quick: bool) -> str:
+    """The plain summary (``in_short``): what was run, what was found, how sure; every number from ``summary``."""
+    shares, every = summary["share_of_loss_all_on"], summary["runs"]["all"]
+    return " ".join([
+        f"The pendulum was released from the seed's start and run for {summary['stop_time_s']:g} s through the FMU: "
+        "without friction, with each loss alone (air drag, bearing friction, a damped springy pivot) and with all "
+        "three, each at its parameters' default values, not fitted to the measurement.",
+        f"With all three on it lost {every['lost_fraction']:.0%} of its energy; of what the pendulum lost the "
+        f"suspension took {shares['suspension']:.0%}, air drag {shares['air_drag']:.0%} and bearing friction "
+        f"{shares['bearing_friction']:.0%} ({shares['still_in_suspension']:.0%} was still in the suspension).",
+        f"All on, the energy decays at b = {summary['decay_rate_b_per_s']['all']:.4f} 1/s, against the "
+        f"{summary['seed_measured_b_per_s']:g} 1/s the seed measured.",
+        "How sure: the shares are exact for these parameter values; which values the real pendulum has, the "
+        "loss_identification scenario asks." + (" A quick run: a smoke test." if quick else ""),
+    ])
 
 
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
@@ -120,5 +137,6 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False) -> dict:
 
     plots.plot_energy_per_mechanism(results, out_dir / "energy_per_mechanism.png", note=COEFFICIENTS_NOTE)
     plots.plot_energy_budget_stacked(results["all"], out_dir / "energy_budget_stacked.png", note=COEFFICIENTS_NOTE)
+    summary["in_short"] = _in_short(summary, quick)
     write_json(out_dir / "summary.json", summary)
     return summary

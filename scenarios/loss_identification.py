@@ -36,7 +36,7 @@ from double_pendulum.analysis.losses.claims import SUPPORTED_DAIC
 from double_pendulum.analysis.losses.identification import identify_losses
 from double_pendulum.analysis.losses.mechanisms import model_title, parameters_of
 from double_pendulum.analysis.losses.report import report_text
-from double_pendulum.results_io import table_from_columns, write_json, write_results_csv, write_text
+from double_pendulum.runs.results_io import table_from_columns, write_json, write_results_csv, write_text
 
 DESCRIPTION = "loss mechanisms of the real pendulum identified from its measured energy (AIC/BIC, shares)"
 

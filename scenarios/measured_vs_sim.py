@@ -46,16 +46,15 @@ fitted start (frictionless, rods, :data:`LYAPUNOV_S` s; quick: :data:`QUICK_LYAP
 :data:`THOROUGH_LYAPUNOV_S` s), compared with the energy the lower rod needs to flip.
 
 Cost: about 21 s of CPU by default once ``loss_identification`` has cached its fits (about 34 s on a first
-run that fits the losses itself). ``thorough`` (``--thorough``) adds the fit-window check (the start and
-geometry fitted again to the first :data:`WINDOW_SENSITIVITY` frames, about 35 s of CPU) and averages the
-Lyapunov exponent over :data:`THOROUGH_LYAPUNOV_S` s (5 s more). ``quick``: a 3 s prediction, the geometry
-fitted to :data:`QUICK_GEOMETRY_FIT_FRAMES` frames, :data:`QUICK_ENSEMBLE_SIZE` ensemble runs, a 10 s
-Lyapunov exponent.
+run that fits the losses itself). ``thorough`` adds the fit-window check (the start and geometry fitted again to
+the first :data:`WINDOW_SENSITIVITY` frames, about 35 s of CPU) and averages the Lyapunov exponent over
+:data:`THOROUGH_LYAPUNOV_S` s (5 s more). ``quick``: a 3 s prediction, the geometry fitted to
+:data:`QUICK_GEOMETRY_FIT_FRAMES` frames, :data:`QUICK_ENSEMBLE_SIZE` ensemble runs, a 10 s Lyapunov exponent.
 
-Outputs in ``results/measured_vs_sim/``: one CSV per run (FMU outputs from t0), ``errors.csv``
-(track and position errors per frame), ``coordinates.png`` (x1, y1, x2, y2 measured and simulated,
-the seed's figs. 11-14), ``prediction_error.png`` (smoothed errors over time with the 2 cm / 5 cm
-lines), ``summary.json`` and ``report.md``.
+Outputs in ``results/measured_vs_sim/``: a CSV per run (FMU outputs from t0), ``errors.csv`` (per frame),
+``coordinates.png`` (the seed's figs. 11-14), ``prediction_error.png``, ``paths.csv`` (measured and main run's bob
+positions per frame) and drawn from it ``lower_bob_paths.png`` (the x-y overlay) and ``measured_vs_sim.gif`` (real
+time), ``summary.json`` and ``report.md``.
 """
 
 from __future__ import annotations
@@ -98,13 +97,14 @@ from double_pendulum.analysis.prediction.comparison import (
     start_fit_summary,
     window_sensitivity,
 )
+from double_pendulum.analysis.prediction.paths import PATHS_UNITS, paths_table
 from double_pendulum.analysis.prediction.report import report_text
 from double_pendulum.analysis.suspension.identification import START_FIT_FRAMES
 from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, Reconstruction
 from double_pendulum.analysis.track.start_state import STATE_NAMES
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.model.parameters import PendulumParameters
-from double_pendulum.results_io import write_json, write_results_csv, write_text
+from double_pendulum.runs.results_io import read_results_csv, write_json, write_results_csv, write_text
 
 DESCRIPTION = ("FMU prediction of the measured track from t0 = 0.8 s: the seed's start and least-squares starts "
                "(with geometry), identified losses")
@@ -138,16 +138,11 @@ ENSEMBLE_SIZE = 6
 QUICK_ENSEMBLE_SIZE = 3
 
 
-def _plots(
-    out_dir: Path,
-    rec: Reconstruction,
-    i0: int,
-    n_frames: int,
-    predictions: list[Prediction],
-    spread: tuple[np.ndarray, np.ndarray],
-) -> None:
-    """``coordinates.png`` (track and four runs in the track's coordinates over the whole comparison) and
-    ``prediction_error.png`` (every run), a run in the same colour in both."""
+def _plots(out_dir: Path, rec: Reconstruction, i0: int, n_frames: int, predictions: list[Prediction],
+           spread: tuple[np.ndarray, np.ndarray]) -> None:  # fmt: skip
+    """``coordinates.png`` (track and four runs in the track's coordinates over the whole comparison),
+    ``prediction_error.png`` (every run), a run in the same colour in each, and the main run's x-y overlay and
+    animation (from ``paths.csv``)."""
     t, measured = measured_coordinates(rec, i0, n_frames)
     colours = plots.run_colours([run_title(p.label) for p in predictions])
     runs = {}
@@ -161,6 +156,9 @@ def _plots(
     plots.plot_track_comparison(t, measured, runs, out_dir / "coordinates.png", starts=starts, colours=colours,
                                 title=f"bob coordinates: measured track and FMU predictions from t0, the whole "
                                       f"{span:.2f} s compared")  # fmt: skip
+    paths, main = read_results_csv(out_dir / "paths.csv"), run_title(predictions[-1].label)  # drawn as written
+    plots.plot_lower_bob_paths(paths, out_dir / "lower_bob_paths.png", run=main, colour=colours[main])
+    plots.animate_prediction(paths, out_dir / "measured_vs_sim.gif", colour=colours[main])
     curves = error_curves(predictions, spread)
     plots.plot_prediction_errors(
         curves.smoothed, list(THRESHOLDS_M), out_dir / "prediction_error.png", per_frame=curves.per_frame,
@@ -242,6 +240,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     for p in predictions:
         write_results_csv(out_dir / f"{p.label}.csv", p.result, runner.units)
     write_results_csv(out_dir / "errors.csv", errors_table(rec, i0, n_frames, predictions), errors_units(predictions))
+    write_results_csv(out_dir / "paths.csv", paths_table(rec, i0, n_frames, predictions[-1]), PATHS_UNITS)
     _plots(out_dir, rec, i0, n_frames, predictions, spread)
     summary["wall_time_s"] = time.perf_counter() - wall0
     write_json(out_dir / "summary.json", summary)

@@ -30,7 +30,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from double_pendulum import plots
-from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.solvers.stability_cases import (
     case_cost,
     cases,
@@ -42,7 +41,8 @@ from double_pendulum.analysis.solvers.stability_cases import (
 )
 from double_pendulum.analysis.sweep import runner_map, where_runs
 from double_pendulum.fmu.runner import FmuRunner
-from double_pendulum.results_io import write_json, write_results_csv, write_table_csv, write_text
+from double_pendulum.runs.progress import step
+from double_pendulum.runs.results_io import write_json, write_results_csv, write_table_csv, write_text
 
 __all__ = ["DESCRIPTION", "run", "run_case"]
 

@@ -40,7 +40,6 @@ from double_pendulum.scenarios.energy_decay import SEED_FIT
 
 from double_pendulum import plots
 from double_pendulum.analysis.decay.error_budget import error_budget
-from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.suspension import transfer as study
 from double_pendulum.analysis.suspension.decay_map import (
     BASE_SETTINGS,
@@ -68,7 +67,8 @@ from double_pendulum.analysis.suspension.report import report_text
 from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.analysis.track.measurement import load_track, reconstruct
 from double_pendulum.fmu.runner import FmuRunner
-from double_pendulum.results_io import write_json, write_results_csv, write_text
+from double_pendulum.runs.progress import step
+from double_pendulum.runs.results_io import write_json, write_results_csv, write_text
 
 DESCRIPTION = "decay rate b over suspension stiffness and damping; suspension identified from the measured decay"
 

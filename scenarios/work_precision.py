@@ -31,7 +31,6 @@ from pathlib import Path
 from typing import Any
 
 from double_pendulum import plots
-from double_pendulum.analysis.progress import step
 from double_pendulum.analysis.solvers.reference import CROSS_CHECK, THOROUGH_CROSS_CHECK, Reference, cached_reference
 from double_pendulum.analysis.solvers.work_precision import (
     BASE_COMM_STEP,
@@ -51,7 +50,8 @@ from double_pendulum.analysis.solvers.work_precision import (
 )
 from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.fmu.runner import FmuRunner
-from double_pendulum.results_io import write_json, write_table_csv, write_text
+from double_pendulum.runs.progress import step
+from double_pendulum.runs.results_io import write_json, write_table_csv, write_text
 from double_pendulum.solvers import METHODS
 
 __all__ = ["DESCRIPTION", "OUTPUTS", "Config", "configurations", "run", "run_config"]

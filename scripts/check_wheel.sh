@@ -18,4 +18,6 @@ rm -rf build/lib build/bdist.*
 cd "$tmp"
 "$tmp/venv/bin/double-pendulum" --version
 MPLBACKEND=Agg "$tmp/venv/bin/double-pendulum" run all $mode --out "$tmp/results" --fmu "$tmp/DoublePendulum.fmu"
-echo "wheel install: every scenario ran from $(ls "$tmp/results" | wc -l) result folders"
+test -s "$tmp/results/index.html"  # the run's page, from the installed package
+echo "wheel install: every scenario ran from $(find "$tmp/results" -mindepth 1 -maxdepth 1 -type d | wc -l) result" \
+     "folders, and the run's page is there"

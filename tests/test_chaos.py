@@ -19,7 +19,7 @@ from double_pendulum.analysis.chaos.ensemble import (
 from double_pendulum.model.dynamics import linearised_normal_modes
 from double_pendulum.model.parameters import AirDragParameters, BearingParameters, PendulumParameters
 from double_pendulum.model.vector_field import ModelConfig
-from double_pendulum.results_io import read_results_csv
+from double_pendulum.runs.results_io import read_results_csv
 
 P = PendulumParameters()
 FIELD = pendulum_field(P)

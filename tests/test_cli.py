@@ -14,7 +14,7 @@ from double_pendulum.scenarios import SCENARIOS
 
 import double_pendulum
 from double_pendulum.cli import default_fmu_path, fmu_set, fmu_set_is_current, main, run_scenario
-from double_pendulum.results_io import read_results_csv
+from double_pendulum.runs.results_io import read_results_csv
 
 
 def test_list_names_the_scenarios(capsys):
@@ -35,13 +35,15 @@ def test_run_free_swing_writes_csv_plots_and_summary(fmu_path, tmp_path):
     assert main(["run", "free_swing", "--quick", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 0
     out = tmp_path / "free_swing"
     summary = json.loads((out / "summary.json").read_text())
-    assert set(summary["runs"]) == {"regular", "chaotic"}
+    assert set(summary["runs"]) == {"regular", "chaotic", "chaotic_nudged"}
     assert summary["runs"]["regular"]["max_relative_energy_drift"] < 1e-8
     for name in ("angles", "traces", "energy", "phase_portraits"):
         assert (out / f"{name}.png").stat().st_size > 10_000
-    chaotic = read_results_csv(out / "chaotic.csv")
+    chaotic, nudged = (read_results_csv(out / f"{name}.csv") for name in ("chaotic", "chaotic_nudged"))
     assert chaotic["time"][-1] == summary["stop_time_s"]
-    assert chaotic["phi1"][0] == 2.0
+    assert chaotic["phi1"][0] == 2.0 and nudged["phi1"][0] == 2.0 + summary["twin_starts"]["phi1_0_difference_rad"]
+    assert (out / "twin_starts.gif").is_file() and summary["in_short"]
+    assert (tmp_path / "index.html").is_file()  # the page of the run, beside the scenario's folder
 
 
 def test_unknown_scenario_is_one_clear_line(capsys):

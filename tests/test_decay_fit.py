@@ -11,7 +11,7 @@ import pytest
 from double_pendulum.analysis.decay import fit as df
 from double_pendulum.analysis.track.measurement import load_track, reconstruct
 from double_pendulum.model.energy import total_energy
-from double_pendulum.results_io import read_results_csv
+from double_pendulum.runs.results_io import read_results_csv
 
 T = np.arange(630) / 29.97  # the seed's frames [s]
 

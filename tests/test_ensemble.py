@@ -19,7 +19,7 @@ from double_pendulum.analysis.chaos.ensemble import (
 from double_pendulum.model.dynamics import fixed_pivot_vector_field
 from double_pendulum.model.parameters import AirDragParameters, PendulumParameters
 from double_pendulum.model.vector_field import ModelConfig
-from double_pendulum.results_io import read_results_csv
+from double_pendulum.runs.results_io import read_results_csv
 from double_pendulum.solvers import make_integrator
 
 P = PendulumParameters()

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from matplotlib.transforms import Bbox
 
-from double_pendulum.plots import coupling, excitation, losses, prediction, style, suspension, trajectories
+from double_pendulum.plots import case, coupling, excitation, losses, prediction, style, suspension, trajectories
 
-MODULES = (coupling, excitation, losses, prediction, suspension, trajectories)
+MODULES = (case, coupling, excitation, losses, prediction, suspension, trajectories)
 
 
 @pytest.fixture
@@ -107,6 +107,46 @@ def test_the_coordinates_show_the_whole_comparison_in_the_colours_of_the_error_p
     assert lo <= t[0] and hi >= t[-1]  # to the end of the comparison
     simulated = [line for line in fig.axes[0].get_lines() if line.get_label() == "simulated: run 3"]
     assert simulated[0].get_color() == colours["run 3"]  # as in the error plot, not the next in the cycle
+    _check_labels_and_legends(fig)
+
+
+def _paths(n: int = 600) -> np.ndarray:
+    """A stand-in for ``paths.csv``: the measured and the simulated lower bob on ellipses, 30 frames a second."""
+    t = np.arange(n) / 30.0
+    columns = {"time": t + 0.8, "t_since_t0": t, "pivot_x_simulated": np.full(n, 0.002),
+               "pivot_y_simulated": np.full(n, -0.001)}
+    for kind, lag in (("measured", 0.0), ("simulated", 0.05)):
+        for bob, r in (("1", 0.3), ("2", 0.45)):
+            columns[f"x{bob}_{kind}"] = 0.1 * np.sin(4 * (t - lag)) * r
+            columns[f"y{bob}_{kind}"] = -r + 0.05 * np.cos(3 * (t - lag))
+    return np.rec.fromarrays(list(columns.values()), names=list(columns)).view(np.ndarray)
+
+
+def test_the_lower_bob_paths_show_three_windows_with_the_legend_under_them(drawn):
+    prediction.plot_lower_bob_paths(_paths(), "unused.png", run="a fitted run", colour="C5")
+    fig = drawn[0]
+    titles = [ax.get_title() for ax in fig.axes]
+    assert titles[0] == "t - t0 = 0.00 to 2.00 s" and titles[2] == "t - t0 = 17.97 to 19.97 s"  # start and end
+    assert titles[1].startswith("t - t0 = 9.00 to ")  # and the middle, 2 s each
+    assert len(fig.legends) == 1 and all(ax.get_legend() is None for ax in fig.axes)
+    assert all(ax.get_aspect() == 1.0 for ax in fig.axes)  # a path in the plane is not stretched
+    _check_labels_and_legends(fig)
+
+
+def test_the_figure_of_a_case_of_one_s_own_labels_every_panel_and_keeps_legends_off_the_data(drawn):
+    t = np.linspace(0.0, 10.0, 1001)
+    names = ("phi1", "phi2", "E_total", "E_kin", "E_pot", "W_air", "W_bearing", "W_bearing_drag", "W_suspension",
+             "W_input", "energy_residual", "x1", "y1", "x2", "y2")
+    columns = {"time": t, **{name: np.sin(t + k) for k, name in enumerate(names)}}
+    columns["W_bearing"] = columns["W_input"] = np.zeros_like(t)  # switched off: not drawn
+    result = np.rec.fromarrays(list(columns.values()), names=list(columns)).view(np.ndarray)
+    case.plot_case(result, "unused.png", title="your case: phi1_0 = 2; 10 s")
+    fig = drawn[0]
+    assert fig.get_suptitle() == "your case: phi1_0 = 2; 10 s"
+    energy = fig.axes[1]
+    labels = [line.get_label() for line in energy.get_lines()]
+    assert "dissipated by air drag (W_air)" in labels and not any("W_bearing)" in label for label in labels)
+    assert not any("W_input" in label for label in labels)
     _check_labels_and_legends(fig)
 
 

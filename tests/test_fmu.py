@@ -23,7 +23,7 @@ from double_pendulum.fmu.simulate import simulate
 from double_pendulum.model.dynamics import linearised_normal_modes
 from double_pendulum.model.outputs import OUTPUT_NAMES
 from double_pendulum.model.parameters import PendulumParameters
-from double_pendulum.results_io import read_results_csv
+from double_pendulum.runs.results_io import read_results_csv
 
 
 def _model_description(fmu_path) -> ET.Element:

@@ -30,14 +30,14 @@ def _group(pgid: int) -> list[int]:
     return members
 
 
-def _start(args: list[str], tmp_path: Path) -> tuple[subprocess.Popen, queue.Queue, Path]:
-    """Start ``double-pendulum ARGS`` in a process group of its own with an empty $TMPDIR; its stdout lines
+def _start(args: list[str], tmp_path: Path, command: str = "run") -> tuple[subprocess.Popen, queue.Queue, Path]:
+    """Start ``double-pendulum COMMAND ARGS`` in a process group of its own with an empty $TMPDIR; its stdout lines
     arrive in the queue."""
     tmpdir = tmp_path / "tmp"
     tmpdir.mkdir()
     env = {**os.environ, "TMPDIR": str(tmpdir), "MPLBACKEND": "Agg", "DOUBLE_PENDULUM_PROGRESS": "off"}
     env.pop("DOUBLE_PENDULUM_WORKERS", None)  # a worker process per core, as a user's run has
-    process = subprocess.Popen([sys.executable, "-m", "double_pendulum.cli", "run", *args],
+    process = subprocess.Popen([sys.executable, "-m", "double_pendulum.cli", command, *args],
                                env=env, start_new_session=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                text=True)  # fmt: skip
     lines: queue.Queue = queue.Queue()
@@ -87,3 +87,27 @@ def test_ctrl_c_ends_every_process_of_the_run_and_leaves_no_temporary_file(tmp_p
     assert "Traceback" not in stderr and "interrupted" in stderr
     assert list(tmpdir.iterdir()) == []  # no extracted FMU, no temporary folder of the run
     assert not any(path.name.endswith(".incomplete") for path in out.iterdir())  # unfinished folders discarded
+
+
+@pytest.mark.slow
+def test_ctrl_c_on_a_case_of_one_s_own_writes_nothing_and_leaves_nothing(tmp_path, fmu_path):
+    out = tmp_path / "case"
+    out.mkdir()
+    (out / "summary.json").write_text("an earlier run's\n")
+    args = ["--stop", "200", "--step", "0.001", "--fmu", str(fmu_path), "--out", str(out)]  # long: 200,000 steps
+    process, lines, tmpdir = _start(args, tmp_path, command="simulate")
+    try:
+        _wait_for(lines, "simulating", process)
+        time.sleep(1.0)  # into the FMU's run
+        os.killpg(process.pid, signal.SIGINT)
+        code = process.wait(timeout=120)  # a guard against a hang, not a bound on the time
+    finally:
+        if process.poll() is None:
+            os.killpg(process.pid, signal.SIGKILL)
+            process.wait()
+    stderr = process.stderr.read()
+    assert code == 130, stderr
+    assert "Traceback" not in stderr and "interrupted; nothing was written" in stderr
+    assert list(tmpdir.iterdir()) == []  # no extracted FMU
+    assert [p.name for p in out.iterdir()] == ["summary.json"]  # no staging folder, the earlier file as it was
+    assert (out / "summary.json").read_text() == "an earlier run's\n"

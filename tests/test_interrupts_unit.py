@@ -8,7 +8,7 @@ import sys
 
 SCRIPT = """
 import gc, sys, weakref
-from double_pendulum.analysis import interrupts
+from double_pendulum.runs import interrupts
 
 class Raises:
     def __init__(self, error):

@@ -21,7 +21,7 @@ from double_pendulum.analysis.track.start_state import (
     state_start_values,
 )
 from double_pendulum.model.parameters import PendulumParameters
-from double_pendulum.results_io import read_results_csv
+from double_pendulum.runs.results_io import read_results_csv
 
 MODEL = {"air_drag": True, "rod_drag": True, "bearing_friction": True, "suspension": True}
 TRUE_STATE = np.array([-0.2, 0.7, 2.0, -4.0])  # rad, rad, rad/s, rad/s

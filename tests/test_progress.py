@@ -7,7 +7,7 @@ import types
 import pytest
 
 from double_pendulum import cli
-from double_pendulum.analysis import progress
+from double_pendulum.runs import progress
 
 
 def test_plain_lines_every_tenth_of_a_long_loop(capsys, monkeypatch):

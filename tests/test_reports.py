@@ -22,7 +22,7 @@ import pytest
 from double_pendulum.scenarios import SCENARIOS
 from fmpy.util import read_csv
 
-from double_pendulum.results_io import IN_SHORT, WORDS_USED, read_results_csv, read_table_csv
+from double_pendulum.runs.results_io import IN_SHORT, WORDS_USED, read_results_csv, read_table_csv
 
 TABLES = {"stability.csv", "work_precision.csv", "acheson_bands.csv", "acheson_map.csv", "kapitza_bisection.csv",
           "resonance_peaks.csv", "resonance_curve.csv", "runs.csv", "stability_map.csv"}

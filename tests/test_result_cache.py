@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from double_pendulum.analysis import result_cache
+from double_pendulum.runs import result_cache
 
 
 @pytest.fixture

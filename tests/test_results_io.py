@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from double_pendulum import results_io
-from double_pendulum.results_io import (
+from double_pendulum.runs import results_io
+from double_pendulum.runs.results_io import (
     read_results_csv,
     read_table_csv,
     write_json,

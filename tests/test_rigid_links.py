@@ -330,7 +330,7 @@ def test_batch_field_for_ensembles_has_the_rods_too():
 
 def test_fmu_agrees_with_the_committed_rigid_reference_trajectory(runner):
     """data/reference/rigid_chaotic.csv: Hamilton's equations with the plates summed over mass points."""
-    from double_pendulum.results_io import read_results_csv
+    from double_pendulum.runs.results_io import read_results_csv
 
     meta = json.loads((REPO / "data" / "reference" / "reference_meta.json").read_text())["cases"]["rigid_chaotic"]
     assert meta["rods"] == dict(SEED_RIGID_LINKS)

@@ -6,26 +6,31 @@ import sys
 from pathlib import Path
 
 import pytest
-from double_pendulum.scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, SCENARIOS
+from double_pendulum.scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF, SCENARIOS
 
-from double_pendulum import scenario_lines, scenario_pool
-from double_pendulum.analysis.progress import ENV
-from double_pendulum.analysis.sweep import WORKERS_ENV
 from double_pendulum.cli import main
+from double_pendulum.runs import lines as scenario_lines
+from double_pendulum.runs import pool as scenario_pool
+from double_pendulum.runs.pool import Costs
+from double_pendulum.runs.progress import ENV
+from double_pendulum.runs.workers import WORKERS_ENV
+
+COSTS = Costs(EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF)
+"""The scenarios' own costs, as the command line gives them to the pool."""
 
 
 def test_every_scenario_has_an_expected_cost_and_the_longest_start_first():
     assert set(EXPECTED_CPU_S) == set(SCENARIOS)
     assert set(EXPECTED_QUICK_CPU_S) == set(SCENARIOS)
-    order = scenario_pool.longest_first(SCENARIOS)
+    order = scenario_pool.longest_first(SCENARIOS, COSTS)
     costs = [EXPECTED_CPU_S[name] for name in order]
     assert costs == sorted(costs, reverse=True)
     assert sorted(order) == sorted(SCENARIOS)
 
 
 def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_small_ones_a_few_the_largest_first():
-    groups = scenario_pool.scenario_groups(SCENARIOS, quick=False, jobs=2)
-    order = scenario_pool.longest_first(SCENARIOS)
+    groups = scenario_pool.scenario_groups(SCENARIOS, COSTS, quick=False, jobs=2)
+    order = scenario_pool.longest_first(SCENARIOS, COSTS)
     small = [name for name in order if EXPECTED_CPU_S[name] < scenario_pool.SMALL_SCENARIO_CPU_S]
     assert 1 < len(small) < len(SCENARIOS)
     singles = [group for group in groups if not set(group) & set(small)]
@@ -38,49 +43,44 @@ def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_small_ones_a_
     assert totals == sorted(totals, reverse=True)
 
 
-def test_default_run_groups_sort_by_their_sum_and_keep_the_packing_order(monkeypatch):
+def test_default_run_groups_sort_by_their_sum_and_keep_the_packing_order():
     costs = {"a": 100.0, "b": 10.0, "cosimulation": 5.0, "c": 20.0, "d": 30.0}
-    monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", costs)
-    assert scenario_pool.scenario_groups(list(costs), quick=False, jobs=2) == [
+    assert scenario_pool.scenario_groups(list(costs), Costs(costs, {}), quick=False, jobs=2) == [
         ["a"], ["c", "b", "cosimulation"], ["d"]]  # the small ones' 35 s before d's 30 s, longest first
 
 
-def test_small_scenarios_are_packed_first_fit_under_the_cap(monkeypatch):
+def test_small_scenarios_are_packed_first_fit_under_the_cap():
     costs = {"a": 29.0, "b": 18.0, "c": 11.0, "d": 5.0, "e": 2.5, "f": 50.0}
-    monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", costs)
-    assert scenario_pool.pack_small(["f", "a", "b", "c", "d", "e"], cap=40.0) == [
+    assert scenario_pool.pack_small(["f", "a", "b", "c", "d", "e"], Costs(costs, {}), cap=40.0) == [
         ["f"], ["a", "c"], ["b", "d", "e"]]  # f over the cap alone; a + b would be 47 s
 
 
-def test_a_quick_run_shares_the_scenarios_out_longest_first_to_the_least_loaded(monkeypatch):
+def test_a_quick_run_shares_the_scenarios_out_longest_first_to_the_least_loaded():
     costs = {"a": 5.0, "b": 4.0, "c": 3.0, "d": 3.0, "e": 2.0, "cosimulation": 1.0, "f": 0.5}
-    monkeypatch.setattr(scenario_pool, "EXPECTED_QUICK_CPU_S", costs)
     # a 5 | b 4 | c -> b 7 | d -> a 8 | e -> b 9 | cosimulation -> a 9 | f -> a 9.5 (the first of the least)
-    assert scenario_pool.scenario_groups(list(costs), quick=True, jobs=2) == [
+    assert scenario_pool.scenario_groups(list(costs), Costs({}, costs), quick=True, jobs=2) == [
         ["a", "d", "cosimulation", "f"],  # 9.5, in the order they joined: no scenario needs to run first
         ["b", "c", "e"],  # 9
     ]
 
 
-def test_a_quick_run_keeps_a_scenario_that_reads_a_cached_fit_after_the_one_that_writes_it(monkeypatch):
+def test_a_quick_run_keeps_a_scenario_that_reads_a_cached_fit_after_the_one_that_writes_it():
     for jobs in (1, 2, 3, 4):  # the real pair: measured_vs_sim reads loss_identification's fit
-        host = next(group for group in scenario_pool.scenario_groups(SCENARIOS, quick=True, jobs=jobs)
+        host = next(group for group in scenario_pool.scenario_groups(SCENARIOS, COSTS, quick=True, jobs=jobs)
                     if "loss_identification" in group)
         assert host.index("measured_vs_sim") > host.index("loss_identification")
-    costs = {"a": 5.0, "writer": 4.0, "b": 3.5, "reader": 3.0, "cosimulation": 1.0}
-    monkeypatch.setattr(scenario_pool, "EXPECTED_QUICK_CPU_S", costs)
-    monkeypatch.setattr(scenario_pool, "READS_FITS_OF", {"reader": "writer"})
+    costs = Costs({}, {"a": 5.0, "writer": 4.0, "b": 3.5, "reader": 3.0, "cosimulation": 1.0}, {"reader": "writer"})
     # alone the reader would join a (a 5 | writer 4 | b -> 7.5 | reader -> a 8); as a unit: writer + reader 7 | a 5
     # | b -> a 8.5 | cosimulation -> 8
-    assert scenario_pool.scenario_groups(list(costs), quick=True, jobs=2) == [
+    assert scenario_pool.scenario_groups(list(costs.quick), costs, quick=True, jobs=2) == [
         ["a", "b"], ["writer", "reader", "cosimulation"]]
-    assert scenario_pool.scenario_groups(["a", "reader", "cosimulation"], quick=True, jobs=2) == [
+    assert scenario_pool.scenario_groups(["a", "reader", "cosimulation"], costs, quick=True, jobs=2) == [
         ["a"], ["reader", "cosimulation"]]  # without its writer the reader is placed alone
 
 
 @pytest.mark.parametrize("jobs", [1, 2, 3, 4, 11, 20])
 def test_quick_groups_hold_every_scenario_once_and_balanced(jobs):
-    groups = scenario_pool.scenario_groups(SCENARIOS, quick=True, jobs=jobs)
+    groups = scenario_pool.scenario_groups(SCENARIOS, COSTS, quick=True, jobs=jobs)
     assert len(groups) == min(jobs, len(SCENARIOS))
     assert sorted(name for group in groups for name in group) == sorted(SCENARIOS)
     assert all(group for group in groups)
@@ -188,8 +188,8 @@ def test_a_group_child_relays_its_scenarios_lines_marked_with_each(monkeypatch, 
     script = ("print('[1/2] a: first ...'); print('working'); print('a: wrote x'); "
               "print('[2/2] b: second ...'); print('working'); print('b: wrote y')")  # fmt: skip
     _fake_children(monkeypatch, {"a": script})
-    failed = scenario_pool.run_in_children(["a", "b"], tmp_path, tmp_path / "x.fmu", quick=True, thorough=False,
-                                           jobs=1)  # fmt: skip
+    failed = scenario_pool.run_in_children(["a", "b"], tmp_path, tmp_path / "x.fmu", COSTS, quick=True,
+                                           thorough=False, jobs=1)  # fmt: skip
     assert failed == []
     out = capsys.readouterr().out.splitlines()
     assert out == ["[1/2] a: first ...", "  a: working", "a: wrote x", "[2/2] b: second ...", "  b: working",
@@ -198,12 +198,12 @@ def test_a_group_child_relays_its_scenarios_lines_marked_with_each(monkeypatch, 
 
 def test_a_group_child_that_dies_mid_group_fails_the_rest_and_the_bar_still_ends_full(monkeypatch, tmp_path,
                                                                                        capsys):  # fmt: skip
-    monkeypatch.setattr(scenario_pool, "EXPECTED_QUICK_CPU_S", {"a": 5.0, "b": 3.0, "c": 2.0})
     bars = _recorded_bars(monkeypatch)
     _fake_children(monkeypatch, {"a": "import sys; print('[1/3] a: ...'); print('a: wrote x'); "
                                       "print('[2/3] b: ...'); sys.exit(3)"})  # fmt: skip
-    failed = scenario_pool.run_in_children(["c", "b", "a"], tmp_path, tmp_path / "x.fmu", quick=True, thorough=False,
-                                           jobs=1)  # fmt: skip
+    costs = Costs({}, {"a": 5.0, "b": 3.0, "c": 2.0})
+    failed = scenario_pool.run_in_children(["c", "b", "a"], tmp_path, tmp_path / "x.fmu", costs, quick=True,
+                                           thorough=False, jobs=1)  # fmt: skip
     assert failed == ["c", "b"]  # in the order of the names given
     err = capsys.readouterr().err
     assert "b: FAILED: its process ended with code 3" in err and "c: FAILED: its process ended with code 3" in err
@@ -213,13 +213,13 @@ def test_a_group_child_that_dies_mid_group_fails_the_rest_and_the_bar_still_ends
 
 
 def test_failed_children_are_named_and_the_others_finish(monkeypatch, tmp_path, capsys):
-    monkeypatch.setattr(scenario_pool, "EXPECTED_CPU_S", {"a": 300.0, "b": 200.0, "c": 100.0})  # a child each
+    costs = Costs({"a": 300.0, "b": 200.0, "c": 100.0}, {})  # a child each
     _fake_children(monkeypatch, {
         "a": "print('working'); import sys; sys.exit(3)",
         "b": "import sys; print('b: FAILED: bad input', file=sys.stderr); sys.exit(1)",
         "c": "print('c: wrote it')",
     })  # fmt: skip
-    failed = scenario_pool.run_in_children(["a", "b", "c"], tmp_path, tmp_path / "x.fmu", quick=False,
+    failed = scenario_pool.run_in_children(["a", "b", "c"], tmp_path, tmp_path / "x.fmu", costs, quick=False,
                                            thorough=False, jobs=2)  # fmt: skip
     assert failed == ["a", "b"]
     out, err = capsys.readouterr()
@@ -244,7 +244,8 @@ def test_ctrl_c_stops_every_child(monkeypatch, tmp_path):
     monkeypatch.setattr(scenario_pool, "_pause", interrupt)
     monkeypatch.setattr(scenario_pool, "STOP_GRACE_S", 0.2)
     with pytest.raises(KeyboardInterrupt):
-        scenario_pool.run_in_children(["a", "b"], tmp_path, tmp_path / "x.fmu", quick=True, thorough=False, jobs=2)
+        scenario_pool.run_in_children(["a", "b"], tmp_path, tmp_path / "x.fmu", COSTS, quick=True, thorough=False,
+                                      jobs=2)
     assert len(started) == 2
     assert all(child.process.poll() is not None for child in started)  # none left running
 
@@ -253,7 +254,7 @@ def test_several_scenarios_in_children_write_every_folder(tmp_path, capsys, fmu_
     names = ["energy_decay", "free_swing", "friction_budget"]
     assert main(["run", *names, "--quick", "--jobs", "2", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert sorted(p.name for p in tmp_path.iterdir()) == names
+    assert sorted(p.name for p in tmp_path.iterdir()) == [*names, "index.html"]  # the run's page by the parent alone
     assert "3 scenarios in 2 processes" in out
     # free_swing alone, energy_decay and friction_budget one after another in the other child: numbered 1 to 3
     # in the order they start

@@ -18,7 +18,7 @@ from double_pendulum.analysis.suspension.identification import (
 )
 from double_pendulum.analysis.suspension.response import pivot_force_spectrum
 from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, load_track, reconstruct
-from double_pendulum.results_io import read_results_csv
+from double_pendulum.runs.results_io import read_results_csv
 
 
 @pytest.fixture(scope="module")

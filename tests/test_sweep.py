@@ -9,9 +9,7 @@ import pytest
 
 from double_pendulum.analysis.chaos import flips
 from double_pendulum.analysis.sweep import (
-    WORKERS_ENV,
     chunk,
-    default_workers,
     grid_cases,
     parallel_map,
     random_cases,
@@ -19,6 +17,7 @@ from double_pendulum.analysis.sweep import (
     worker_pool,
 )
 from double_pendulum.fmu.runner import FmuRunError
+from double_pendulum.runs.workers import WORKERS_ENV, default_workers
 
 OPTIONS = {"stop_time": 0.5, "output_interval": 0.05}
 

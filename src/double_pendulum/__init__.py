@@ -11,7 +11,8 @@ What studies it (NumPy, SciPy, Matplotlib, fmpy; never bundled):
 
 * :mod:`.fmu` -- build the FMU, run it through fmpy or libcosim, or in-process;
 * :mod:`.analysis` -- measured track, decay fits, identification, chaos, ensembles, sweeps;
-* :mod:`.plots`, :mod:`.results_io`, :mod:`.scenarios` and :mod:`.cli`.
+* :mod:`.plots`, :mod:`.scenarios` and :mod:`.cli`;
+* :mod:`.runs` -- the run machinery: child processes, progress, Ctrl-C, the cache, the result files, the page.
 
 Imports point one way, from the studies to the runtime (``.importlinter``, checked in CI).
 Importing the package is cheap: the FMU loads it at start-up.

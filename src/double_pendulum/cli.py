@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import ast
 import contextlib
+import datetime
 import importlib
 import importlib.util
 import inspect
@@ -27,10 +28,10 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from . import __version__
-from .analysis.interrupts import acknowledge, handling_interrupts, interrupted
 from .component.variables import INTERFACES
 from .fmu.build import DEFAULT_FMU_PATH, build_all
-from .scenario_lines import failed_line, header_line, wrote_line
+from .runs.interrupts import acknowledge, handling_interrupts, interrupted
+from .runs.lines import failed_line, header_line, wrote_line
 from .scenarios import SCENARIOS
 
 PROG = "double-pendulum"
@@ -342,7 +343,8 @@ def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: 
 
 def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path, jobs: int) -> list[str]:
     """Build the FMU if needed, then run the scenarios in child processes, ``jobs`` at a time."""
-    from .scenario_pool import run_in_children
+    from .runs.pool import Costs, run_in_children
+    from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF
 
     _load_fmu(args.fmu, args.rebuild).close()  # build once here, and fail early on an unusable FMU
     if args.quick:
@@ -351,7 +353,8 @@ def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path
     else:
         print(f"running {len(names)} scenarios, {jobs} at a time in their own processes, the longest first",
               flush=True)
-    return run_in_children(names, out, Path(args.fmu), quick=args.quick, thorough=args.thorough, jobs=jobs)
+    costs = Costs(EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF)
+    return run_in_children(names, out, Path(args.fmu), costs, quick=args.quick, thorough=args.thorough, jobs=jobs)
 
 
 @contextlib.contextmanager
@@ -378,6 +381,23 @@ def private_tempdir() -> Iterator[Path]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
+def _run_command(args: argparse.Namespace) -> str:
+    """The ``run`` command line as the page shows it."""
+    flags = [flag for flag, on in (("--quick", args.quick), ("--thorough", args.thorough)) if on]
+    return " ".join([PROG, "run", *args.scenarios, *flags, "--out", args.out])
+
+
+def write_run_page(out: Path, args: argparse.Namespace, names: tuple[str, ...], failed: list[str],
+                   started: datetime.datetime, wall_s: float, cpu_s: float) -> Path:  # fmt: skip
+    """Write ``out/index.html``, the page of this run (:mod:`double_pendulum.runs.page`)."""
+    from .runs.page import RunInfo, write_index
+    from .scenarios import READING_ORDER, page
+
+    mode = "quick" if args.quick else "thorough" if args.thorough else "default"
+    run = RunInfo(started, __version__, mode, wall_s, cpu_s, _run_command(args), names, tuple(failed))
+    return write_index(out, run, [page(name, scenario_description(name)) for name in READING_ORDER])
+
+
 def cmd_run(args: argparse.Namespace) -> int:
     names = _check_scenarios(args.scenarios)
     if args.quick and args.thorough:
@@ -387,18 +407,62 @@ def cmd_run(args: argparse.Namespace) -> int:
     out = _writable_folder(args.out)
     if args.fmu is None:
         args.fmu = str(default_fmu_path(out))
-    from .analysis.sweep import default_workers  # one scenario per core this process may use
+    from .runs.workers import default_workers  # one scenario per core this process may use
 
     jobs = min(len(names), args.jobs or default_workers())
-    start, cpu_start = time.perf_counter(), _cpu_seconds()
+    started, start, cpu_start = datetime.datetime.now(datetime.UTC), time.perf_counter(), _cpu_seconds()
     with private_tempdir():
         failed = _run_in_children(names, args, out, jobs) if jobs > 1 else _run_in_this_process(names, args, out)
+    wall_s, cpu_s = time.perf_counter() - start, _cpu_seconds() - cpu_start
     if len(names) > 1 and args.index is None:  # a child of run_in_children leaves the sum to its parent
         print(f"{len(names) - len(failed)} of {len(names)} scenarios wrote {out} in "
-              f"{time.perf_counter() - start:.1f} s (CPU {_cpu_seconds() - cpu_start:.1f} s)", flush=True)
+              f"{wall_s:.1f} s (CPU {cpu_s:.1f} s)", flush=True)
+    if args.index is None:  # the page of the whole run, by the process that ran it all
+        index = write_run_page(out, args, names, failed, started, wall_s, cpu_s)
+        print(f"the whole run on one page: {index}", flush=True)
     if failed and args.index is None:
         print(f"{len(failed)} of {len(names)} scenarios failed: {', '.join(failed)}", file=sys.stderr)
     return 1 if failed else 0
+
+
+def _positive(option: str, value: float) -> float:
+    """``value`` of ``option`` if it is a positive finite number, else a CliError."""
+    if not (0.0 < value < float("inf")):
+        raise CliError(f"{option} must be a positive number of seconds, got {value:g}")
+    return value
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    """Run a case of one's own through the FMU (:mod:`double_pendulum.case`): CSV, figure, animation, summary."""
+    from fmpy import read_model_description
+
+    from .case import Case, run_case
+    from .fmu.start_values import StartValueError, parse_start_values
+
+    if args.me and args.fmi != "3":
+        raise CliError("--me needs --fmi 3: the FMI 2.0 FMU is co-simulation only")
+    stop, step = _positive("--stop", args.stop), _positive("--step", args.step)
+    if step > stop:
+        raise CliError(f"--step {step:g} s is longer than the run (--stop {stop:g} s)")
+    out = _writable_folder(args.out)
+    fmu2 = Path(args.fmu) if args.fmu is not None else default_fmu_path(out)
+    with private_tempdir():
+        _load_fmu(str(fmu2), args.rebuild).close()  # builds the FMUs if they are missing or stale
+        fmu = fmu2 if args.fmi == "2" else fmu2.parent / "fmi3" / fmu2.name
+        try:
+            values = parse_start_values(args.set, read_model_description(str(fmu)))
+        except StartValueError as error:
+            raise CliError(str(error)) from None
+        case = Case(fmu, values, stop, step, "ModelExchange" if args.me else "CoSimulation")
+        print(f"simulating {case.words()} through {fmu} with fmpy ...", flush=True)
+        outcome = run_case(case, out, animate=not args.no_animation)
+    names = ", ".join(path.name for path in outcome.files)
+    if outcome.message is not None:
+        print(f"{PROG}: the FMU stopped the run at t = {outcome.summary.get('end_time_s', 0.0):g} s: "
+              f"{outcome.message} (wrote {names} in {out})", file=sys.stderr)
+        return 1
+    print(f"wrote {names} in {out} ({outcome.summary['rows']} rows, {outcome.summary['wall_time_s']:.1f} s)")
+    return 0
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -466,6 +530,33 @@ def build_parser() -> argparse.ArgumentParser:
                          "input file; logs go to DIR/compliance-checker/")
     p_cross.set_defaults(func=cmd_cross_check)
 
+    p_sim = sub.add_parser(
+        "simulate",
+        help="run a case of your own through the FMU with fmpy: CSV, figure, animation, summary",
+        description="Run the FMU once with fmpy, from the start values you give, and write simulation.csv\n"
+        "(units in the column names), simulation.png (angles, energies and their budget, the bobs' paths),\n"
+        "simulation.gif (the pendulum in real time) and summary.json (with the fmpy call that gives the\n"
+        "same numbers) into OUT.",
+        epilog="example:\n  double-pendulum simulate --set phi1_0=2 --set air_drag=true --stop 20 --out my_case\n"
+        "parameters and their units: double-pendulum variables",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p_sim.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",
+                       help="start value of a parameter of the FMU, by its FMU name (repeatable)")
+    p_sim.add_argument("--stop", type=float, default=10.0, metavar="SECONDS", help="stop time (default: 10)")
+    p_sim.add_argument("--step", type=float, default=0.01, metavar="SECONDS",
+                       help="output interval, also the co-simulation step (default: 0.01)")
+    p_sim.add_argument("--fmi", choices=("2", "3"), default="2", help="FMI version of the FMU (default: 2)")
+    p_sim.add_argument("--me", action="store_true",
+                       help="model exchange (with --fmi 3): fmpy integrates the FMU with its own solver")
+    p_sim.add_argument("--out", default="results/simulate", help="output folder (default: results/simulate)")
+    p_sim.add_argument("--fmu", default=None,
+                       help="the FMI 2.0 FMU, built with the others next to it if missing or older than the sources "
+                       "(--fmi 3 uses fmi3/ next to it; default as for run)")
+    p_sim.add_argument("--rebuild", action="store_true", help="rebuild the FMUs first")
+    p_sim.add_argument("--no-animation", action="store_true", help="write no simulation.gif")
+    p_sim.set_defaults(func=cmd_simulate)
+
     p_list = sub.add_parser("list", help="list the scenarios", description="List the scenarios.")
     p_list.set_defaults(func=cmd_list)
 
@@ -488,8 +579,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{PROG}: error: {error}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print(f"{PROG}: interrupted; finished scenarios are kept, unfinished ones are discarded",
-              file=sys.stderr)
+        kept = ("nothing was written" if args.command == "simulate"
+                else "finished scenarios are kept, unfinished ones are discarded")
+        print(f"{PROG}: interrupted; {kept}", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader of stdout went away: say nothing more there
         _stdout_to_devnull()

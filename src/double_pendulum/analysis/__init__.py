@@ -2,6 +2,6 @@
 decay (:mod:`.decay`), the loss identification (:mod:`.losses`), the pivot suspension (:mod:`.suspension`),
 predictions of the track (:mod:`.prediction`), chaos and ensembles (:mod:`.chaos`), the solvers
 (:mod:`.solvers`), co-simulation (:mod:`.coupling`) and the driven pivot (:mod:`.excitation`); with the
-tools they share: parameter sweeps (:mod:`.sweep`), progress (:mod:`.progress`) and the result cache
-(:mod:`.result_cache`). Uses the model, the solvers and the FMU; never bundled.
+parameter sweeps they share (:mod:`.sweep`). Uses the model, the solvers, the FMU and the run machinery
+(:mod:`double_pendulum.runs`: progress, Ctrl-C, the result cache and files); never bundled.
 """

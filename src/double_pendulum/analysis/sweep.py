@@ -31,7 +31,6 @@ import itertools
 import math
 import multiprocessing
 import multiprocessing.util
-import os
 import sys
 import tempfile
 import threading
@@ -45,26 +44,11 @@ from typing import Any
 import numpy as np
 
 from ..fmu.runner import FmuRunError, FmuRunner
-from .interrupts import acknowledge, sigint_blocked, worker_ignores_sigint
-from .progress import progress_bar as _progress_bar
+from ..runs.interrupts import acknowledge, sigint_blocked, worker_ignores_sigint
+from ..runs.progress import progress_bar as _progress_bar
+from ..runs.workers import default_workers
 
 CHUNKS_PER_WORKER = 4
-
-
-WORKERS_ENV = "DOUBLE_PENDULUM_WORKERS"
-"""Environment variable capping the worker processes of every sweep (``run all`` sets it to 1 in its
-children, which already run one per core)."""
-
-
-def default_workers() -> int:
-    """Number of worker processes a sweep uses by default: the cores this process may use, at most
-    ``$DOUBLE_PENDULUM_WORKERS`` when that is set to a positive integer."""
-    try:
-        cores = max(1, len(os.sched_getaffinity(0)))
-    except AttributeError:  # not on Linux
-        cores = max(1, os.cpu_count() or 1)
-    cap = os.environ.get(WORKERS_ENV, "").strip()
-    return min(cores, int(cap)) if cap.isdigit() and int(cap) > 0 else cores
 
 
 def chunk(items: Sequence[Any], n_chunks: int) -> list[list[Any]]:
@@ -118,7 +102,7 @@ def _call(func: Callable[..., Any], item: Any, shared: Any) -> Any:
 
 
 def progress_bar(total: int, label: str, *, enabled: bool | None = None, unit: str = "run") -> Any:
-    """A progress counter on stderr (:func:`double_pendulum.analysis.progress.progress_bar`): a tqdm bar
+    """A progress counter on stderr (:func:`double_pendulum.runs.progress.progress_bar`): a tqdm bar
     on a terminal or in a notebook, a few plain lines for long loops otherwise."""
     return _progress_bar(total, label, enabled=enabled, unit=unit)
 

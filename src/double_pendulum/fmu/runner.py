@@ -129,8 +129,8 @@ class FmuRunner:
         messages = self._messages
         messages.clear()
 
-        def logger(_env: Any, _instance: Any, status: int, _category: Any, message: bytes) -> None:
-            _collect(messages, status, message)
+        def logger(*call: Any) -> None:  # FMI 2: (env, instance, status, category, message); FMI 3: no instance
+            _collect(messages, call[-3], call[-1])
 
         try:
             with _fmu_errors_to_log_only():

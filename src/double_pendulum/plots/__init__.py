@@ -1,5 +1,6 @@
 """Matplotlib figures for scenario results (PNG files, headless), one module a topic."""
 
+from .animation import Swing, animate_swings, swing
 from .chaos import (
     plot_ensemble_clouds,
     plot_ensemble_spread,
@@ -14,7 +15,13 @@ from .chaos import (
 )
 from .decay import plot_circle_fit, plot_energy_decay
 from .losses import plot_energy_fit, plot_loss_shares, plot_profiles
-from .prediction import plot_prediction_errors, plot_track_comparison, run_colours
+from .prediction import (
+    animate_prediction,
+    plot_lower_bob_paths,
+    plot_prediction_errors,
+    plot_track_comparison,
+    run_colours,
+)
 from .solvers import plot_work_precision
 from .suspension import plot_decay_rate_cuts, plot_decay_rate_map, plot_energy_flow, plot_force_spectrum
 from .trajectories import (
@@ -55,6 +62,11 @@ __all__ = [
     "plot_track_comparison",
     "plot_prediction_errors",
     "run_colours",
+    "plot_lower_bob_paths",
+    "Swing",
+    "animate_swings",
+    "animate_prediction",
+    "swing",
     "plot_energy_fit",
     "plot_loss_shares",
     "plot_profiles",

@@ -8,6 +8,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .animation import animate_swings, swing
 from .style import legend_below, save
 
 ERROR_FLOOR_M = 1e-5
@@ -91,3 +92,47 @@ def plot_prediction_errors(
     ax.grid(alpha=0.3, which="both")
     legend_below(fig, *ax.get_legend_handles_labels(), ncols=2, fontsize=8)
     return save(fig, path)
+
+
+def plot_lower_bob_paths(
+    paths: np.ndarray,
+    path: str | Path,
+    *,
+    run: str,
+    colour: str = "C0",
+    window_s: float = 2.0,
+    title: str = "path of the lower bob in the x-y plane: measured track and FMU prediction",
+) -> Path:
+    """The lower bob's measured positions (dots) and the simulated run's (line, ``colour``; ``run``: its title) in
+    the x-y plane [m], relative to the measured pivot, in three windows of ``window_s`` seconds (at most a third
+    of the comparison each): at its start, in its middle and at its end. ``paths``: the table of
+    :func:`~double_pendulum.analysis.prediction.paths.paths_table`, as read back from ``paths.csv``."""
+    t = np.asarray(paths["t_since_t0"])
+    span = float(t[-1])
+    width = min(window_s, span / 3)
+    starts = (0.0, (span - width) / 2, span - width)
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5.6), sharex=True, sharey=True)
+    for ax, start in zip(axes, starts):
+        rows = (t >= start - 1e-9) & (t <= start + width + 1e-9)
+        ax.plot(paths["x2_simulated"][rows], paths["y2_simulated"][rows], "-", color=colour, lw=1.2,
+                label=f"simulated lower bob (FMU, at the camera's frames): {run}")
+        ax.plot(paths["x2_measured"][rows], paths["y2_measured"][rows], ".", color="k", ms=4,
+                label="measured lower bob (camera track, one dot a frame)")
+        ax.set(title=f"t - t0 = {t[rows][0]:.2f} to {t[rows][-1]:.2f} s", aspect="equal",
+               xlabel="horizontal position x [m], from the pivot")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("vertical position y [m], up from the pivot")
+    fig.suptitle(f"{title}, at the start, in the middle and at the end of the {span:.2f} s compared")
+    legend_below(fig, *axes[0].get_legend_handles_labels(), ncols=2)
+    return save(fig, path)
+
+
+def animate_prediction(paths: np.ndarray, path: str | Path, *, colour: str = "C0") -> Path:
+    """The camera's two markers (black rings) and the simulated pendulum (rods and bobs, ``colour``) overlaid as a
+    real-time GIF (:func:`~double_pendulum.plots.animation.animate_swings`), relative to the measured pivot, from
+    the table of :func:`~double_pendulum.analysis.prediction.paths.paths_table` as read back from ``paths.csv``."""
+    pivot = (float(paths["pivot_x_simulated"][0]), float(paths["pivot_y_simulated"][0]))
+    swings = [swing(paths, "camera", "k", suffix="_measured", links=False),
+              swing(paths, "FMU", colour, suffix="_simulated", pivot=pivot)]
+    title = f"measured (camera) and simulated (FMU) pendulum from t0 = {float(paths['time'][0]):.2f} s"
+    return animate_swings(paths["t_since_t0"], swings, path, title=title, time_label="t - t0")

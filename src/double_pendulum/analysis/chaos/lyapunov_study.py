@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...model.parameters import PendulumParameters
-from ...results_io import table_from_columns
+from ...runs.results_io import table_from_columns
 from .ensemble import BatchField, batch_energy, initial_states
 from .flips import flip_energy_threshold
 from .lyapunov import (

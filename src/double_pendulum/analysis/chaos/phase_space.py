@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...model.parameters import PendulumParameters
-from ...results_io import table_from_columns
+from ...runs.results_io import table_from_columns
 from . import flips, poincare
 from .ensemble import BatchField, batch_energy, batch_potential_energy, initial_states
 

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...model.parameters import PendulumParameters
-from ...results_io import table_from_columns
+from ...runs.results_io import table_from_columns
 from . import releases
 from .ensemble import BatchField, dop853_trajectory, initial_states, pendulum_field
 

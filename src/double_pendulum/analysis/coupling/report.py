@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ...results_io import report_opening
+from ...runs.results_io import report_opening
 from .stability import __doc__ as DERIVATION
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ...results_io import report_opening
+from ...runs.results_io import report_opening
 from ..track.measurement import FPS, SEED_TOTAL_MASS_KG, SG_POLYORDER, SG_WINDOW
 from .error_budget import budget_table
 from .fit import AUTOCORRELATION_LAG_S

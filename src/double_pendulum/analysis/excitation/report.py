@@ -7,7 +7,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ...model.parameters import PendulumParameters
-from ...results_io import report_opening
+from ...runs.results_io import report_opening
 from .drive import FLOQUET_TOLERANCE
 from .study import KapitzaResult, distance_to_bound, normal_modes, wedge_tip_frequency
 from .theory import equivalent_lengths

@@ -59,8 +59,8 @@ import numpy as np
 
 from ...fmu.simulate import simulate
 from ...model.parameters import SEED_RIGID_LINKS
+from ...runs.result_cache import cached
 from ..decay.fit import fit_model
-from ..result_cache import cached
 from ..suspension.identification import MeasuredDecay, decay_shape, fit_release_state
 from ..track.measurement import FRAME_INTERVAL, Reconstruction
 from .mechanisms import (
@@ -262,7 +262,7 @@ def fit_loss_model(
     """Fit ``model`` to ``problem`` (least squares in x = theta/ref); ``fixed``: index -> value held.
 
     ``start``: start values of theta (default the references). Returns the fit at the optimum. Fits
-    are cached on disk (:func:`~double_pendulum.analysis.result_cache.cached`, kind ``loss_fits``)
+    are cached on disk (:func:`~double_pendulum.runs.result_cache.cached`, kind ``loss_fits``)
     under the model, the start, the held values, the run budget and the problem's digest: a repeated
     run, or another scenario fitting the same model from the same start, reads the same fit.
     """

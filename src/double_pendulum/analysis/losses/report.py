@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from ...results_io import report_opening
+from ...runs.results_io import report_opening
 from .mechanisms import model_title
 
 

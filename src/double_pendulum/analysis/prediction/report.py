@@ -14,7 +14,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from ...results_io import report_opening
+from ...runs.results_io import report_opening
 from ..track.measurement import FPS
 
 LABELS = {

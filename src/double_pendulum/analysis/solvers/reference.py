@@ -28,7 +28,7 @@ import numpy as np
 
 from ...component.cosimulation import DoublePendulumCoSimulation
 from ...fmu.simulate import simulate
-from ..result_cache import cache_root, key_hash, sources_hash
+from ...runs.result_cache import cache_root, key_hash, sources_hash
 
 STATE_OUTPUTS = ("phi1", "phi2", "omega1", "omega2")
 REFERENCE_SETTINGS = {"solver": "dop853", "rtol": 1e-13, "atol": 1e-15, "max_steps": 1e8}

@@ -21,7 +21,7 @@ import numpy as np
 
 from ...fmu.runner import FmuRunError, FmuRunner
 from ...model.parameters import PendulumParameters
-from ...results_io import report_opening
+from ...runs.results_io import report_opening
 
 STIFF = "rodas4"
 SYMPLECTIC = "gauss4"

@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 from ...fmu.runner import FmuRunError, FmuRunner
-from ...results_io import report_opening
+from ...runs.results_io import report_opening
 from ...solvers import make_method
 from .reference import STATE_OUTPUTS, Reference, reference_solution
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ...results_io import report_opening
+from ...runs.results_io import report_opening
 from .decay_map import k_of_key
 
 

@@ -1,5 +1,5 @@
 """The lines a scenario run prints about itself, defined once: printed by :mod:`double_pendulum.cli`,
-read back by :mod:`double_pendulum.scenario_pool` from its child processes.
+read back by :mod:`double_pendulum.runs.pool` from its child processes.
 
 * header (stdout): ``[k/N] NAME: description ...`` when the scenario starts;
 * wrote (stdout): ``NAME: wrote FOLDER in X s (CPU Y s)`` when it finished;

@@ -6,6 +6,8 @@ a time (one per core by default) keeps the cores busy. Each child is ``python -m
 double_pendulum.cli run NAME... --jobs 1 ...``, so it writes its results exactly as a single run
 does (fresh folder, replaced on success).
 
+What the pool knows of the scenarios, their expected CPU times and which reads another's cached fit, the
+command line gives it (:class:`Costs`, from :mod:`double_pendulum.scenarios`): the pool imports no scenario.
 A default or thorough run gives every scenario a child of its own, the longest first (by
 :data:`double_pendulum.scenarios.EXPECTED_CPU_S`), so the run does not end on a long scenario started
 last, and a scenario cannot disturb another's process; only the small ones (under
@@ -29,7 +31,7 @@ of the time left are not inflated by the scenarios that have not finished yet.
 
 Ctrl-C reaches the children too (they share the terminal's process group): each discards its unfinished
 scenario and ends; the parent waits up to :data:`STOP_GRACE_S` for them, kills what is left, and a
-second Ctrl-C ends that wait at once (:func:`double_pendulum.analysis.interrupts.hurried`).
+second Ctrl-C ends that wait at once (:func:`double_pendulum.runs.interrupts.hurried`).
 """
 
 from __future__ import annotations
@@ -45,12 +47,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
-from .analysis.interrupts import acknowledge, hurried
-from .analysis.progress import ENV as PROGRESS_ENV
-from .analysis.progress import progress_bar, write_line
-from .analysis.sweep import WORKERS_ENV
-from .scenario_lines import FAILED, WROTE, failed_line, header_name, outcome, renumbered
-from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF
+from .interrupts import acknowledge, hurried
+from .lines import FAILED, WROTE, failed_line, header_name, outcome, renumbered
+from .progress import ENV as PROGRESS_ENV
+from .progress import progress_bar, write_line
+from .workers import WORKERS_ENV
 
 POLL_S = 0.2
 """How often [s] the parent looks for finished children."""
@@ -60,42 +61,54 @@ CREDIT_CAP = 0.9
 """At most this fraction of a running scenario's share of the progress bar is credited before it reports."""
 
 
-def expected_cpu_s(name: str, quick: bool) -> float:
-    """The expected CPU time [s] of scenario ``name`` in a quick or a default run (1 s if unknown)."""
-    return (EXPECTED_QUICK_CPU_S if quick else EXPECTED_CPU_S).get(name, 1.0)
+@dataclass(frozen=True)
+class Costs:
+    """What the pool knows of the scenarios it schedules, given by the caller (the command line passes
+    :data:`double_pendulum.scenarios.EXPECTED_CPU_S`, ``EXPECTED_QUICK_CPU_S`` and ``READS_FITS_OF``): the expected
+    CPU time [s] of each in a default and in a quick run, and which scenario reads a fit another one caches (by
+    the name of that one)."""
+
+    default: Mapping[str, float]
+    quick: Mapping[str, float]
+    reads_fits_of: Mapping[str, str] = field(default_factory=dict)
+
+    def cpu_s(self, name: str, quick: bool) -> float:
+        """The expected CPU time [s] of scenario ``name`` in a quick or a default run (1 s if unknown)."""
+        return (self.quick if quick else self.default).get(name, 1.0)
 
 
-def longest_first(names: Sequence[str], quick: bool = False) -> list[str]:
+def longest_first(names: Sequence[str], costs: Costs, quick: bool = False) -> list[str]:
     """``names`` ordered by expected CPU time, longest first (ties keep their order)."""
-    return sorted(names, key=lambda name: -expected_cpu_s(name, quick))
+    return sorted(names, key=lambda name: -costs.cpu_s(name, quick))
 
 
-def _units(names: Sequence[str]) -> list[list[str]]:
+def _units(names: Sequence[str], costs: Costs) -> list[list[str]]:
     """``names`` (longest first) as the units :func:`balanced_groups` places: one scenario each, except that a
-    scenario reading another's cached fit (:data:`~double_pendulum.scenarios.READS_FITS_OF`) follows that one
-    in its unit, if both are in ``names``."""
-    order = longest_first(names, quick=True)
-    units = {name: [name] for name in order if READS_FITS_OF.get(name) not in order}
+    scenario reading another's cached fit (:attr:`Costs.reads_fits_of`) follows that one in its unit, if both are
+    in ``names``."""
+    order = longest_first(names, costs, quick=True)
+    reads = costs.reads_fits_of
+    units = {name: [name] for name in order if reads.get(name) not in order}
     for name in order:
         if name not in units:
-            units[READS_FITS_OF[name]].append(name)
+            units[reads[name]].append(name)
     return list(units.values())
 
 
-def balanced_groups(names: Sequence[str], count: int) -> list[list[str]]:
+def balanced_groups(names: Sequence[str], count: int, costs: Costs) -> list[list[str]]:
     """``names`` shared out among ``count`` groups of about equal expected quick-run CPU time: each unit
     (a scenario; with fewer groups than scenarios, a scenario and those reading its cached fit,
     :func:`_units`), the longest first, joins the group with the least so far. Within a group the
     scenarios run in the order they joined (a reader after the scenario it reads from); the groups come
     largest first; none is empty."""
-    units = _units(names) if count < len(names) else [[name] for name in longest_first(names, quick=True)]
-    units.sort(key=lambda unit: -sum(expected_cpu_s(name, quick=True) for name in unit))  # stable: ties keep order
+    units = _units(names, costs) if count < len(names) else [[name] for name in longest_first(names, costs, True)]
+    units.sort(key=lambda unit: -sum(costs.cpu_s(name, quick=True) for name in unit))  # stable: ties keep order
     groups: list[list[str]] = [[] for _ in range(max(1, min(count, len(units))))]
     totals = [0.0] * len(groups)
     for unit in units:
         least = totals.index(min(totals))
         groups[least] += unit
-        totals[least] += sum(expected_cpu_s(name, quick=True) for name in unit)
+        totals[least] += sum(costs.cpu_s(name, quick=True) for name in unit)
     order = sorted(range(len(groups)), key=lambda k: -totals[k])
     return [groups[k] for k in order if groups[k]]
 
@@ -108,13 +121,13 @@ SMALL_GROUP_CPU_S = 40.0
 one large one: the last children to start are short, so the cores finish at about the same time)."""
 
 
-def pack_small(names: Sequence[str], cap: float = SMALL_GROUP_CPU_S) -> list[list[str]]:
+def pack_small(names: Sequence[str], costs: Costs, cap: float = SMALL_GROUP_CPU_S) -> list[list[str]]:
     """``names`` (longest first) packed first-fit into groups of at most ``cap`` expected default-run CPU
     seconds (a scenario over ``cap`` alone)."""
     groups: list[list[str]] = []
     totals: list[float] = []
     for name in names:
-        cost = expected_cpu_s(name, quick=False)
+        cost = costs.cpu_s(name, quick=False)
         fit = next((k for k, total in enumerate(totals) if total + cost <= cap), None)
         if fit is None:
             groups.append([name])
@@ -125,17 +138,17 @@ def pack_small(names: Sequence[str], cap: float = SMALL_GROUP_CPU_S) -> list[lis
     return groups
 
 
-def scenario_groups(names: Sequence[str], *, quick: bool, jobs: int) -> list[list[str]]:
+def scenario_groups(names: Sequence[str], costs: Costs, *, quick: bool, jobs: int) -> list[list[str]]:
     """The scenarios each child runs, in the order the children start: in a quick run ``jobs``
     balanced groups (:func:`balanced_groups`), otherwise one scenario per child, except that those
     under :data:`SMALL_SCENARIO_CPU_S` share children of at most :data:`SMALL_GROUP_CPU_S`
     (:func:`pack_small`); the children with the most expected CPU time first."""
     if quick:
-        return balanced_groups(names, jobs)
-    order = longest_first(names)
-    small = [name for name in order if expected_cpu_s(name, quick=False) < SMALL_SCENARIO_CPU_S]
-    groups = [[name] for name in order if name not in small] + pack_small(small)
-    return sorted(groups, key=lambda group: -sum(expected_cpu_s(name, quick=False) for name in group))
+        return balanced_groups(names, jobs, costs)
+    order = longest_first(names, costs)
+    small = [name for name in order if costs.cpu_s(name, quick=False) < SMALL_SCENARIO_CPU_S]
+    groups = [[name] for name in order if name not in small] + pack_small(small, costs)
+    return sorted(groups, key=lambda group: -sum(costs.cpu_s(name, quick=False) for name in group))
 
 
 def child_command(names: Sequence[str], indices: Sequence[str], out: Path, fmu: Path, quick: bool,
@@ -289,15 +302,15 @@ def progress_done(weight: Mapping[str, int], done: Collection[str], running: Seq
 
 
 def run_in_children(
-    names: Sequence[str], out: Path, fmu: Path, *, quick: bool, thorough: bool, jobs: int
+    names: Sequence[str], out: Path, fmu: Path, costs: Costs, *, quick: bool, thorough: bool, jobs: int
 ) -> list[str]:
     """Run the scenarios ``names`` in child processes, ``jobs`` at a time (:func:`scenario_groups`:
     one scenario per child, or in a quick run ``jobs`` children with a group each); return the names
     of those that failed, in the order of ``names``. Ctrl-C stops every child and raises
     KeyboardInterrupt once they have cleaned up."""
-    weight = {name: max(1, round(expected_cpu_s(name, quick))) for name in names}
+    weight = {name: max(1, round(costs.cpu_s(name, quick))) for name in names}
     lock = threading.Lock()
-    waiting, running, failed = scenario_groups(names, quick=quick, jobs=jobs), [], []
+    waiting, running, failed = scenario_groups(names, costs, quick=quick, jobs=jobs), [], []
     order = [name for group in waiting for name in group]  # the children's own "k/N": until their header is seen
     starts = itertools.count(1)
     done: set[str] = set()  # scenarios whose whole share the bar holds

@@ -1,0 +1,168 @@
+"""A case of one's own (``double-pendulum simulate``): the FMU run once, the way fmpy runs it, to a CSV file, a
+figure, an animation and a summary.
+
+:func:`run_case` calls :func:`fmpy.simulate_fmu` on the FMU with the user's start values (through
+:class:`~double_pendulum.fmu.runner.FmuRunner`, a new instance, as a plain ``simulate_fmu`` call makes: the
+numbers are fmpy's, bit for bit, ``summary.json`` says which call gives them) and writes into the output folder:
+
+* ``simulation.csv``: time and every output, units in the column names;
+* ``simulation.png``: angles, energies, the energy budget and the bobs' paths, drawn from the CSV file;
+* ``simulation.gif``: the pendulum in real time, drawn from the CSV file (at most the first
+  :data:`MAX_ANIMATION_S` seconds);
+* ``summary.json``: the call, the start values, how the run ended and its energies.
+
+The files are made in a folder of their own inside the output folder and moved into it once all are written,
+so an interrupted run changes nothing there and leaves nothing behind. When the FMU stops the run (a bad value
+it refuses at the start, a step it cannot complete), the rows it returned are written all the same, with the
+FMU's message in the summary and the figure.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .fmu.runner import FmuRunError, FmuRunner
+from .fmu.start_values import value_text
+from .plots import animate_swings, swing
+from .plots.case import plot_case
+from .runs.interrupts import acknowledge, interrupted
+from .runs.results_io import read_results_csv, write_json, write_results_csv
+
+MAX_ANIMATION_S = 30.0
+"""The animation shows at most this much of a run [s] (600 frames at 20 a second: about 3 MB)."""
+FILES = ("simulation.csv", "simulation.png", "simulation.gif", "summary.json")
+"""What :func:`run_case` writes, in that order."""
+FMI_TYPES = {"CoSimulation": "co-simulation", "ModelExchange": "model exchange"}
+
+
+@dataclass(frozen=True)
+class Case:
+    """A run of the FMU file ``fmu`` as :func:`fmpy.simulate_fmu` makes it: ``fmi_type``, the ``start_values``,
+    ``stop_time`` [s] and ``output_interval`` [s] (also the communication step of a co-simulation)."""
+
+    fmu: Path
+    start_values: dict[str, Any] = field(default_factory=dict)
+    stop_time: float = 10.0
+    output_interval: float = 0.01
+    fmi_type: str = "CoSimulation"
+
+    def fmpy_call(self) -> str:
+        """The Python call that gives the same numbers."""
+        return (f"fmpy.simulate_fmu({str(self.fmu)!r}, fmi_type={self.fmi_type!r}, "
+                f"start_values={self.start_values!r}, stop_time={self.stop_time!r}, "
+                f"output_interval={self.output_interval!r})")
+
+    def words(self) -> str:
+        """The case in a line: its start values and length."""
+        values = ", ".join(f"{k} = {value_text(v)}" for k, v in self.start_values.items()) or "the FMU's defaults"
+        return f"{values}; {self.stop_time:g} s"
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What :func:`run_case` wrote (``files`` in the output folder) and the run's ``summary``; ``message``: why the
+    FMU stopped the run (None if it ran to the stop time)."""
+
+    files: list[Path]
+    summary: dict[str, Any]
+    message: str | None
+
+
+def _summary(case: Case, runner: FmuRunner, result: np.ndarray | None, message: str | None,
+             wall_s: float) -> dict[str, Any]:  # fmt: skip
+    """``summary.json``: the call, the case and how the run ended, with the energies of the rows returned."""
+    md = runner.model_description
+    experiment = md.defaultExperiment
+    summary: dict[str, Any] = {
+        "command": "double-pendulum simulate",
+        "fmpy_call": case.fmpy_call(),
+        "fmu": str(case.fmu),
+        "fmi_version": md.fmiVersion,
+        "fmi_type": case.fmi_type,
+        "start_values": case.start_values,
+        "stop_time_s": case.stop_time,
+        "output_interval_s": case.output_interval,
+        "status": "finished" if message is None else "stopped by the FMU",
+        "fmu_message": message,
+        "rows": 0 if result is None else len(result),
+        "wall_time_s": wall_s,
+        "null_means": {"fmu_message": "the run reached its stop time",
+                       "relative_tolerance": "not used: the FMU integrates with its own solver (its rtol)"},
+    }
+    if case.fmi_type == "ModelExchange":  # fmpy's CVode: the default experiment's tolerance, else its own 1e-5
+        summary["relative_tolerance"] = float(experiment.tolerance) if experiment and experiment.tolerance else 1e-5
+    else:
+        summary["relative_tolerance"] = None
+    if result is not None and len(result):
+        e = np.asarray(result["E_total"])
+        summary.update(end_time_s=float(result["time"][-1]), E_total_start_J=float(e[0]),
+                       E_total_end_J=float(e[-1]),
+                       max_abs_energy_residual_J=float(np.max(np.abs(result["energy_residual"]))))
+    return summary
+
+
+def _title(case: Case, summary: dict[str, Any]) -> str:
+    kind = FMI_TYPES.get(case.fmi_type, case.fmi_type)
+    line = f"your case: {case.words()}, FMI {summary['fmi_version']} {kind} through fmpy"
+    if summary["fmu_message"] is not None:
+        line += f"\nstopped by the FMU at t = {summary.get('end_time_s', 0.0):g} s: {summary['fmu_message']}"
+    return line
+
+
+def _draw(folder: Path, case: Case, summary: dict[str, Any], animate: bool) -> None:
+    """The figure and the animation, drawn from ``simulation.csv`` as written."""
+    result = read_results_csv(folder / "simulation.csv")
+    plot_case(result, folder / "simulation.png", title=_title(case, summary))
+    rows = result["time"] <= MAX_ANIMATION_S + 1e-9
+    if animate and rows.sum() > 1:
+        shown = float(result["time"][rows][-1])
+        note = "" if shown >= float(result["time"][-1]) else f" (the first {shown:g} s)"
+        animate_swings(result["time"][rows], [swing(result[rows], "your case", "C0")], folder / "simulation.gif",
+                       title=f"{case.words()}{note}")
+        summary["animation_s"] = shown
+    else:
+        summary["animation_s"] = None
+        summary["null_means"]["animation_s"] = "no animation: fewer than two rows, or switched off"
+
+
+def run_case(case: Case, out: Path, *, animate: bool = True) -> Outcome:
+    """Run ``case`` and write :data:`FILES` into ``out`` (the GIF only if ``animate``); see the module docstring.
+    KeyboardInterrupt (also when the FMU turned Ctrl-C into a failed run) leaves ``out`` as it was."""
+    out = Path(out)
+    staging = Path(tempfile.mkdtemp(prefix=".simulate-", dir=out))
+    try:
+        with FmuRunner(case.fmu, reuse_instance=False) as runner:
+            start, message = time.perf_counter(), None
+            try:
+                result = runner.simulate(case.start_values, stop_time=case.stop_time,
+                                         output_interval=case.output_interval, fmi_type=case.fmi_type)
+            except FmuRunError as error:
+                if interrupted():
+                    raise KeyboardInterrupt from None
+                result, message = error.partial_result, str(error).split(" -- FMU says: ")[-1]
+            summary = _summary(case, runner, result, message, time.perf_counter() - start)
+            if result is not None and len(result):
+                write_results_csv(staging / "simulation.csv", result, runner.units)
+                _draw(staging, case, summary, animate)
+        write_json(staging / "summary.json", summary)
+        written = []
+        for name in FILES:  # this run's set replaces an earlier run's whole: no file of that one stays beside it
+            if (staging / name).is_file():
+                os.replace(staging / name, out / name)
+                written.append(out / name)
+            else:
+                (out / name).unlink(missing_ok=True)
+        return Outcome(written, summary, message)
+    except KeyboardInterrupt:
+        acknowledge()  # the run stops here: a repeated interrupt must not cut the clean-up below short
+        raise
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)

@@ -1,0 +1,291 @@
+"""``index.html``: one page that shows a whole run, written into the output folder by every ``double-pendulum run``.
+
+At the top the run itself (date, version, mode, wall and CPU time, the command) and a list of the scenarios that
+ran; then, for each, its plain summary (the "In short" of its ``report.md``, or ``in_short`` of its
+``summary.json``), its headline figures with their uncertainty, read from its ``summary.json`` as the scenario
+wrote them (:class:`Headline`: nothing on the page is a number typed by hand), its key figures and animations,
+and links to its report, its CSV files, its ``summary.json`` and its other figures. Scenario folders of earlier
+runs that this run did not touch are listed at the end, with links.
+
+The page is self-contained: plain HTML with its style sheet inline, every link and image a relative path into
+the output folder, no script, nothing from the network. It is written atomically (:mod:`.results_io`). The
+scenarios' registry (:mod:`double_pendulum.scenarios`) declares what it shows of each with the classes here, so
+this module imports nothing slow at its top.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+import math
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from datetime import datetime
+from pathlib import Path
+from typing import Any
+
+PAGE = "index.html"
+
+
+@dataclass(frozen=True)
+class Headline:
+    """A headline figure of a scenario: ``label`` in words, the ``value`` and its ``uncertainty`` (one standard
+    error or the error budget's total, as the summary says) as paths into ``summary.json`` (:func:`lookup`), its
+    ``unit``, and ``note``: the path of a text in the summary that qualifies it (e.g. why a horizon is a bound)."""
+
+    label: str
+    value: str
+    uncertainty: str | None = None
+    unit: str = ""
+    note: str | None = None
+
+
+@dataclass(frozen=True)
+class ScenarioPage:
+    """What the page shows of one scenario: its ``description``, its :class:`Headline` figures and its key
+    ``figures`` (file name and caption, in the order shown)."""
+
+    name: str
+    description: str
+    headlines: Sequence[Headline] = ()
+    figures: Sequence[tuple[str, str]] = ()
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """The run the page is about: when it ``started``, the package ``version``, its ``mode`` (quick, default or
+    thorough), its wall and CPU time [s], the ``command``, the scenarios it ran (in the order given) and those of
+    them that ``failed``."""
+
+    started: datetime
+    version: str
+    mode: str
+    wall_s: float
+    cpu_s: float
+    command: str
+    ran: Sequence[str]
+    failed: Sequence[str] = field(default_factory=tuple)
+
+
+_PART = re.compile(r"(?<! )/(?! )")
+"""Path parts are separated by ``/``; a ``/`` between spaces belongs to a key (``"regular / default / jacobi"``)."""
+
+
+def lookup(summary: Any, path: str) -> Any:
+    """The value at ``path`` in ``summary``: keys separated by ``/`` (see :data:`_PART`), an integer indexes a list,
+    ``[name=value]`` selects the list entry whose ``name`` is ``value``; ``*SCALE`` at the end multiplies a number
+    (each number of a list) by SCALE. A KeyError (or IndexError) if the path does not exist."""
+    path, _, scale = path.partition("*")
+    value = summary
+    for part in _PART.split(path):
+        selector = re.fullmatch(r"\[(\w+)=(.+)\]", part)
+        if selector:
+            value = next(v for v in value if str(v.get(selector[1])) == selector[2])
+        elif isinstance(value, list):
+            value = value[int(part)]
+        else:
+            value = value[part]
+    if not scale:
+        return value
+    factor = float(scale)
+    if isinstance(value, list):
+        return [v * factor if isinstance(v, (int, float)) and not isinstance(v, bool) else v for v in value]
+    return value * factor if isinstance(value, (int, float)) and not isinstance(value, bool) else value
+
+
+def null_reason(summary: Any, path: str) -> str | None:
+    """Why the value at ``path`` is null: the text of a ``null_means`` entry at or above it that names a key on
+    the path (as the summaries explain their nulls), or None."""
+    parts = _PART.split(path.partition("*")[0])
+    node, reason = summary, None
+    for part in parts:
+        if isinstance(node, dict):
+            means = node.get("null_means", {})
+            reason = next((means[p] for p in parts if p in means), reason)
+            node = node.get(part)
+        elif isinstance(node, list) and part.isdigit() and int(part) < len(node):
+            node = node[int(part)]
+        else:
+            break
+    return reason
+
+
+def _decimals(uncertainty: float) -> int:
+    """Decimals that show ``uncertainty`` (> 0) to two significant digits."""
+    return max(0, 1 - math.floor(math.log10(uncertainty)))
+
+
+def format_figure(value: Any, uncertainty: Any = None) -> str:
+    """A headline value as text: a number with its uncertainty as ``v +- u`` (u to two significant digits, v to
+    the same decimal), a number alone to four significant digits, a range ``lo to hi``, yes/no, or the text."""
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value):
+        return f"{format_figure(value[0])} to {format_figure(value[1])}"
+    if isinstance(value, int):
+        return str(value)
+    if not isinstance(value, float):
+        return str(value)
+    if isinstance(uncertainty, (int, float)) and not isinstance(uncertainty, bool) and uncertainty > 0:
+        exponent = math.floor(math.log10(abs(value))) if value and not 1e-3 <= abs(value) < 1e5 else 0
+        v, u = value / 10**exponent, float(uncertainty) / 10**exponent
+        digits = _decimals(u)
+        text = f"{v:.{digits}f} \u00b1 {u:.{digits}f}"
+        return f"({text}) \u00d7 10^{exponent}" if exponent else text
+    return f"{value:.4g}"
+
+
+def in_short(folder: Path, summary: Mapping[str, Any]) -> str:
+    """The scenario's plain summary: the "In short" paragraph of its ``report.md``, else ``in_short`` of its summary
+    ("" if it has neither)."""
+    from .results_io import IN_SHORT  # here: the scenarios' registry imports this module, and NumPy is slow
+
+    report = folder / "report.md"
+    if report.is_file():
+        text = report.read_text(encoding="utf-8")
+        if IN_SHORT in text:
+            after = text.split(IN_SHORT, 1)[1]
+            return re.split(r"\n(?:#|---)", after, maxsplit=1)[0].strip()
+    return str(summary.get("in_short", ""))
+
+
+def _inline(text: str) -> str:
+    """Markdown text as HTML: escaped, ``**bold**`` and ```code``` kept."""
+    text = html.escape(text)
+    text = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", text)
+    return re.sub(r"`([^`]+)`", r"<code>\1</code>", text)
+
+
+def _link(href: str, text: str) -> str:
+    return f'<a href="{html.escape(href)}">{html.escape(text)}</a>'
+
+
+def _headline_rows(page: ScenarioPage, summary: Mapping[str, Any]) -> list[str]:
+    rows = []
+    for line in page.headlines:
+        try:
+            value = lookup(summary, line.value)
+            uncertainty = lookup(summary, line.uncertainty) if line.uncertainty else None
+        except (KeyError, IndexError, StopIteration, TypeError):
+            continue  # not in this run's summary (e.g. a setting of the thorough run only)
+        if value is None:
+            shown = "none: " + (null_reason(summary, line.value) or "no value in summary.json")
+        else:
+            shown = format_figure(value, uncertainty) + (f" {line.unit}" if line.unit else "")
+        note = ""
+        if line.note:
+            try:
+                note = str(lookup(summary, line.note))
+            except (KeyError, IndexError, StopIteration, TypeError):
+                note = ""
+        source = line.value + (f", \u00b1 {line.uncertainty}" if line.uncertainty else "")
+        rows.append(f'<tr><td>{html.escape(line.label)}</td><td class="value" title="summary.json: '
+                    f'{html.escape(source)}">{html.escape(shown)}</td><td class="note">{html.escape(note)}</td></tr>')
+    return rows
+
+
+def _files(folder: Path, shown: set[str]) -> str:
+    """The links to a scenario folder's report, summary, CSV files and the figures not shown above."""
+    name = folder.name
+    parts = []
+    if (folder / "report.md").is_file():
+        parts.append("report: " + _link(f"{name}/report.md", "report.md"))
+    parts.append("figures in numbers: " + _link(f"{name}/summary.json", "summary.json"))
+    csv = sorted(p.name for p in folder.glob("*.csv"))
+    if csv:
+        parts.append("data: " + ", ".join(_link(f"{name}/{c}", c) for c in csv))
+    more = sorted(p.name for p in folder.iterdir() if p.suffix in (".png", ".gif") and p.name not in shown)
+    if more:
+        parts.append("more figures: " + ", ".join(_link(f"{name}/{m}", m) for m in more))
+    return '<p class="files">' + " &middot; ".join(parts) + "</p>"
+
+
+def _mode(summary: Mapping[str, Any]) -> str:
+    return "quick run" if summary.get("quick") else "thorough run" if summary.get("thorough") else "default run"
+
+
+def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
+    folder = out / page.name
+    head = f'<section id="{page.name}"><h2>{html.escape(page.name)}</h2><p class="what">' \
+           f"{html.escape(page.description)}</p>"
+    if failed:
+        kept = f"{page.name}.failed"
+        note = (" What it wrote is in " + _link(f"{kept}/", f"{kept}/") + ".") if (out / kept).is_dir() else ""
+        earlier = " The results below are from an earlier run." if (folder / "summary.json").is_file() else ""
+        head += f'<p class="failed">This scenario failed in this run.{note}{earlier}</p>'
+    summary_path = folder / "summary.json"
+    if not summary_path.is_file():
+        return head + "</section>"
+    try:
+        summary = json.loads(summary_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:  # the page is written whatever a scenario left
+        return head + f'<p class="failed">Its summary.json cannot be read ({html.escape(str(error))}).</p></section>'
+    written = datetime.fromtimestamp(summary_path.stat().st_mtime).strftime("%Y-%m-%d %H:%M")
+    parts = [head, f'<p class="mode">{_mode(summary)}, written {written}</p>']
+    text = in_short(folder, summary)
+    if text:
+        parts.append(f'<p class="short">{_inline(text)}</p>')
+    rows = _headline_rows(page, summary)
+    if rows:
+        parts.append('<table class="headlines"><thead><tr><th>headline figure</th><th>value</th><th></th></tr></thead>'
+                     f'<tbody>{"".join(rows)}</tbody></table>')
+    shown = set()
+    for name, caption in page.figures:
+        if (folder / name).is_file():
+            shown.add(name)
+            src = f"{page.name}/{name}"
+            parts.append(f'<figure><a href="{html.escape(src)}"><img src="{html.escape(src)}" '
+                         f'alt="{html.escape(caption)}"></a><figcaption>{html.escape(caption)} '
+                         f"({html.escape(name)})</figcaption></figure>")
+    parts.append(_files(folder, shown))
+    return "\n".join(parts) + "</section>"
+
+
+STYLE = """
+body { font-family: system-ui, sans-serif; max-width: 62rem; margin: 1.5rem auto; padding: 0 1rem; color: #222;
+       line-height: 1.45; }
+h1 { font-size: 1.6rem; margin-bottom: 0.2rem; } h2 { margin-top: 2.5rem; border-bottom: 1px solid #ccc; }
+.run, .mode, .what, figcaption, .files { color: #555; } .what { font-style: italic; margin-top: 0; }
+table.headlines { border-collapse: collapse; margin: 0.8rem 0; } .headlines td, .headlines th {
+  border-bottom: 1px solid #e4e4e4; padding: 0.25rem 0.8rem 0.25rem 0; text-align: left; vertical-align: top; }
+.headlines .value { white-space: nowrap; font-variant-numeric: tabular-nums; } .note { color: #666; font-size: 0.9em; }
+figure { margin: 1rem 0; } img { max-width: 100%; height: auto; border: 1px solid #eee; }
+.failed { color: #a00; font-weight: bold; } .files { font-size: 0.92em; } code { font-size: 0.95em; }
+nav li { margin: 0.15rem 0; }
+"""
+
+
+def page_html(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> str:
+    """The HTML of ``index.html`` for ``run`` in the output folder ``out``; ``pages`` in the order shown (the
+    scenarios of the run among them get a section, the other folders in ``out`` a line at the end)."""
+    ran = [p for p in pages if p.name in run.ran]
+    earlier = [p for p in pages if p.name not in run.ran and (out / p.name / "summary.json").is_file()]
+    failed = set(run.failed)
+    status = f"{len(ran) - len(failed & {p.name for p in ran})} of {len(ran)} scenarios wrote their results"
+    when = run.started.astimezone().strftime("%Y-%m-%d %H:%M %Z")
+    head = ["<h1>Double pendulum: the results of a run</h1>",
+            f'<p class="run">{html.escape(when)} &middot; double-pendulum-fmu {html.escape(run.version)} &middot; '
+            f"{html.escape(run.mode)} run &middot; {run.wall_s:.0f} s (CPU {run.cpu_s:.0f} s) &middot; "
+            f"<code>{html.escape(run.command)}</code><br>{status}.</p>",
+            "<nav><ul>"]
+    for p in ran:
+        mark = " (failed)" if p.name in failed else ""
+        head.append(f'<li><a href="#{p.name}">{html.escape(p.name)}</a>{mark}: {html.escape(p.description)}</li>')
+    head.append("</ul></nav>")
+    body = [_section(out, p, p.name in failed) for p in ran]
+    if earlier:
+        items = "".join(f"<li>{_link(f'{p.name}/summary.json', p.name)}: {html.escape(p.description)}</li>"
+                        for p in earlier)
+        body.append(f'<section id="earlier"><h2>From earlier runs in this folder</h2><ul>{items}</ul></section>')
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+            f"<title>Double pendulum: results of a {html.escape(run.mode)} run</title><style>{STYLE}</style>"
+            "</head><body>\n" + "\n".join([*head, *body]) + "\n</body></html>\n")
+
+
+def write_index(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> Path:
+    """Write ``out/index.html`` (:func:`page_html`), atomically; return its path."""
+    from .results_io import write_text
+
+    return write_text(Path(out) / PAGE, page_html(Path(out), run, pages))

@@ -1,0 +1,154 @@
+"""``double-pendulum simulate``: a case of one's own through the FMU, fmpy's numbers bit for bit, ``--set`` checked
+against the modelDescription, misuse answered in one line, nothing lost or left behind."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from fmpy import read_model_description, simulate_fmu
+
+from double_pendulum.case import FILES
+from double_pendulum.cli import main
+from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.start_values import StartValueError, closest_name, parse_start_values
+from double_pendulum.runs.results_io import read_results_csv
+
+
+def _columns(result: np.ndarray) -> dict[str, np.ndarray]:
+    return {name: np.asarray(result[name]) for name in result.dtype.names}
+
+
+def _one_error_line(capsys) -> str:
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    return err
+
+
+def test_a_case_writes_csv_figure_animation_and_summary_with_fmpy_s_numbers(fmu_path, tmp_path, capsys):
+    out = tmp_path / "case"
+    argv = ["simulate", "--set", "phi1_0=2", "--set", "air_drag=true", "--stop", "3", "--step", "0.02",
+            "--fmu", str(fmu_path), "--out", str(out)]
+    assert main(argv) == 0
+    assert sorted(p.name for p in out.iterdir()) == sorted(FILES)  # nothing else, no staging folder left
+    assert "wrote simulation.csv, simulation.png, simulation.gif, summary.json" in capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["start_values"] == {"phi1_0": 2.0, "air_drag": True} and summary["status"] == "finished"
+    written = read_results_csv(out / "simulation.csv")
+    with open(out / "simulation.csv") as fh:
+        assert '"time [s]","phi1 [rad]"' in fh.readline()  # units in the column names
+    plain = simulate_fmu(str(fmu_path), start_values={"phi1_0": 2.0, "air_drag": True}, stop_time=3.0,
+                         output_interval=0.02)  # what a user of fmpy writes
+    assert written.dtype.names == plain.dtype.names
+    for name, column in _columns(plain).items():
+        assert np.array_equal(written[name], column), name  # bit for bit
+    assert summary["E_total_start_J"] > summary["E_total_end_J"]  # air drag takes energy
+    assert summary["fmpy_call"].startswith("fmpy.simulate_fmu(") and "'air_drag': True" in summary["fmpy_call"]
+
+
+def test_model_exchange_through_the_fmi3_fmu_gives_fmpy_s_numbers(fmu_path, tmp_path):
+    out = tmp_path / "me"
+    assert main(["simulate", "--fmi", "3", "--me", "--set", "phi2_0=0.5", "--stop", "1", "--fmu", str(fmu_path),
+                 "--out", str(out), "--no-animation"]) == 0
+    assert not (out / "simulation.gif").exists()
+    fmu3 = fmu_path.parent / "fmi3" / fmu_path.name
+    plain = simulate_fmu(str(fmu3), fmi_type="ModelExchange", start_values={"phi2_0": 0.5}, stop_time=1.0,
+                         output_interval=0.01)
+    written = read_results_csv(out / "simulation.csv")
+    for name, column in _columns(plain).items():
+        assert np.array_equal(written[name], column), name
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["fmi_version"] == "3.0" and summary["fmi_type"] == "ModelExchange"
+    assert summary["relative_tolerance"] == float(read_model_description(str(fmu3)).defaultExperiment.tolerance)
+
+
+@pytest.mark.parametrize("setting, words", [
+    ("phi1_O=2", "no parameter phi1_O; the closest parameter is phi1_0"),
+    ("airdrag=true", "the closest parameter is air_drag"),
+    ("air_drag=maybe", "air_drag is a switch: true or false"),
+    ("m1=heavy", "m1 is a real number [kg]"),
+    ("m1=nan", "m1 must be a finite number [kg]"),
+    ("pivot_x=0.1", "pivot_x is an input"),
+    ("x2=0.1", "x2 is an output variable"),
+    ("phi1_0", "write NAME=VALUE"),
+])
+def test_a_bad_set_is_refused_in_one_line_that_says_why(fmu_path, tmp_path, capsys, setting, words):
+    assert main(["simulate", "--set", setting, "--fmu", str(fmu_path), "--out", str(tmp_path / "x")]) == 2
+    err = _one_error_line(capsys)
+    assert words in err
+    assert list((tmp_path / "x").iterdir()) == []  # nothing written
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--me"], "--me needs --fmi 3"),
+    (["--stop", "-1"], "--stop must be a positive number"),
+    (["--step", "0"], "--step must be a positive number"),
+    (["--stop", "1", "--step", "2"], "longer than the run"),
+])
+def test_misuse_of_the_options_is_one_line(fmu_path, tmp_path, capsys, argv, words):
+    assert main(["simulate", *argv, "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 2
+    assert words in _one_error_line(capsys)
+
+
+def test_a_value_the_fmu_refuses_is_one_line_with_the_fmu_s_reason(fmu_path, tmp_path, capsys):
+    out = tmp_path / "bad"
+    assert main(["simulate", "--set", "l1=-1", "--fmu", str(fmu_path), "--out", str(out)]) == 1
+    err = _one_error_line(capsys)
+    assert "l1" in err and "must be > 0" in err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "stopped by the FMU" and "l1" in summary["fmu_message"]
+
+
+def test_an_interrupted_case_changes_nothing_and_leaves_nothing(fmu_path, tmp_path, capsys, monkeypatch):
+    out = tmp_path / "case"
+    out.mkdir()
+    (out / "simulation.csv").write_text("an earlier run's\n")
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(FmuRunner, "simulate", interrupted)
+    assert main(["simulate", "--fmu", str(fmu_path), "--out", str(out)]) == 130
+    assert "interrupted; nothing was written" in _one_error_line(capsys)
+    assert [p.name for p in out.iterdir()] == ["simulation.csv"]  # no staging folder, the earlier file intact
+    assert (out / "simulation.csv").read_text() == "an earlier run's\n"
+
+
+def _description(*variables: SimpleNamespace) -> SimpleNamespace:
+    return SimpleNamespace(modelVariables=list(variables))
+
+
+def _variable(name: str, kind: str = "Real", **extra) -> SimpleNamespace:
+    fields = {"causality": "parameter", "variability": "fixed", "min": None, "max": None, "unit": None,
+              "declaredType": None}
+    return SimpleNamespace(name=name, type=kind, **{**fields, **extra})
+
+
+def test_set_checks_range_variability_and_type_of_any_fmu():
+    md = _description(_variable("k", min="0", max="10", unit="N/m"), _variable("n", "Int32"),
+                      _variable("c", variability="constant"), _variable("d", causality="calculatedParameter"),
+                      _variable("s", "String"), _variable("on", "Boolean"))
+    assert parse_start_values(["k=10", "n=3", "s=rk4", "on=FALSE"], md) == {"k": 10.0, "n": 3, "s": "rk4", "on": False}
+    for setting, words in (("k=10.5", "outside the range 0 .. 10 [N/m]"), ("n=1.5", "whole number"),
+                           ("c=1", "constant parameter, which a master cannot set"),
+                           ("d=1", "fixed calculatedParameter"), ("k=1", "set twice")):
+        with pytest.raises(StartValueError, match=words.replace(".", r"\.").replace("[", r"\[")):
+            parse_start_values(["k=1", setting] if setting == "k=1" else [setting], md)
+
+
+def test_the_closest_parameter_is_named_whatever_the_case_of_the_letters():
+    assert closest_name("PHI2_0", ["phi1_0", "phi2_0", "omega2_0"]) == "phi2_0"
+    assert closest_name("anything", []) is None
+
+
+def test_the_example_in_the_help_runs_as_written(fmu_path, tmp_path, capsys):
+    from double_pendulum.cli import build_parser
+
+    example = build_parser().command_parsers["simulate"].epilog.splitlines()[1].split()
+    assert example[:2] == ["double-pendulum", "simulate"]
+    argv = [*example[1:-2], "--stop", "0.5", "--fmu", str(fmu_path), "--out", str(tmp_path / "my_case")]
+    assert main(argv) == 0
+    assert Path(tmp_path / "my_case" / "simulation.png").stat().st_size > 10_000
