@@ -26,6 +26,8 @@ from typing import Any
 import pytest
 from conftest import REPO, quick_scenario
 
+from double_pendulum.runs.page import lookup  # the one path reader: the page shows the same figures
+
 PAGES = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
 RECORDED = REPO / "docs" / "results"
 MARKER = re.compile(
@@ -37,20 +39,6 @@ MARKER = re.compile(
 def markers(text: str) -> list[re.Match]:
     """Every figure marker of a page's text (with the number before it)."""
     return list(MARKER.finditer(text))
-
-
-def lookup(summary: Any, path: str) -> Any:
-    """The value at ``path`` (keys separated by ``/``; ``[name=value]`` selects a list entry; an integer, an index)."""
-    value = summary
-    for part in path.split("/"):
-        selector = re.fullmatch(r"\[(\w+)=(.+)\]", part)
-        if selector:
-            value = next(v for v in value if str(v.get(selector[1])) == selector[2])
-        elif isinstance(value, list):
-            value = value[int(part)]
-        else:
-            value = value[part]
-    return value
 
 
 def mismatch(match: re.Match, summary: Any) -> str | None:
