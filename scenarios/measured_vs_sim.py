@@ -4,12 +4,15 @@ The seed started its simulation from the state estimated at t0 = 0.8 s and found
 coordinates agreeing with the camera track until about 2 s, i.e. about 1.2 s after t0 (its figs.
 11-14). This scenario does the same through the FMU and goes further. The model is the seed's
 pendulum with its acrylic rods (:data:`~double_pendulum.model.parameters.SEED_RIGID_LINKS`) and the
-losses of the ``loss_identification`` scenario's best model, air drag with a free factor on rho_air
-plus a bearing drag torque at both joints, fitted to the measured energy decay exactly as that scenario's
-run in the same mode fits it (:func:`double_pendulum.analysis.prediction.comparison.identified_losses`: default,
-warm-started from the one-mechanism fits; quick, from the reference values; the whole record in both: the
-first 8 s alone leave the two losses unidentified). The fits are cached, so after ``loss_identification``
-they are read, not repeated (and the other way round). Four runs:
+losses of air drag with a free factor on rho_air plus a bearing drag torque at both joints, one of the models
+``loss_identification`` finds the measured energy supports equally (within delta AIC 2; the record does not rank
+them), fitted exactly as that scenario's run in the same mode fits it
+(:func:`double_pendulum.analysis.prediction.comparison.identified_losses`: default, warm-started from the
+one-mechanism fits; quick, from the reference values; the whole record in both: the first 8 s alone leave the two
+losses unidentified). The fits are cached, so after ``loss_identification`` they are read, not repeated (and the
+other way round). The main start then runs with every other supported model as well
+(:mod:`double_pendulum.analysis.prediction.loss_models`, ``loss_model_sensitivity``): the spread of its horizons
+is what the energy record cannot pin down. The runs:
 
 - **seed start**: angles and rates of the frame nearest t0 from the measurement reconstruction
   (angles from the positions, rates from the Savitzky-Golay derivative), run frictionless with point
@@ -97,6 +100,12 @@ from double_pendulum.analysis.prediction.comparison import (
     start_fit_summary,
     window_sensitivity,
 )
+from double_pendulum.analysis.prediction.loss_models import (
+    loss_model_predictions,
+    loss_model_sensitivity,
+    smoothed_error_band,
+    supported_loss_values,
+)
 from double_pendulum.analysis.prediction.paths import PATHS_UNITS, paths_table
 from double_pendulum.analysis.prediction.report import report_text
 from double_pendulum.analysis.suspension.identification import START_FIT_FRAMES
@@ -139,10 +148,10 @@ QUICK_ENSEMBLE_SIZE = 3
 
 
 def _plots(out_dir: Path, rec: Reconstruction, i0: int, n_frames: int, predictions: list[Prediction],
-           spread: tuple[np.ndarray, np.ndarray]) -> None:  # fmt: skip
+           spread: tuple[np.ndarray, np.ndarray], by_model: dict[str, Prediction]) -> None:  # fmt: skip
     """``coordinates.png`` (track and four runs in the track's coordinates over the whole comparison),
-    ``prediction_error.png`` (every run), a run in the same colour in each, and the main run's x-y overlay and
-    animation (from ``paths.csv``)."""
+    ``prediction_error.png`` (every run, and the main start's range over the loss models ``by_model``), a run in the
+    same colour in each, and the main run's x-y overlay and animation (from ``paths.csv``)."""
     t, measured = measured_coordinates(rec, i0, n_frames)
     colours = plots.run_colours([run_title(p.label) for p in predictions])
     runs = {}
@@ -163,6 +172,8 @@ def _plots(out_dir: Path, rec: Reconstruction, i0: int, n_frames: int, predictio
     plots.plot_prediction_errors(
         curves.smoothed, list(THRESHOLDS_M), out_dir / "prediction_error.png", per_frame=curves.per_frame,
         spread=curves.spread, floor=rod_length_floor(rec, i0, n_frames), colours=colours,
+        band=(f"the same start with each of the {len(by_model)} loss models the energy fits equally well: their range, "
+              "smoothed", main, *smoothed_error_band(by_model)) if len(by_model) > 1 else None,
         dashed=[run_title("lsq_pivot_shift_identified")],  # close to the main run: dashed to tell them apart
         title=f"distance between the simulated and the measured lower bob (smoothed: moving median over "
               f"{SMOOTHING_S:g} s)",
@@ -199,6 +210,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         predict(runner, "lsq_geometry_identified", values, geo.state, rec, i0, n_frames, geo.geometry),
     ]
     headlines = {p.label: headline_horizon(p, (n_frames - 1) * FRAME_INTERVAL) for p in predictions[3:]}
+    by_model = loss_model_predictions(runner, rec, i0, n_frames, losses.pendulum, geo,
+                                      supported_loss_values(rec, quick=quick))  # fmt: skip
     spread = chaos_spread(runner, values, geo, predictions[-1], n_frames, ensemble_size)
     prediction_s = (n_frames - 1) * FRAME_INTERVAL
     smoothed = {p.label: p.smoothed_horizons() for p in predictions}
@@ -225,6 +238,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         "smoothing": {"method": "centred moving median of the per-frame position error", "window_s": SMOOTHING_S},
         "horizons_smoothed_s": smoothed,
         "horizons_raw_s": {p.label: p.horizons() for p in predictions},
+        "loss_model_sensitivity": loss_model_sensitivity(by_model, n_frames),
         "goal": goal_entry(reached, prediction_s, GOAL_S),
         "regime": regime(PendulumParameters(**{**losses.pendulum, **fitted_l2}), geo.state, lyapunov_s),
         "chaos_horizons_s": chaos_horizons(spread),
@@ -241,7 +255,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         write_results_csv(out_dir / f"{p.label}.csv", p.result, runner.units)
     write_results_csv(out_dir / "errors.csv", errors_table(rec, i0, n_frames, predictions), errors_units(predictions))
     write_results_csv(out_dir / "paths.csv", paths_table(rec, i0, n_frames, predictions[-1]), PATHS_UNITS)
-    _plots(out_dir, rec, i0, n_frames, predictions, spread)
+    _plots(out_dir, rec, i0, n_frames, predictions, spread, by_model)
     summary["wall_time_s"] = time.perf_counter() - wall0
     write_json(out_dir / "summary.json", summary)
     write_text(out_dir / "report.md", report_text(summary))

@@ -61,6 +61,7 @@ def plot_prediction_errors(
     per_frame: tuple[str, np.ndarray, np.ndarray] | None = None,
     spread: tuple[np.ndarray, np.ndarray] | None = None,
     floor: tuple[np.ndarray, np.ndarray] | None = None,
+    band: tuple[str, str, np.ndarray, np.ndarray, np.ndarray] | None = None,
     colours: Mapping[str, str] | None = None,
     dashed: Sequence[str] = (),
     title: str = "distance between the simulated and the measured lower bob",
@@ -69,9 +70,15 @@ def plot_prediction_errors(
     in its colour of ``colours``, dashed for the runs named in ``dashed`` where runs lie on top of each other), one
     run's per-frame error (``per_frame``: title, t, error; thin and pale, in that run's colour), the fit's
     uncertainty ``spread`` (t, error) as a shaded band up to it, the track's own rod-length error ``floor``
-    (t, error) as grey dots and the ``thresholds`` [m] as black lines. The legend goes under the axes."""
+    (t, error) as grey dots, a ``band`` of smoothed errors (label, the run whose colour it takes, t, lowest,
+    highest: e.g. one start under several equally supported models) and the ``thresholds`` [m] as black lines.
+    The legend goes under the axes."""
     colours = colours or run_colours(list(smoothed))
     fig, ax = plt.subplots(figsize=(11, 5.5))
+    if band is not None:
+        text, run, t, low, high = band
+        ax.fill_between(t, np.maximum(low, ERROR_FLOOR_M), np.maximum(high, ERROR_FLOOR_M), color=colours[run],
+                        alpha=0.4, lw=0, label=text)
     if spread is not None:
         ax.fill_between(spread[0], ERROR_FLOOR_M, np.maximum(spread[1], ERROR_FLOOR_M), color="tab:olive", alpha=0.3,
                         lw=0, label="fit's own uncertainty: median spread of runs drawn from its covariance")

@@ -75,10 +75,13 @@ _PART = re.compile(r"(?<! )/(?! )")
 def lookup(summary: Any, path: str) -> Any:
     """The value at ``path`` in ``summary``: keys separated by ``/`` (see :data:`_PART`), an integer indexes a list,
     ``[name=value]`` selects the list entry whose ``name`` is ``value``; ``*SCALE`` at the end multiplies a number
-    (each number of a list) by SCALE. A KeyError (or IndexError) if the path does not exist."""
+    (each number of a list) by SCALE. A KeyError (or IndexError) if the path does not exist; None where a part of
+    it is null (a summary's null, which its ``null_means`` explain: :func:`null_reason`)."""
     path, _, scale = path.partition("*")
     value = summary
     for part in _PART.split(path):
+        if value is None:
+            return None
         selector = re.fullmatch(r"\[(\w+)=(.+)\]", part)
         if selector:
             value = next(v for v in value if str(v.get(selector[1])) == selector[2])

@@ -164,7 +164,7 @@ def report_opening(title: str, in_short: Sequence[str], terms: Mapping[str, str]
     """The start of a scenario's ``report.md``: the title, "In short" (three to five plain sentences a student
     understands: what was measured, what was found, how sure) and "Words used below" (each technical term of the
     report with its meaning, before its first use), then a rule before the report's own sections."""
-    lines = [f"# {title}", "", IN_SHORT, "", " ".join(s.strip() for s in in_short), ""]
+    lines = [f"# {title}", "", IN_SHORT, "", " ".join(s.strip() for s in in_short if s.strip()), ""]
     if terms:
         lines += [WORDS_USED, "", *(f"- **{term}**: {meaning}" for term, meaning in terms.items()), ""]
     return "\n".join([*lines, "---", "", ""])

@@ -82,7 +82,7 @@ def supported_models(rows: Sequence[Mapping[str, Any]], daic: float = SUPPORTED_
             "not rank them, so none is the model and no split of the loss is measured: "
             + (f"the air-drag share ranges from {min(air):.0%} to {max(air):.0%} across them, depending on which "
                "mechanism is assumed beside it or instead of it." if air else "none of them has air drag."))
-    return {"daic": daic, "models": models, "reduced": reduced,
+    return {"daic": daic, "models": models, "n_models": len(models), "reduced": reduced,
             "air_share_range": [min(air), max(air)] if air else None, "text": text}
 
 

@@ -20,7 +20,8 @@ A start may be fitted together with free geometry (:func:`least_squares_start` w
 :data:`FREE_GEOMETRY`: the camera's rotation against gravity, the pivot's offset from the measurement's
 circle-fit pivot and the lower rod's length l2); a prediction then runs with the fitted l2 and its
 positions are turned and shifted by the fitted rotation and offset.
-The losses are those of the ``loss_identification`` scenario's best model (:func:`identified_losses`).
+The losses are those of one of the models the ``loss_identification`` scenario finds equally supported
+(:func:`identified_losses`; the others: :mod:`.loss_models`).
 
 Two floors limit the horizon: the track's own rod-length error
 :math:`\big|\,|r_2 - r_1| - l_2\big|` (:func:`rod_length_floor`), which no rigid-rod model can match,
@@ -67,8 +68,10 @@ FREE_GEOMETRY: tuple[str, ...] = ("view_rotation", "pivot_offset_x", "pivot_offs
 turned about the pivot), the pivot's offset [m] from the circle-fit pivot and l2 [m]. l1 is left at the
 track's value: freed as well, it trades off against the pivot's height over a few swings."""
 LOSS_MODEL = "air+drag"
-"""The best loss model of the ``loss_identification`` scenario (air drag with a free factor on rho_air,
-a bearing drag torque at both joints), obtained here as that scenario obtains it (:func:`identified_losses`)."""
+"""The loss model of the predictions (air drag with a free factor on rho_air, a bearing drag torque at both joints),
+obtained here as the ``loss_identification`` scenario obtains it (:func:`identified_losses`): one of the models that
+scenario finds within delta AIC 2 of the lowest, not a verdict (two separate mechanisms, each with a physical
+origin; :mod:`.loss_models` runs the main start with each of the others)."""
 FIT_TOLERANCE = 1e-6
 """Relative stopping tolerance of the least-squares starts (scipy's ``ftol``, ``xtol``): on the seed's track the
 start and geometry fit then ends after about half the FMU runs of scipy's 1e-8, with chi2 1e-7 (relative) and
@@ -550,8 +553,8 @@ def headline_entries(headlines: dict[str, dict[str, Any]]) -> dict[str, Any]:
     entries["horizon_5cm_details"] = headlines
     entries["horizon_statement"] = (
         "lower bob, smoothed error, 5 cm; censored: never exceeded within the record, so the horizon is only known "
-        "to exceed horizon_5cm_s. In-sample: the losses are fitted to the same record. The motion is regular, so a "
-        "horizon measures how well frequencies and damping match, not predictability."
+        "to exceed the record's length. In-sample: the losses are fitted to the same record. The motion is regular, "
+        "so a horizon measures how well frequencies and damping match, not predictability."
     )
     return entries
 
