@@ -120,6 +120,7 @@ def test_the_pendulums_page_has_its_equations_switches_rules_and_needs(contents)
     needs = page.split("What a target machine needs")[1]
     assert "binaries/linux64/DoublePendulum.so" in needs and "glibc &gt;= 2.17" in needs
     assert "DOUBLE_PENDULUM_FMU_PYTHON" in needs and "version=3." in needs  # how it finds its Python
+    assert "needs nothing installed" in needs and "only the standard library" in needs  # and what that Python needs
     fmi3 = contents["fmi3/DoublePendulum.fmu"]["documentation/index.html"].decode()
     assert "Model Exchange of the FMI 3 <code>DoublePendulum</code> FMU" in fmi3
 

@@ -12,6 +12,9 @@ In a Python host the loader uses the host's interpreter and changes
 nothing; in any other host it finds a CPython >= 3.11 with a shared libpython: the one named by
 ``DOUBLE_PENDULUM_FMU_PYTHON``, else the one the FMU was built with (``resources/python.cfg``,
 :func:`python_record`), else ``python3`` on PATH (docs/fmu.md, "Use the FMU in other FMI tools").
+That Python needs nothing installed: the loader starts it without ``site`` (no site-packages), and
+everything the FMU runs in it (the model code and pythonfmu's Python part) is bundled under
+``resources/`` and imports only the standard library.
 
 The loader is compiled with the system C compiler (``$CC``, else ``cc``, ``gcc`` or ``clang``)
 against the FMI 2 and FMI 3 headers fmpy ships (``fmpy/c-code``); nothing compiled is committed. Without a
