@@ -92,6 +92,11 @@ def test_the_pendulums_pivot_plugs_into_the_suspensions_mount(contents):
     assert terminal_members(contents["fmi3/DoublePendulum.fmu"]) == pendulum
     assert terminal_members(contents["PendulumOnSuspension.fmu"]) == {
         "angles": {"phi1": "DoublePendulum.phi1", "phi2": "DoublePendulum.phi2"}}
+    # the container has the angles but not their rates: its terminal says so, the pendulum's does not need to
+    descriptions = {name: {t.get("name"): t.get("description") for t in ET.fromstring(contents[name][terminals.FILE])
+                           .iter("Terminal")} for name in ("DoublePendulum.fmu", "PendulumOnSuspension.fmu")}
+    assert descriptions["PendulumOnSuspension.fmu"]["angles"].endswith("(this FMU has phi1, phi2 only)")
+    assert "only" not in descriptions["DoublePendulum.fmu"]["angles"]
 
 
 @pytest.mark.parametrize("name", FMUS)

@@ -73,14 +73,18 @@ TERMINALS: tuple[Terminal, ...] = (
 
 def terminals_for(variables: Iterable[str], prefix: str = "") -> list[Terminal]:
     """The terminals of an FMU with ``variables``: each with the members it has (``prefix`` + variable: the
-    container's ``DoublePendulum.``), a ``plug`` only if it has them all, a ``bus`` if it has any."""
+    container's ``DoublePendulum.``), a ``plug`` only if it has them all, a ``bus`` if it has any (its
+    description then names the members it has)."""
     names = set(variables)
     found = []
     for terminal in TERMINALS:
         members = tuple((prefix + variable, member) for variable, member in terminal.members
                         if prefix + variable in names)
         if members and (terminal.matching_rule != "plug" or len(members) == len(terminal.members)):
-            found.append(terminal._replace(members=members))
+            description = terminal.description
+            if len(members) < len(terminal.members):  # a bus with some of its members: say which it has
+                description += f" (this FMU has {', '.join(member for _, member in members)} only)"
+            found.append(terminal._replace(members=members, description=description))
     return found
 
 
