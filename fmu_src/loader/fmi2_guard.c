@@ -9,10 +9,12 @@
  *    only what the standard allows in its Error state (get values, FMU states, reset, free,
  *    setDebugLogging);
  *  - arguments are checked before anything is forwarded: the instance (NULL, freed, foreign), NULL
- *    arrays with n > 0, every pointer the standard requires, doStep's step size (> 0, finite) and
- *    communication point (the FMU's time: the end of the last step, or of the FMU state set);
+ *    arrays with n > 0, every pointer the standard requires, String values that are not UTF-8,
+ *    doStep's step size (> 0, finite) and communication point (the FMU's time: the end of the last
+ *    step, or of the FMU state set);
  *  - fmi2Instantiate refuses (NULL and one line; stderr where the host gave no logger) a wrong GUID,
- *    Model Exchange, a missing instance name or resource location, a folder that is not this FMU's;
+ *    Model Exchange, a missing or non-UTF-8 instance name, a missing resource location, a folder that
+ *    is not this FMU's;
  *  - the host's logger is only ever called with the constant format "%s" and the message as its
  *    argument; errors reach it from instantiation on, other messages only with debug logging on
  *    (fmi2SetDebugLogging as specified);
@@ -170,7 +172,11 @@ FMI2_Export const char *fmi2GetVersion(void) { return fmi2Version; }
 static int instantiation_allowed(fmi2String name, fmi2Type type, fmi2String guid, fmi2String location,
                                  char *resources, size_t size, char *why, size_t why_size) {
     char marker[4200];
+    long bad;
     if (!name || !name[0]) guard_format(why, why_size, "instanceName is %s", name ? "empty" : "NULL");
+    else if ((bad = guard_utf8_error(name)) >= 0)
+        guard_format(why, why_size, "instanceName is not UTF-8 (byte %ld is 0x%02x; an fmi2String is UTF-8 encoded)",
+                     bad, (unsigned char)name[bad]);
     else if (type != fmi2CoSimulation)
         guard_format(why, why_size, "fmuType = %d: this FMU supports co-simulation (fmi2CoSimulation = %d) only",
                      (int)type, (int)fmi2CoSimulation);
@@ -189,6 +195,9 @@ static int instantiation_allowed(fmi2String name, fmi2Type type, fmi2String guid
     else if (guard_format(marker, sizeof marker, "%s/slavemodule.txt", resources), !guard_is_file(marker))
         guard_format(why, why_size, "fmuResourceLocation \"%.1000s\" is not this FMU's resources folder "
                      "(no slavemodule.txt in %.1000s)", location, resources);
+    else if ((bad = guard_utf8_error(resources)) >= 0)
+        guard_format(why, why_size, "fmuResourceLocation \"%.1000s\": the folder's path is not UTF-8 (byte %ld), "
+                     "which the FMU's Python side cannot take", location, bad);
     else
         return 1;
     return 0;
@@ -210,7 +219,7 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
     char why[2048] = "", resources[4096];
     guarded *g = calloc(1, sizeof *g);
     char *uri = malloc(sizeof resources + 8);
-    char *name = strdup(instanceName && instanceName[0] ? instanceName : "?");
+    char *name = strdup(instanceName && instanceName[0] && guard_utf8_error(instanceName) < 0 ? instanceName : "?");
     if (!g || !uri || !name) {
         guard_orphan(MODEL_IDENTIFIER, "fmi2Instantiate", "out of memory");
         free(g), free(uri), free(name);
@@ -327,7 +336,12 @@ FMI2_Export fmi2Status fmi2Reset(fmi2Component c) {
     }
 #define NO_CHECK
 #define STRINGS_PRESENT                                                                                           \
-    for (size_t k = 0; k < nvr; k++) REQUIRE(value[k], "fmi2SetString: value[%zu] (vr = %u) is NULL", k, vr[k]);
+    for (size_t k = 0; k < nvr; k++) {                                                                            \
+        REQUIRE(value[k], "fmi2SetString: value[%zu] (vr = %u) is NULL", k, vr[k]);                               \
+        long bad = guard_utf8_error(value[k]);                                                                    \
+        REQUIRE(bad < 0, "fmi2SetString: value[%zu] (vr = %u) is not UTF-8 (byte %ld is 0x%02x; an fmi2String is " \
+                "UTF-8 encoded)", k, vr[k], bad, (unsigned char)value[k][bad]);                                   \
+    }
 
 ACCESS(GetReal, fmi2Real, MASK_GET, , NO_CHECK)
 ACCESS(GetInteger, fmi2Integer, MASK_GET, , NO_CHECK)

@@ -3,10 +3,10 @@
  * available first).  What it guarantees is what fmi2_guard.c does for FMI 2, after FMI 3.0
  * (sections 2.2.4, 3.2 and 4.2: the Model Exchange and Co-Simulation state machines): the state
  * machine of the interface the instance was made for, argument checks (NULL arrays, nValues against
- * the value references, the step size and communication point, every out-argument), instantiation
- * checks (instantiation token, instance name, resource path), the host's logger given text, errors
- * logged from instantiation on, Error instead of pythonfmu3's Fatal, instantiation and reset
- * serialised across threads.  Where pythonfmu3 0.3.4 falls short it also stands in:
+ * the value references, String values that are not UTF-8, the step size and communication point, every
+ * out-argument), instantiation checks (instantiation token, instance name, resource path), the host's
+ * logger given text, errors logged from instantiation on, Error instead of pythonfmu3's Fatal,
+ * instantiation and reset serialised across threads.  Where pythonfmu3 0.3.4 falls short it also stands in:
  *  - fmi3UpdateDiscreteStates, fmi3DoStep and fmi3CompletedIntegratorStep: every out-argument is
  *    given its "nothing to do" value first (pythonfmu3 leaves some unwritten, and a strict host that
  *    initialised discreteStatesNeedUpdate = true would iterate its Event Mode forever);
@@ -197,7 +197,7 @@ static void free_guarded(guarded *g) {
 static guarded *new_guarded(fmi3String name, int interface, fmi3Boolean loggingOn,
                             fmi3InstanceEnvironment environment, fmi3LogMessageCallback logger) {
     guarded *g = calloc(1, sizeof *g);
-    char *copy = strdup(name && name[0] ? name : "?");
+    char *copy = strdup(name && name[0] && guard_utf8_error(name) < 0 ? name : "?");
     if (!g || !copy) {
         guard_orphan(MODEL_IDENTIFIER, "fmi3Instantiate", "out of memory");
         free(g), free(copy);
@@ -217,7 +217,11 @@ static int ready_to_instantiate(guarded *g, fmi3String name, fmi3String token, f
                                 const char *function) {
     char why[2048] = "", resources[4096], marker[4200];
     void *backend = NULL;
+    long bad;
     if (!name || !name[0]) guard_format(why, sizeof why, "instanceName is %s", name ? "empty" : "NULL");
+    else if ((bad = guard_utf8_error(name)) >= 0)
+        guard_format(why, sizeof why, "instanceName is not UTF-8 (byte %ld is 0x%02x; an fmi3String is UTF-8 encoded)",
+                     bad, (unsigned char)name[bad]);
     else if (!token || strcmp(token, FMU_GUID) != 0)
         guard_format(why, sizeof why,
                      "instantiationToken %s%.100s%s is not this FMU's %s: the binary and its modelDescription.xml "
@@ -231,6 +235,9 @@ static int ready_to_instantiate(guarded *g, fmi3String name, fmi3String token, f
     else if (guard_format(marker, sizeof marker, "%s/slavemodule.txt", resources), !guard_is_file(marker))
         guard_format(why, sizeof why, "resourcePath \"%.1000s\" is not this FMU's resources folder (no "
                      "slavemodule.txt in it)", resourcePath);
+    else if ((bad = guard_utf8_error(resourcePath)) >= 0)
+        guard_format(why, sizeof why, "resourcePath \"%.1000s\" is not UTF-8 (byte %ld; an fmi3String is UTF-8 "
+                     "encoded)", resourcePath, bad);
     else if ((backend = python_runtime_load_backend(resourcePath, BACKEND_FILE, why, sizeof why)) &&
              resolve(backend, why, sizeof why))
         return 1;
@@ -422,8 +429,12 @@ FMI3_Export fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
     }
 #define NO_CHECK
 #define STRINGS_PRESENT                                                                                           \
-    for (size_t k = 0; k < nValues; k++)                                                                          \
-        REQUIRE(values[k], "fmi3SetString: values[%zu] (valueReference %u) is NULL", k, valueReferences[k]);
+    for (size_t k = 0; k < nValues; k++) {                                                                        \
+        REQUIRE(values[k], "fmi3SetString: values[%zu] (valueReference %u) is NULL", k, valueReferences[k]);      \
+        long bad = guard_utf8_error(values[k]);                                                                   \
+        REQUIRE(bad < 0, "fmi3SetString: values[%zu] (valueReference %u) is not UTF-8 (byte %ld is 0x%02x; an "    \
+                "fmi3String is UTF-8 encoded)", k, valueReferences[k], bad, (unsigned char)values[k][bad]);       \
+    }
 
 ACCESS(GetFloat64, fmi3Float64, MASK_GET, , NO_CHECK)
 ACCESS(GetInt32, fmi3Int32, MASK_GET, , NO_CHECK)

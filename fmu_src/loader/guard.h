@@ -148,6 +148,12 @@ void guard_library_message(const char *message, char *out, size_t size);
 /* Like snprintf, never fails: a message cut at `size` ends in "...". */
 void guard_format(char *out, size_t size, const char *format, ...) __attribute__((format(printf, 3, 4)));
 
+/* The offset of the first byte of `text` that is not strict UTF-8 (what CPython's decoder accepts: no
+ * overlong forms, no surrogates, nothing above U+10FFFF), or -1 if all of it is.  FMI strings are UTF-8 (fmi2TypesPlatform.h,
+ * fmi3PlatformTypes.h); pythonfmu's libraries decode them as such, and a name that does not decode crashed
+ * the host (the instance name) or reached Python with its exception pending (a String value). */
+long guard_utf8_error(const char *text);
+
 /* ------------------------------------------------------------------------------- paths */
 
 int guard_is_directory(const char *path);

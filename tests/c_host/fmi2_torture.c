@@ -263,6 +263,10 @@ static int null_instance_name(void) {
 static int empty_instance_name(void) {
     return instance_or_null(fmi2Instantiate_("", fmi2CoSimulation, guid, resources, &callbacks, 0, 0));
 }
+/* Not UTF-8 (an fmi2String is): refused, where pythonfmu's library crashed the host. */
+static int instance_name_not_utf8(void) {
+    return instance_or_null(fmi2Instantiate_("t\xff", fmi2CoSimulation, guid, resources, &callbacks, 0, 0));
+}
 static int null_resource_location(void) {
     return instance_or_null(fmi2Instantiate_("t", fmi2CoSimulation, guid, NULL, &callbacks, 0, 0));
 }
@@ -310,6 +314,14 @@ NULL_ARRAY_PROBE(zero_values_need_no_arrays, fmi2GetReal_(c, NULL, 0, NULL))
 static int set_string_null_element(void) {
     fmi2Component c = instantiate(fmi2False);
     fmi2String v = NULL;
+    int s = fmi2SetString_(c, &SOLVER, 1, &v);
+    fmi2FreeInstance_(c);
+    return s;
+}
+/* A String value that is not UTF-8: fmi2Error naming it, before pythonfmu's library passes on its decoding error. */
+static int set_string_not_utf8(void) {
+    fmi2Component c = instantiate(fmi2False);
+    fmi2String v = "dop\xe9";
     int s = fmi2SetString_(c, &SOLVER, 1, &v);
     fmi2FreeInstance_(c);
     return s;
@@ -511,11 +523,11 @@ static const struct {
     P(error_state_then_reset) P(start_value_nan) P(negative_mass) P(unknown_value_reference) P(unknown_solver)
     P(wrong_type) P(fixed_parameter_after_initialisation) P(errors_leave_siblings_working) P(wrong_guid)
     P(empty_guid) P(null_guid) P(model_exchange) P(null_instance_name) P(empty_instance_name)
-    P(null_resource_location) P(missing_resource_folder) P(foreign_resource_folder) P(null_callbacks)
+    P(instance_name_not_utf8)    P(null_resource_location) P(missing_resource_folder) P(foreign_resource_folder) P(null_callbacks)
     P(null_logger) P(format_directives_in_a_string) P(get_real_null_references) P(get_real_null_values)
     P(set_real_null_values) P(get_integer_null_values) P(get_boolean_null_references) P(get_string_null_values)
     P(set_boolean_null_values) P(set_integer_null_references) P(zero_values_need_no_arrays)
-    P(set_string_null_element) P(debug_logging_null_categories) P(debug_logging_unknown_category)
+    P(set_string_null_element) P(set_string_not_utf8) P(debug_logging_null_categories) P(debug_logging_unknown_category)
     P(debug_logging_null_category) P(errors_silenced_by_set_debug_logging) P(get_fmu_state_null)
     P(set_fmu_state_null) P(set_fmu_state_foreign_pointer) P(free_fmu_state_null_pointer)
     P(free_fmu_state_null_state) P(serialized_size_null) P(deserialize_garbage) P(deserialize_null_bytes)

@@ -153,6 +153,11 @@ static int format_directives_in_a_string(void) {
     fmi3String v = "%s%s%n";
     return done(c, fmi3SetString_(c, &SOLVER, 1, &v, 1));
 }
+static int set_string_not_utf8(void) {
+    fmi3Instance c = cs();
+    fmi3String v = "dop\xe9";
+    return done(c, fmi3SetString_(c, &SOLVER, 1, &v, 1));
+}
 static int fixed_parameter_after_initialisation(void) {
     fmi3Instance c = stepping();
     fmi3Float64 v = 0.5;
@@ -171,6 +176,10 @@ static int null_resource_path(void) {
 }
 static int null_instance_name(void) {
     return instance_or_null(fmi3InstantiateModelExchange_(NULL, token, resources, 0, 0, NULL, logger));
+}
+static int instance_name_not_utf8(void) {
+    return instance_or_null(fmi3InstantiateCoSimulation_("t\xff", token, resources, 0, 0, 0, 0, NULL, 0, NULL, logger,
+                                                         NULL));
 }
 static int event_mode_requested(void) {
     return instance_or_null(fmi3InstantiateCoSimulation_("t", token, resources, 0, 0, fmi3True, 0, NULL, 0, NULL,
@@ -233,8 +242,8 @@ static const struct {
     P(communication_point_not_the_fmus_time) P(do_step_null_out_argument)
     P(start_time_is_the_first_communication_point) P(start_value_nan) P(values_count_not_references_count)
     P(get_float64_null_references) P(get_float64_null_values) P(get_float32_not_a_type_of_this_fmu) P(get_clock)
-    P(format_directives_in_a_string) P(fixed_parameter_after_initialisation) P(wrong_token) P(null_token)
-    P(null_resource_path) P(null_instance_name) P(event_mode_requested) P(scheduled_execution)
+    P(format_directives_in_a_string) P(set_string_not_utf8) P(fixed_parameter_after_initialisation) P(wrong_token) P(null_token)
+    P(null_resource_path) P(null_instance_name) P(instance_name_not_utf8) P(event_mode_requested) P(scheduled_execution)
     P(null_logger_still_instantiates) P(update_discrete_states_null_out_argument) P(set_continuous_states_wrong_count)
     P(get_continuous_states_null) P(set_time_nan) P(completed_integrator_step_null) P(number_of_states)
     P(get_fmu_state_null) P(set_fmu_state_foreign) P(deserialize_garbage) P(debug_logging_null_categories)
