@@ -16,13 +16,13 @@ is what the energy record cannot pin down. The runs:
 
 - **seed start**: angles and rates of the frame nearest t0 from the measurement reconstruction
   (angles from the positions, rates from the Savitzky-Golay derivative), run frictionless with point
-  masses as in the seed, and with the identified model;
+  masses as in the seed, and with the fitted losses;
 - **least-squares start (state only)**: (phi1, phi2, omega1, omega2) at t0 fitted to the positions of
-  the first :data:`FIT_FRAMES` frames (1/3 s) through the FMU, identified model;
+  the first :data:`FIT_FRAMES` frames (1/3 s) through the FMU, fitted losses;
 - **least-squares start and geometry**: the state fitted together with the camera's rotation against
   gravity [rad], the pivot's offset (x, y) [m] from the measurement's circle-fit pivot and the lower
   rod's length l2 [m] (:data:`~double_pendulum.analysis.prediction.comparison.FREE_GEOMETRY`) to the first
-  :data:`GEOMETRY_FIT_FRAMES` frames (1.5 s; quick: :data:`QUICK_GEOMETRY_FIT_FRAMES`) after t0, identified model;
+  :data:`GEOMETRY_FIT_FRAMES` frames (1.5 s; quick: :data:`QUICK_GEOMETRY_FIT_FRAMES`) after t0, fitted losses;
   beside it, over the same frames, the state alone with the geometry fixed (circle-fit pivot, the track's
   l1 and l2, no rotation) and the state with the pivot offset and l2 but no rotation
   (:data:`~double_pendulum.analysis.prediction.comparison.PIVOT_SHIFT_GEOMETRY`), the alternative the rotation
@@ -116,7 +116,7 @@ from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.runs.results_io import read_results_csv, write_json, write_results_csv, write_text
 
 DESCRIPTION = ("FMU prediction of the measured track from t0 = 0.8 s: the seed's start and least-squares starts "
-               "(with geometry), identified losses")
+               "(with geometry), fitted losses")
 
 SEED_T0 = 0.8
 """The seed's start time [s]."""

@@ -95,11 +95,11 @@ PIVOT_SHIFT_GEOMETRY: tuple[str, ...] = ("pivot_offset_x", "pivot_offset_y", "l2
 """The alternative to the camera's rotation: the same fit without it (the pivot moves sideways instead)."""
 RUN_TITLES = {
     "seed_start_frictionless": "seed's start, frictionless model",
-    "seed_start_identified": "seed's start, identified losses",
-    "lsq_start_identified": "least-squares start (state only), identified losses",
+    "seed_start_identified": "seed's start, fitted losses",
+    "lsq_start_identified": "least-squares start (state only), fitted losses",
     "lsq_fixed_geometry_identified": "least-squares start over the geometry fit's window, geometry fixed",
-    "lsq_pivot_shift_identified": "least-squares start, pivot offset and l2 (no rotation), identified losses",
-    "lsq_geometry_identified": "least-squares start and geometry, identified losses",
+    "lsq_pivot_shift_identified": "least-squares start, pivot offset and l2 (no rotation), fitted losses",
+    "lsq_geometry_identified": "least-squares start and geometry, fitted losses",
 }
 """Plain words for the prediction labels (which also name their CSV files) in figures."""
 
@@ -461,7 +461,7 @@ def rod_floor_summary(rec: Reconstruction, i0: int, n_frames: int) -> dict[str, 
 
 
 def model_summary(losses: IdentifiedLosses) -> dict[str, Any]:
-    """The predicting model: lengths [m], bob and rod masses [kg], plate lengths [m], the identified losses."""
+    """The predicting model: lengths [m], bob and rod masses [kg], plate lengths [m], the fitted losses."""
     p = losses.pendulum
     return {
         "lengths_m": {"l1": p["l1"], "l2": p["l2"]},

@@ -1,6 +1,6 @@
 r"""The Markdown report of the ``measured_vs_sim`` scenario: every figure from its summary.
 
-Model and identified losses, start states (state-only and with geometry), prediction horizons (first
+Model and fitted losses, start states (state-only and with geometry), prediction horizons (first
 time after t0 at which the smoothed and the raw position error [m] exceed 2 cm and 5 cm,
 :mod:`.comparison`), the goal of at least 3 s at 5 cm, the two floors of the horizon (the track's
 rod-length error and the spread from the fit's uncertainty), whether model error or the fit's
@@ -20,12 +20,12 @@ from ..track.measurement import FPS
 
 LABELS = {
     "seed_start_frictionless": "seed start (reconstruction at t0), frictionless point masses",
-    "seed_start_identified": "seed start, identified model",
-    "lsq_start_identified": "least-squares start (state only), identified model",
+    "seed_start_identified": "seed start, fitted losses",
+    "lsq_start_identified": "least-squares start (state only), fitted losses",
     "lsq_fixed_geometry_identified": "least-squares start over the geometry's frames, geometry fixed (circle-fit"
                                      " pivot, track's l1 and l2, no rotation)",
     "lsq_pivot_shift_identified": "least-squares start, pivot offset and l2 (no rotation)",
-    "lsq_geometry_identified": "least-squares start and geometry (rotation, pivot offset, l2), identified model",
+    "lsq_geometry_identified": "least-squares start and geometry (rotation, pivot offset, l2), fitted losses",
 }
 """Names of the runs in the report, by run label."""
 
