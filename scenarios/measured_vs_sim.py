@@ -211,7 +211,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     ]
     headlines = {p.label: headline_horizon(p, (n_frames - 1) * FRAME_INTERVAL) for p in predictions[3:]}
     by_model = loss_model_predictions(runner, rec, i0, n_frames, losses.pendulum, geo,
-                                      supported_loss_values(rec, quick=quick))  # fmt: skip
+                                      supported_loss_values(rec, quick=quick), done=(values, predictions[-1]))
     spread = chaos_spread(runner, values, geo, predictions[-1], n_frames, ensemble_size)
     prediction_s = (n_frames - 1) * FRAME_INTERVAL
     smoothed = {p.label: p.smoothed_horizons() for p in predictions}

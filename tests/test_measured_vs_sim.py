@@ -260,3 +260,26 @@ def test_quick_run_compares_both_starts_with_the_track(quick_results):
     assert "are fitted with ``--thorough``" in report
     assert summary["starts"]["least_squares_geometry"]["n_frames"] <= 15  # the quick run's shorter geometry fit
     assert summary["regime"]["averaging_time_s"] == pytest.approx(10.0)
+
+
+def test_the_loss_models_reuse_the_main_run_and_run_each_other_model_once(monkeypatch):
+    """loss_model_predictions runs the start once per supported model, except the model whose start values are
+    those of the run already done (the main run's), which it takes as it is."""
+    from types import SimpleNamespace
+
+    from double_pendulum.analysis.prediction import loss_models
+
+    ran = []
+    monkeypatch.setattr(loss_models, "predict",
+                        lambda runner, label, values, *args: ran.append((label, values)) or label)
+    start = SimpleNamespace(state=None, geometry={})
+    pendulum = {"l1": 0.3}
+    losses = {"air+drag": {"air_factor": 2.2}, "viscous": {"b_v1": 1e-4}}
+    main = object()
+    out = loss_models.loss_model_predictions(None, None, 0, 10, pendulum, start, losses,
+                                             done=({"l1": 0.3, "air_factor": 2.2}, main))
+    assert out == {"air+drag": main, "viscous": "loss_model_viscous"}
+    assert ran == [("loss_model_viscous", {"l1": 0.3, "b_v1": 1e-4})]
+    ran.clear()
+    loss_models.loss_model_predictions(None, None, 0, 10, pendulum, start, losses, done=({"l1": 0.3}, main))
+    assert [label for label, _ in ran] == ["loss_model_air+drag", "loss_model_viscous"]

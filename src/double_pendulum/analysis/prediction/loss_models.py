@@ -56,12 +56,19 @@ def loss_model_predictions(
     pendulum: Mapping[str, Any],
     start: StartStateFit,
     losses: Mapping[str, Mapping[str, Any]],
+    done: tuple[Mapping[str, Any], Prediction] | None = None,
 ) -> dict[str, Prediction]:
     """The prediction from ``start`` (state and geometry) over ``n_frames`` frames with each model's ``losses``
-    (:func:`supported_loss_values`) on the ``pendulum`` (lengths, masses, rods), by model name."""
-    return {model: predict(runner, f"loss_model_{model}", {**pendulum, **values}, start.state, rec, i0, n_frames,
-                           start.geometry)
-            for model, values in losses.items()}  # fmt: skip
+    (:func:`supported_loss_values`) on the ``pendulum`` (lengths, masses, rods), by model name. ``done``: the
+    start values of a prediction already run from ``start`` and that prediction; a model whose start values are
+    those takes it instead of running again (the main run's model is one of the supported ones)."""
+    out = {}
+    for model, values in losses.items():
+        start_values = {**pendulum, **values}
+        out[model] = (done[1] if done is not None and start_values == dict(done[0]) else
+                      predict(runner, f"loss_model_{model}", start_values, start.state, rec, i0, n_frames,
+                              start.geometry))  # fmt: skip
+    return out
 
 
 def loss_model_sensitivity(predictions: Mapping[str, Prediction], n_frames: int) -> dict[str, Any]:

@@ -197,14 +197,25 @@ def loss_models_text(s: Mapping[str, Any]) -> str:
                 "the models the record supports equally is unknown here.")
     rows = "; ".join(f"{model_title(m)}: {claim_horizon(h['horizon_s'], h['censored'])} smoothed, "
                      f"{fmt_horizon(h['raw_horizon_s'], span)} s per frame" for m, h in sens["models"].items())
-    lo, hi = sens["smoothed_5cm_range_s"]
-    raw_lo, raw_hi = sens["raw_5cm_range_s"]
     return (f"**Under the other loss models.** The energy record supports {sens['n_models']} loss models equally "
             "(``loss_identification``), and the horizons depend on which one the prediction uses. The same start and "
-            f"geometry with each ({rows}) keep the smoothed error within 5 cm for {lo:.1f} s to "
-            + (f"the end of the {hi:.2f} s compared (censored)" if sens["smoothed_censored_models"] else f"{hi:.1f} s")
-            + f" and the per-frame error for {raw_lo:.1f} to {raw_hi:.1f} s. That range, not one run's figure, is what "
-            "the record supports; the table above is the run with one of them.")
+            f"geometry with each ({rows}) keep the smoothed error within 5 cm for {smoothed_range_text(sens)} and the "
+            f"per-frame error for {raw_range_text(sens)}. That range, not one run's figure, is what the record "
+            "supports; the table above is the run with one of them.")
+
+
+def smoothed_range_text(sens: Mapping[str, Any]) -> str:
+    """The smoothed 5 cm horizons' range over the loss models (``loss_model_sensitivity``), its top said as the
+    end of the record where a model's horizon is censored."""
+    lo, hi = sens["smoothed_5cm_range_s"]
+    top = f"the end of the {hi:.2f} s compared (censored)" if sens["smoothed_censored_models"] else f"{hi:.1f} s"
+    return f"{lo:.1f} s to {top}"
+
+
+def raw_range_text(sens: Mapping[str, Any]) -> str:
+    """The per-frame 5 cm horizons' range over the loss models [s]."""
+    lo, hi = sens["raw_5cm_range_s"]
+    return f"{lo:.1f} to {hi:.1f} s"
 
 
 def loss_text(s: Mapping[str, Any]) -> str:
@@ -218,12 +229,9 @@ def _loss_models_sentence(s: Mapping[str, Any]) -> str:
     sens = s["loss_model_sensitivity"]
     if sens["n_models"] < 2:
         return ""
-    lo, hi = sens["smoothed_5cm_range_s"]
-    raw_lo, raw_hi = sens["raw_5cm_range_s"]
-    top = f"the end of the {hi:.2f} s compared (censored)" if sens["smoothed_censored_models"] else f"{hi:.1f} s"
     return (f"These losses are one of {sens['n_models']} loss models that fit the measured energy equally well; with "
-            f"each of them the same start stays within 5 cm for {lo:.1f} s to {top} smoothed and {raw_lo:.1f} to "
-            f"{raw_hi:.1f} s frame by frame, so the record supports that range, not one figure.")
+            f"each of them the same start stays within 5 cm for {smoothed_range_text(sens)} smoothed and "
+            f"{raw_range_text(sens)} frame by frame, so the record supports that range, not one figure.")
 
 
 def _opening(s: Mapping[str, Any], quick: str) -> str:
