@@ -32,7 +32,7 @@ EXPECTED_CPU_S: dict[str, float] = {
     "energy_decay": 1.1,
     "loss_identification": 62.0,
     "suspension_transfer": 54.6,
-    "measured_vs_sim": 35.0,
+    "measured_vs_sim": 28.0,
     "work_precision": 47.1,
     "stability": 15.3,
     "chaos": 63.0,
@@ -43,7 +43,7 @@ EXPECTED_CPU_S: dict[str, float] = {
 measured again after it came to fit eight models from eleven starts: 83 s under another job's load, which made the
 others 1.3 to 1.4 times their entries here, so about 62 s on the quiet machine; free_swing measured again with its
 third run and its animation: 5.0 s beside other jobs; measured_vs_sim measured again after it came to run the main start
-under all five supported loss models: 12 s more on 2026-12-03): ``run all``
+under the four other supported loss models: 28.5 s on a fresh clone, 2026-12-03): ``run all``
 starts the longest first, packs the small ones into shared children and weights its progress bar by them;
 nothing else depends on them."""
 

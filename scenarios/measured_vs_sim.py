@@ -48,7 +48,7 @@ covariance). The regime at the measured energy comes from the largest Lyapunov e
 fitted start (frictionless, rods, :data:`LYAPUNOV_S` s; quick: :data:`QUICK_LYAPUNOV_S` s; thorough:
 :data:`THOROUGH_LYAPUNOV_S` s), compared with the energy the lower rod needs to flip.
 
-Cost: about 37 s of CPU by default once ``loss_identification`` has cached its fits (about 130 s on a first
+Cost: about 29 s of CPU by default once ``loss_identification`` has cached its fits (about 130 s on a first
 run that fits every model itself). ``thorough`` adds the fit-window check (the start and geometry fitted again to
 the first :data:`WINDOW_SENSITIVITY` frames, about 35 s of CPU) and averages the Lyapunov exponent over
 :data:`THOROUGH_LYAPUNOV_S` s (5 s more). ``quick``: a 3 s prediction, the geometry fitted to
