@@ -11,12 +11,11 @@ independent variable) and, for Model Exchange, the continuous states and their d
 * **Model Exchange**: the host integrates the states; the FMU gives their derivatives from the
   runtime's vector field, no event indicators (:mod:`double_pendulum.component.model_exchange`).
 
-pythonfmu3 builds the same Python object for either interface and does not say which; the
-Model Exchange functions (``fmi3SetTime`` after initialisation, ``fmi3Get/SetContinuousStates``,
-``fmi3GetContinuousStateDerivatives``, ``fmi3UpdateDiscreteStates``) switch the outputs over to
-the host's states. The FMU's binary (``fmu_src/loader/fmi3_loader.c``) passes the start time of
-``fmi3EnterInitializationMode`` on through ``fmi3SetTime`` (pythonfmu3 drops it) and initialises the
-out-arguments pythonfmu3 does not write.
+The same class serves either interface; the Model Exchange functions (``fmi3SetTime`` after
+initialisation, ``fmi3SetContinuousStates``, ``fmi3UpdateDiscreteStates``) switch the outputs over
+to the host's states. In Initialization Mode the continuous states and their derivatives are those
+of the start values set so far, as FMI 3.0 lets a host read them there. The FMU's binary
+(``fmu_src/loader/fmi3_guard.c``) calls it through ``fmi_bridge.py``.
 """
 
 from __future__ import annotations
@@ -24,7 +23,7 @@ from __future__ import annotations
 import importlib
 from types import SimpleNamespace
 
-from .slave_common import ComponentMapping, fmi_library, leave_host_as_found, runtime_module, runtime_package
+from .slave_common import ComponentMapping, fmi_library, runtime_module, runtime_package
 
 _exchange = runtime_module("component.model_exchange")
 DERIVATIVE_UNITS, LOCAL_STATES, STATES = _exchange.DERIVATIVE_UNITS, _exchange.LOCAL_STATES, _exchange.STATES
@@ -52,7 +51,7 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
     """The double pendulum behind FMI 3.0 Model Exchange and Co-Simulation."""
 
     interface = _interface
-    error_status = Status.error
+    discard_status, warning_status = Status.discard, Status.warning
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -71,7 +70,6 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
         for variable in _interface.variables():
             self._register(variable)
         self._register_states()
-        leave_host_as_found(self.resources)
 
     def make_component(self):
         return _cosimulation.DoublePendulumCoSimulation()
@@ -119,12 +117,13 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
         """The current time [s]: the host's under Model Exchange, the last communication point otherwise."""
         return self._states.time if self._model_exchange_used else self._sim.time
 
+    def setup_experiment(self, start_time: float) -> None:
+        """The start time of fmi3EnterInitializationMode."""
+        self._sim.set_start_time(start_time)
+
     def set_time(self, time: float) -> None:
-        """fmi3SetTime; before initialisation (from the loader's fmi3EnterInitializationMode) the start time."""
-        if self._sim.initialised:
-            self._model_exchange().set_time(time)
-        else:
-            self._guarded(self._sim.set_start_time, time)
+        """fmi3SetTime (Model Exchange, after initialisation)."""
+        self._model_exchange().set_time(time)
 
     def _set_input(self, name: str, value: float) -> None:
         self._guarded(self._sim.set_input, name, value)
@@ -160,14 +159,19 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
     def get_number_of_continuous_states(self) -> int:
         return len(STATES)
 
+    def _states_to_read(self) -> PendulumStates:
+        """The states a host reads: its own under Model Exchange; in Initialization Mode those of the start
+        values set so far (FMI 3.0 lets a host read states and derivatives there)."""
+        return self._model_exchange() if self._states is not None else self._view()
+
     def get_continuous_states(self) -> list[float]:
-        return list(self._guarded(self._model_exchange).x)
+        return list(self._states_to_read().x)
 
     def set_continuous_states(self, values: list[float]) -> None:
-        self._guarded(lambda: self._model_exchange().set_states(values))
+        self._model_exchange().set_states(values)
 
     def get_continuous_state_derivatives(self) -> list[float]:
-        return list(self._guarded(lambda: self._model_exchange().derivatives()))
+        return list(self._states_to_read().derivatives())
 
     def get_event_indicators(self) -> list[float]:
         return []  # a smooth right-hand side (double_pendulum.component.model_exchange)
@@ -178,7 +182,7 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
         The attribute names are those pythonfmu3's C++ layer reads (its own result class spells two
         of them otherwise, so they were never written; the loader also initialises them).
         """
-        changed = self._guarded(lambda: self._model_exchange().book_jump())
+        changed = self._model_exchange().book_jump()
         return SimpleNamespace(discreteStatesNeedUpdate=False, terminateSimulation=False,
                                nominalContinuousStatesChanged=False, valuesOfContinuousStatesChanged=changed,
                                nextEventTimeDefined=False, nextEventTime=0.0)
@@ -190,11 +194,25 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
                 "states": self._states.get_state() if self._states is not None else None}
 
     def _set_fmu_state(self, state):
-        def restore():
-            self._sim.set_state(state["component"])
-            self._states = PendulumStates(self._sim) if state["states"] is not None else None
-            if self._states is not None:
-                self._states.set_state(state["states"])
-            self._model_exchange_used = bool(state["model_exchange_used"])
+        self.check_fmu_state(state)
+        self._sim.set_state(state["component"])
+        self._states = PendulumStates(self._sim) if state["states"] is not None else None
+        if self._states is not None:
+            self._states.set_state(state["states"])
+        self._model_exchange_used = bool(state["model_exchange_used"])
 
-        self._guarded(restore)
+    def check_fmu_state(self, state) -> None:
+        """Raise (naming what is wrong) unless ``state`` is one :meth:`_get_fmu_state` gives."""
+        if not isinstance(state, dict) or set(state) != {"component", "model_exchange_used", "states"}:
+            raise ValueError("an FMU state of the FMI 3 FMU is a dict of component, model_exchange_used and states, "
+                             f"not {_cut(state)}")
+        if not isinstance(state["model_exchange_used"], bool):
+            raise ValueError(f'state["model_exchange_used"] = {_cut(state["model_exchange_used"])} is not a bool')
+        type(self._sim).check_state(state["component"])
+        if state["states"] is not None:
+            PendulumStates.check_state(state["states"])
+
+
+def _cut(value, limit: int = 60) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."

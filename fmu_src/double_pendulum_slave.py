@@ -7,8 +7,8 @@ come from its :class:`~double_pendulum.component.variables.FmuInterface`. Each F
 
 All physics, numerics and validation live in the ``double_pendulum`` package, whose runtime part
 (model, solvers, component) the build bundles into the FMU's resources, with pythonfmu's Python part
-and these adapters. All of them are imported under private names and a Python host is left as it
-was found (``slave_common.py``, shared with the FMI 3 FMU).
+and these adapters, all imported under private names (``slave_common.py``, shared with the FMI 3
+FMU). The FMU's binary calls the slave through ``fmi_bridge.py``.
 """
 
 from __future__ import annotations
@@ -18,7 +18,6 @@ import importlib
 from .slave_common import (
     ComponentMapping,
     fmi_library,
-    leave_host_as_found,
     runtime_module,
     runtime_package,
 )
@@ -43,7 +42,7 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
     """
 
     version = package.__version__
-    error_status, warning_status = Fmi2Status.error, Fmi2Status.warning
+    discard_status, warning_status = Fmi2Status.discard, Fmi2Status.warning
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
@@ -57,38 +56,31 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
             {vr: input_names.index(name) for vr, name in self._real_names.items() if name in input_names}
             if hasattr(self._sim, "set_inputs_at") else {}
         )
-        leave_host_as_found(self.resources)
 
     def set_real(self, vrs, values):
         """fmi2SetReal: inputs go straight to the component (one float check and a store each, as a
         master sets them before every step); anything else through pythonfmu and its setter."""
         index_of = self._input_index
         try:
-            try:
-                indices = [index_of[vr] for vr in vrs]
-            except KeyError:  # not inputs only: one by one
-                for vr, value in zip(vrs, values):
-                    if vr in index_of:
-                        self._sim.set_inputs_at((index_of[vr],), (value,))
-                    else:
-                        super().set_real([vr], [value])
-                return
-            self._sim.set_inputs_at(indices, values)
-        except Exception as error:
-            self._fail(error)
+            indices = [index_of[vr] for vr in vrs]
+        except KeyError:  # not inputs only: one by one
+            for vr, value in zip(vrs, values):
+                if vr in index_of:
+                    self._sim.set_inputs_at((index_of[vr],), (value,))
+                else:
+                    super().set_real([vr], [value])
+            return
+        self._sim.set_inputs_at(indices, values)
 
     def get_real(self, vrs):
         """fmi2GetReal: after initialisation straight from the component (outputs computed when read)."""
         sim = self._sim
+        if not sim.initialised:
+            return super().get_real(vrs)  # the outputs of the values set so far (_output)
         try:
-            if not sim.initialised:
-                return super().get_real(vrs)  # the outputs of the values set so far (_output)
-            try:
-                return list(map(sim.get, map(self._real_names.__getitem__, vrs)))
-            except KeyError:  # not a Real: pythonfmu's message
-                return super().get_real(vrs)
-        except Exception as error:
-            self._fail(error)
+            return list(map(sim.get, map(self._real_names.__getitem__, vrs)))
+        except KeyError:  # not a Real: pythonfmu's message
+            return super().get_real(vrs)
 
     def _register(self, var) -> None:
         name = var.name

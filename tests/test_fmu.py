@@ -66,9 +66,11 @@ def test_fmu_bundles_the_package_its_loader_and_the_python_it_was_built_with(fmu
         assert not [n for n in names if n.startswith("resources/") and n.count("/") == 1 and n.endswith(".py")
                     and not n.startswith("resources/_dp_fmu_")]  # nothing importable under a public name
         assert "resources/requirements.txt" not in names  # it needs nothing installed
+        assert [n for n in names if n.startswith("binaries/")] == ["binaries/linux64/DoublePendulum.so"]  # the loader
+        identity = z.read("resources/identity.cfg").decode()
+        assert "model=DoublePendulum\n" in identity and f"entry={entry}\n" in identity
+        assert f"package=_dp_fmu_{bundle['id']}_adapters\n" in identity
         if sys.platform.startswith("linux") and loader.c_compiler():
-            assert {"binaries/linux64/DoublePendulum.so", "binaries/linux64/libpythonfmu-export.so"} <= set(names)
-            assert bundle["guard"] is True
             record = z.read("resources/python.cfg").decode()
             assert f"version={sys.version_info[0]}.{sys.version_info[1]}" in record
             assert f"home={sys.base_prefix}" in record
@@ -266,34 +268,19 @@ def test_fmu_bundles_only_the_runtime(fmu_path):
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the C loader is for Linux")
-def test_without_a_c_compiler_the_build_says_so_once_and_keeps_pythonfmus_binary(tmp_path, monkeypatch, capfd):
-    from pythonfmu.builder import HERE as PYTHONFMU_FOLDER
-
-    from double_pendulum.fmu import build
-    from double_pendulum.fmu.build_fmi3 import build_fmu3
+def test_without_a_c_compiler_the_build_stops_with_one_line_and_leaves_no_fmu(tmp_path, monkeypatch):
+    """The FMU's binary is compiled from source: without a compiler there is no FMU to write, and the CLI
+    says why in one line (no traceback, nothing half-written)."""
+    from double_pendulum.fmu import build, loader
 
     monkeypatch.setenv("CC", "/nonexistent/cc")
-    build._loader_binary.cache_clear()
-    build._note.cache_clear()
-    try:
-        fmus = [build.build_fmu(tmp_path / f"{name}.fmu", name) for name in ("DoublePendulum", "Suspension")]
-        fmi3 = build_fmu3(tmp_path / "fmi3" / "DoublePendulum.fmu")
-    finally:
-        build._loader_binary.cache_clear()
-    said = capfd.readouterr().err.strip().splitlines()
-    assert len(said) == 1 and "no C compiler found" in said[0] and "only in Python hosts" in said[0]
-    plain = (PYTHONFMU_FOLDER / "resources" / "binaries" / "linux64" / "libpythonfmu-export.so").read_bytes()
-    for fmu in fmus:
-        with zipfile.ZipFile(fmu) as z:
-            binaries = [n for n in z.namelist() if n.startswith("binaries/linux64/")]
-            assert binaries == [f"binaries/linux64/{fmu.stem}.so"] and z.read(binaries[0]) == plain
-            assert "resources/python.cfg" not in z.namelist()
-    from pythonfmu3.builder import HERE as PYTHONFMU3_FOLDER
-
-    plain3 = (PYTHONFMU3_FOLDER / "resources" / "binaries" / "x86_64-linux" / "libpythonfmu-export.so").read_bytes()
-    with zipfile.ZipFile(fmi3) as z:  # the FMI 3 FMU alike, with pythonfmu3's binary
-        binaries = [n for n in z.namelist() if n.startswith("binaries/x86_64-linux/")]
-        assert binaries == ["binaries/x86_64-linux/DoublePendulum.so"] and z.read(binaries[0]) == plain3
+    with pytest.raises(loader.LoaderUnavailable, match="no C compiler found"):
+        build.build_fmu(tmp_path / "DoublePendulum.fmu")
+    assert not list(tmp_path.iterdir())
+    done = subprocess.run([sys.executable, "-m", "double_pendulum.cli", "build", "-o", str(tmp_path / "out")],
+                          capture_output=True, text=True, env={**os.environ, "CC": "/nonexistent/cc"})
+    assert done.returncode != 0 and "Traceback" not in done.stderr, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "no C compiler found" in done.stderr, done.stderr
 
 
 def test_a_newer_build_module_makes_the_fmu_stale(fmu_path, tmp_path, monkeypatch):

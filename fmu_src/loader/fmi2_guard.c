@@ -1,6 +1,5 @@
-/* The FMU's binary for FMI 2.0 co-simulation: a guard in front of pythonfmu's library, which lies
- * beside it as libpythonfmu-export.so and runs the FMU's Python side (python_runtime.c makes a
- * CPython available first).
+/* The FMU's binary for FMI 2.0 co-simulation: the FMI functions, which call the FMU's Python side
+ * (fmu_src/fmi_bridge.py) through bridge.c, in a CPython that python_runtime.c makes available.
  *
  * Whatever the Python side does, the host sees the behaviour of FMI 2.0 (sections 2.1.3, 2.1.5,
  * 4.2.4; modelled on modelica/Reference-FMUs, written anew):
@@ -8,35 +7,31 @@
  *    allow returns fmi2Error with one log line naming the function and the state; after an error
  *    only what the standard allows in its Error state (get values, FMU states, reset, free,
  *    setDebugLogging);
- *  - arguments are checked before anything is forwarded: the instance (NULL, freed, foreign), NULL
+ *  - arguments are checked before anything reaches Python: the instance (NULL, freed, foreign), NULL
  *    arrays with n > 0, every pointer the standard requires, String values that are not UTF-8,
  *    doStep's step size (> 0, finite) and communication point (the FMU's time: the end of the last
- *    step, or of the FMU state set);
+ *    step, or of the FMU state set, to a millionth of the step);
  *  - fmi2Instantiate refuses (NULL and one line; stderr where the host gave no logger) a wrong GUID,
  *    Model Exchange, a missing or non-UTF-8 instance name, a missing resource location, a folder that
- *    is not this FMU's;
+ *    is not this FMU's (another FMU's resources are named as such);
  *  - the host's logger is only ever called with the constant format "%s" and the message as its
- *    argument; errors reach it from instantiation on, other messages only with debug logging on
- *    (fmi2SetDebugLogging as specified);
- *  - pythonfmu answers every Python exception with fmi2Fatal ("every instance is lost"); for this FMU
- *    such an error leaves the other instances untouched and this one resettable: fmi2Error;
- *  - instantiation and reset, which import and edit sys.path, are serialised across threads; every
- *    other call runs in parallel (different instances in different threads).
- * The FMU states the host gets are the guard's (guard.h): the library's state with the instance's
- * FMI state and time, so that fmi2SetFMUstate also restores where the next doStep starts. */
+ *    argument, with no lock held (it may call the FMU again); errors and discarded steps reach it from
+ *    instantiation on, other messages only with debug logging on (fmi2SetDebugLogging as specified);
+ *  - an exception on the Python side is an error of this instance only, which a reset recovers:
+ *    fmi2Error; a Ctrl-C inside a call is too, and is raised again for a Python host;
+ *  - every call runs in parallel with calls on other instances (the GIL serialises the Python); an
+ *    instance is freed only when no call is using it.
+ * The FMU states the host gets are the shared ones of fmu_state.c. */
 #define _GNU_SOURCE
 #include "glibc_compat.h"
 
-#include <dlfcn.h>
 #include <math.h>
-#include <pthread.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bridge.h"
 #include "fmi2Functions.h"
 #include "guard.h"
-#include "python_runtime.h"
 
 #ifndef FMU_GUID
 #error "the build defines FMU_GUID, the guid of the FMU's modelDescription.xml"
@@ -44,41 +39,6 @@
 #ifndef MODEL_IDENTIFIER
 #error "the build defines MODEL_IDENTIFIER"
 #endif
-
-#define BACKEND_FILE "libpythonfmu-export.so"
-#define STATE_MAGIC "DPFMU2S1"
-
-/* ------------------------------------------------------------------------- pythonfmu's library */
-
-#define FMI2_FORWARDED(X)                                                                                         \
-    X(fmi2Instantiate) X(fmi2FreeInstance) X(fmi2SetupExperiment) X(fmi2EnterInitializationMode)                 \
-    X(fmi2ExitInitializationMode) X(fmi2Terminate) X(fmi2Reset) X(fmi2GetReal) X(fmi2GetInteger)                \
-    X(fmi2GetBoolean) X(fmi2GetString) X(fmi2SetReal) X(fmi2SetInteger) X(fmi2SetBoolean) X(fmi2SetString)     \
-    X(fmi2GetFMUstate) X(fmi2SetFMUstate) X(fmi2FreeFMUstate) X(fmi2SerializedFMUstateSize)                     \
-    X(fmi2SerializeFMUstate) X(fmi2DeSerializeFMUstate) X(fmi2DoStep)
-
-#define DECLARE(name) static name##TYPE *backend_##name;
-FMI2_FORWARDED(DECLARE)
-static pthread_mutex_t resolve_lock = PTHREAD_MUTEX_INITIALIZER;
-static int resolved;
-
-static int resolve(void *backend, char *error, size_t size) {
-    pthread_mutex_lock(&resolve_lock);
-    if (!resolved) {
-        error[0] = '\0';
-#define RESOLVE(name)                                                                                             \
-    backend_##name = (name##TYPE *)dlsym(backend, #name);                                                        \
-    if (!backend_##name) guard_format(error, size, "pythonfmu's library lacks %s", #name);
-        FMI2_FORWARDED(RESOLVE)
-        resolved = !error[0];
-    }
-    int ok = resolved;
-    pthread_mutex_unlock(&resolve_lock);
-    return ok;
-}
-
-/* Instantiation and reset run the Python side's imports and its sys.path hygiene: one at a time. */
-static pthread_mutex_t python_lock = PTHREAD_MUTEX_INITIALIZER;
 
 /* ----------------------------------------------------------------------------------- states */
 
@@ -125,13 +85,20 @@ static const char *state_name(int state) {
 #define MASK_CancelStep 0 /* only while an asynchronous step is in progress: never here */
 #define MASK_STATUS (STEP_COMPLETE | STEP_FAILED | TERMINATED | ERROR_STATE)
 
+static int state_allowed(const char *interface, int state) {
+    (void)interface;
+    return (state & ANY_STATE) != 0;
+}
+
+static const guard_version FMI2 = {"fmi2", MODEL_IDENTIFIER, FMU_GUID, "fmuGUID", "fmuResourceLocation",
+                                   ANY_STATE, ERROR_STATE, INSTANTIATED, "FMUstate", state_name, state_allowed};
+
 /* --------------------------------------------------------------------------------- instances */
 
 typedef struct {
     guard_instance common; /* first: a guarded* is a guard_instance* */
-    fmi2Component backend;
-    fmi2CallbackFunctions host;  /* the host's callbacks */
-    fmi2CallbackFunctions inner; /* pythonfmu's: its messages come to library_logger */
+    fmi2CallbackFunctions host; /* the host's callbacks */
+    char *strings;              /* the values of the last fmi2GetString (valid until the next call) */
 } guarded;
 
 /* The host's logger, with the message as data, never as a format. */
@@ -140,24 +107,25 @@ static void host_log(guard_instance *common, int status, const char *category, c
     g->host.logger(g->host.componentEnvironment, common->name, (fmi2Status)status, category, "%s", message);
 }
 
-/* The logger pythonfmu gets: its message is text (it passes no arguments), never a format. */
-static void library_logger(fmi2ComponentEnvironment environment, fmi2String instance_name, fmi2Status status,
-                           fmi2String category, fmi2String message, ...) {
-    (void)instance_name;
-    if (environment) guard_library_message_logged(environment, (int)status, category, message);
+static void destroy(guard_instance *common) {
+    guarded *g = (guarded *)common;
+    guard_free_common(common);
+    free(g->strings);
+    free(g);
 }
 
 #define fail guard_fail
 #define settle(g, status) ((fmi2Status)guard_settle(&(g)->common, (int)(status)))
 
-/* Begin function F (fmi2F) on instance c: look it up, check that its state allows it. */
+/* Begin function F (fmi2F) on instance c: look it up (held until the function returns), check that its
+ * state allows it. */
 #define BEGIN_MASKED(F, MASK)                                                                                     \
-    guarded *g = (guarded *)guard_lookup(c, MODEL_IDENTIFIER, "fmi2" #F);                                         \
+    guarded *g GUARD_CALL = (guarded *)guard_acquire(c, MODEL_IDENTIFIER, "fmi2" #F);                             \
     if (!g) return fmi2Error;                                                                                     \
+    g->common.function = "fmi2" #F;                                                                               \
     if (!(g->common.at.state & (MASK)))                                                                           \
         return (fmi2Status)fail(&g->common, "fmi2" #F ": illegal call sequence: not allowed in state %s",        \
-                                state_name(g->common.at.state));                                                 \
-    g->common.function = "fmi2" #F
+                                state_name(g->common.at.state))
 #define BEGIN(F) BEGIN_MASKED(F, MASK_##F)
 
 #define REQUIRE(condition, ...)                                                                                   \
@@ -168,46 +136,6 @@ static void library_logger(fmi2ComponentEnvironment environment, fmi2String inst
 FMI2_Export const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 FMI2_Export const char *fmi2GetVersion(void) { return fmi2Version; }
 
-/* Check the arguments of fmi2Instantiate; 0 and a message in `why` if they are wrong. */
-static int instantiation_allowed(fmi2String name, fmi2Type type, fmi2String guid, fmi2String location,
-                                 char *resources, size_t size, char *why, size_t why_size) {
-    char marker[4200];
-    long bad;
-    if (!name || !name[0]) guard_format(why, why_size, "instanceName is %s", name ? "empty" : "NULL");
-    else if ((bad = guard_utf8_error(name)) >= 0)
-        guard_format(why, why_size, "instanceName is not UTF-8 (byte %ld is 0x%02x; an fmi2String is UTF-8 encoded)",
-                     bad, (unsigned char)name[bad]);
-    else if (type != fmi2CoSimulation)
-        guard_format(why, why_size, "fmuType = %d: this FMU supports co-simulation (fmi2CoSimulation = %d) only",
-                     (int)type, (int)fmi2CoSimulation);
-    else if (!guid || strcmp(guid, FMU_GUID) != 0)
-        guard_format(why, why_size,
-                     "fmuGUID %s%.100s%s is not this FMU's %s: the binary and its modelDescription.xml come "
-                     "from different builds", guid ? "\"" : "", guid ? guid : "NULL", guid ? "\"" : "", FMU_GUID);
-    else if (!location || !location[0])
-        guard_format(why, why_size, "fmuResourceLocation is %s: the FMU needs its resources folder",
-                     location ? "empty" : "NULL");
-    else if (!guard_uri_to_path(location, resources, size))
-        guard_format(why, why_size, "fmuResourceLocation \"%.1000s\" is not a file URI of this machine", location);
-    else if (!guard_is_directory(resources))
-        guard_format(why, why_size, "fmuResourceLocation \"%.1000s\": there is no folder %.1000s", location,
-                     resources);
-    else if (guard_format(marker, sizeof marker, "%s/slavemodule.txt", resources), !guard_is_file(marker))
-        guard_format(why, why_size, "fmuResourceLocation \"%.1000s\" is not this FMU's resources folder "
-                     "(no slavemodule.txt in %.1000s)", location, resources);
-    else if ((bad = guard_utf8_error(resources)) >= 0)
-        guard_format(why, why_size, "fmuResourceLocation \"%.1000s\": the folder's path is not UTF-8 (byte %ld), "
-                     "which the FMU's Python side cannot take", location, bad);
-    else
-        return 1;
-    return 0;
-}
-
-static void free_guarded(guarded *g) {
-    free(g->common.name);
-    free(g);
-}
-
 FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                                           fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
                                           fmi2Boolean visible, fmi2Boolean loggingOn) {
@@ -216,72 +144,44 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
                      "section 2.1.5)", functions ? "functions->logger" : "functions");
         return NULL;
     }
-    char why[2048] = "", resources[4096];
     guarded *g = calloc(1, sizeof *g);
-    char *uri = malloc(sizeof resources + 8);
-    char *name = strdup(instanceName && instanceName[0] && guard_utf8_error(instanceName) < 0 ? instanceName : "?");
-    if (!g || !uri || !name) {
+    if (!g || !guard_init_instance(&g->common, &FMI2, "CoSimulation", instanceName, loggingOn, host_log, destroy)) {
         guard_orphan(MODEL_IDENTIFIER, "fmi2Instantiate", "out of memory");
-        free(g), free(uri), free(name);
+        if (g) free(g->common.name), free(g);
         return NULL;
     }
-    g->common = (guard_instance){.at = {INSTANTIATED, 0.0, 0.0, 0}, .error_state = ERROR_STATE,
-                                 .categories = loggingOn ? CATEGORIES_EVERY : CATEGORIES_ERRORS,
-                                 .function = "fmi2Instantiate", .name = name, .log = host_log};
-    g->host = g->inner = *functions;
-    g->inner.logger = library_logger;
-    g->inner.componentEnvironment = &g->common;
-    void *backend = NULL;
-    if (!instantiation_allowed(instanceName, fmuType, fmuGUID, fmuResourceLocation, resources, sizeof resources, why,
-                               sizeof why) ||
-        !(backend = python_runtime_load_backend(fmuResourceLocation, BACKEND_FILE, why, sizeof why)) ||
-        !resolve(backend, why, sizeof why)) {
-        fail(&g->common, "fmi2Instantiate: %s", why);
-        free_guarded(g), free(uri);
+    g->host = *functions;
+    g->common.function = "fmi2Instantiate";
+    char why[2048] = "", resources[4096];
+    if (fmuType != fmi2CoSimulation)
+        guard_format(why, sizeof why, "fmuType = %d: this FMU supports co-simulation (fmi2CoSimulation = %d) only",
+                     (int)fmuType, (int)fmi2CoSimulation);
+    else
+        guard_check_instantiation(&FMI2, instanceName, fmuGUID, fmuResourceLocation, resources, sizeof resources, why,
+                                  sizeof why);
+    if (why[0]) fail(&g->common, "fmi2Instantiate: %s", why);
+    if (why[0] || !guard_start_python(&g->common, resources, visible)) {
+        destroy(&g->common);
         return NULL;
     }
-    snprintf(uri, sizeof resources + 8, "file://%s", resources); /* the one form pythonfmu reads */
-    guard_lock_python(&python_lock);
-    /* logging on: every message comes to library_logger, which lets through what the host asked for */
-    g->backend = backend_fmi2Instantiate(instanceName, fmuType, fmuGUID, uri, &g->inner, visible, fmi2True);
-    pthread_mutex_unlock(&python_lock);
-    free(uri);
-    if (!g->backend || !guard_register(&g->common)) {
-        fail(&g->common, "fmi2Instantiate: the FMU's Python side could not be instantiated%s",
-             g->backend ? " (out of memory)" : " (the message before says why)");
-        if (g->backend) backend_fmi2FreeInstance(g->backend);
-        free_guarded(g);
+    if (!guard_register(&g->common)) {
+        fail(&g->common, "fmi2Instantiate: out of memory");
+        destroy(&g->common);
         return NULL;
     }
     return g;
 }
 
-/* Forget state s and free it, with its library state. */
-static void free_state(guarded *g, guard_state *s) {
-    guard_state_forget(s);
-    if (s->backend) backend_fmi2FreeFMUstate(g->backend, (fmi2FMUstate *)&s->backend);
-    free(s);
-}
-
 FMI2_Export void fmi2FreeInstance(fmi2Component c) {
-    if (!c) return;
-    if (!guard_unregister(c)) {
+    if (c && !guard_unregister(c))
         guard_orphan(MODEL_IDENTIFIER, "fmi2FreeInstance", "%p is not a live instance of this FMU (freed twice?)",
                      c);
-        return;
-    }
-    guarded *g = (guarded *)c;
-    g->common.function = "fmi2FreeInstance";
-    while (g->common.states) free_state(g, g->common.states); /* the FMU states the host did not free */
-    backend_fmi2FreeInstance(g->backend);
-    free_guarded(g);
 }
 
 FMI2_Export fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
                                            const fmi2String categories[]) {
     BEGIN(SetDebugLogging);
-    return (fmi2Status)guard_set_debug_logging(&g->common, loggingOn, nCategories, categories,
-                                               "fmi2SetDebugLogging");
+    return (fmi2Status)guard_set_debug_logging(&g->common, loggingOn, nCategories, categories);
 }
 
 /* --------------------------------------------------------------------------------- the modes */
@@ -295,163 +195,142 @@ FMI2_Export fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranc
             startTime);
     REQUIRE(!toleranceDefined || (isfinite(tolerance) && tolerance > 0),
             "fmi2SetupExperiment: tolerance = %g must be finite and > 0", tolerance);
-    fmi2Status status = settle(g, backend_fmi2SetupExperiment(g->backend, toleranceDefined, tolerance, startTime,
-                                                               stopTimeDefined, stopTime));
+    fmi2Status status = settle(g, bridge_call(&g->common, NO_PAYLOAD, "setup_experiment", "(didid)", startTime,
+                                              (int)stopTimeDefined, stopTime, (int)toleranceDefined, tolerance));
     if (status <= fmi2Warning) g->common.at.time = g->common.at.last_successful_time = startTime;
     return status;
 }
 
-/* Run a mode change of the library; on success the instance is in state `next`. */
-#define MODE_CHANGE(F, next)                                                                                      \
+/* Run a mode change of the Python side; on success the instance is in state `next`. */
+#define MODE_CHANGE(F, method, next)                                                                              \
     FMI2_Export fmi2Status fmi2##F(fmi2Component c) {                                                             \
         BEGIN(F);                                                                                                 \
-        fmi2Status status = settle(g, backend_fmi2##F(g->backend));                                              \
+        fmi2Status status = settle(g, bridge_call(&g->common, NO_PAYLOAD, method, "()"));                         \
         if (status <= fmi2Warning) g->common.at.state = (next);                                                  \
         return status;                                                                                            \
     }
-MODE_CHANGE(EnterInitializationMode, INITIALIZATION)
-MODE_CHANGE(ExitInitializationMode, STEP_COMPLETE)
-MODE_CHANGE(Terminate, TERMINATED)
+MODE_CHANGE(EnterInitializationMode, "enter_initialization_mode", INITIALIZATION)
+MODE_CHANGE(ExitInitializationMode, "exit_initialization_mode", STEP_COMPLETE)
+MODE_CHANGE(Terminate, "terminate", TERMINATED)
 
 FMI2_Export fmi2Status fmi2Reset(fmi2Component c) {
     BEGIN(Reset);
-    guard_lock_python(&python_lock); /* the Python side is made anew */
-    fmi2Status status = settle(g, backend_fmi2Reset(g->backend));
-    pthread_mutex_unlock(&python_lock);
-    if (status <= fmi2Warning) g->common.at = (guard_position){INSTANTIATED, 0.0, 0.0, 0};
-    return status;
+    return (fmi2Status)guard_reset(&g->common);
 }
 
 /* ------------------------------------------------------------------------ getting and setting */
 
-#define ACCESS(F, TYPE, MASK, VALUES_CONST, CHECK_VALUES)                                                        \
-    FMI2_Export fmi2Status fmi2##F(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,                  \
-                                   VALUES_CONST TYPE value[]) {                                                  \
-        BEGIN_MASKED(F, MASK);                                                                                    \
-        if (nvr == 0) return fmi2OK;                                                                              \
-        REQUIRE(vr, "fmi2" #F ": vr is NULL with nvr = %zu", nvr);                                                \
-        REQUIRE(value, "fmi2" #F ": value is NULL with nvr = %zu", nvr);                                          \
-        CHECK_VALUES                                                                                              \
-        return settle(g, backend_fmi2##F(g->backend, vr, nvr, value));                                           \
+/* Every variable is a scalar: the values cross as bytes of `nvr` packed values (fmi2Integer and
+ * fmi2Boolean are C ints, fmi2Real a double), named by their FMI type. */
+#define ACCESS_CHECKS(F)                                                                                          \
+    if (nvr == 0) return fmi2OK;                                                                                  \
+    REQUIRE(vr, "fmi2" #F ": vr is NULL with nvr = %zu", nvr);                                                    \
+    REQUIRE(value, "fmi2" #F ": value is NULL with nvr = %zu", nvr)
+
+#define GET(F, TYPE, NAME)                                                                                        \
+    FMI2_Export fmi2Status fmi2##F(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, TYPE value[]) {  \
+        BEGIN_MASKED(F, MASK_GET);                                                                                \
+        ACCESS_CHECKS(F);                                                                                         \
+        bridge_payload payload = {PAYLOAD_EXACT, value, nvr * sizeof *value, NULL, NULL, NULL};                  \
+        return settle(g, bridge_call(&g->common, payload, "get", "(sy#)", NAME, (const char *)vr,                 \
+                                     (ssize_t)(nvr * sizeof *vr)));                                              \
     }
-#define NO_CHECK
-#define STRINGS_PRESENT                                                                                           \
-    for (size_t k = 0; k < nvr; k++) {                                                                            \
-        REQUIRE(value[k], "fmi2SetString: value[%zu] (vr = %u) is NULL", k, vr[k]);                               \
-        long bad = guard_utf8_error(value[k]);                                                                    \
-        REQUIRE(bad < 0, "fmi2SetString: value[%zu] (vr = %u) is not UTF-8 (byte %ld is 0x%02x; an fmi2String is " \
-                "UTF-8 encoded)", k, vr[k], bad, (unsigned char)value[k][bad]);                                   \
+#define SET(F, TYPE, NAME)                                                                                        \
+    FMI2_Export fmi2Status fmi2##F(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,                  \
+                                   const TYPE value[]) {                                                         \
+        BEGIN_MASKED(F, MASK_SET);                                                                                \
+        ACCESS_CHECKS(F);                                                                                         \
+        return settle(g, bridge_call(&g->common, NO_PAYLOAD, "set", "(sy#y#)", NAME, (const char *)vr,            \
+                                     (ssize_t)(nvr * sizeof *vr), (const char *)value,                           \
+                                     (ssize_t)(nvr * sizeof *value)));                                           \
     }
 
-ACCESS(GetReal, fmi2Real, MASK_GET, , NO_CHECK)
-ACCESS(GetInteger, fmi2Integer, MASK_GET, , NO_CHECK)
-ACCESS(GetBoolean, fmi2Boolean, MASK_GET, , NO_CHECK)
-ACCESS(GetString, fmi2String, MASK_GET, , NO_CHECK)
-ACCESS(SetReal, fmi2Real, MASK_SET, const, NO_CHECK)
-ACCESS(SetInteger, fmi2Integer, MASK_SET, const, NO_CHECK)
-ACCESS(SetBoolean, fmi2Boolean, MASK_SET, const, NO_CHECK)
-ACCESS(SetString, fmi2String, MASK_SET, const, STRINGS_PRESENT)
+GET(GetReal, fmi2Real, "Real")
+GET(GetInteger, fmi2Integer, "Integer")
+GET(GetBoolean, fmi2Boolean, "Boolean")
+SET(SetReal, fmi2Real, "Real")
+SET(SetInteger, fmi2Integer, "Integer")
+SET(SetBoolean, fmi2Boolean, "Boolean")
+
+/* Strings cross as their UTF-8 bytes, each ended by a NUL. */
+FMI2_Export fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                     fmi2String value[]) {
+    BEGIN_MASKED(GetString, MASK_GET);
+    ACCESS_CHECKS(GetString);
+    char *strings = NULL;
+    size_t size = 0;
+    bridge_payload payload = {PAYLOAD_COPY, NULL, 0, &strings, &size, NULL};
+    fmi2Status status = settle(g, bridge_call(&g->common, payload, "get_strings", "(y#)", (const char *)vr,
+                                              (ssize_t)(nvr * sizeof *vr)));
+    if (status > fmi2Warning) return status;
+    size_t found = 0;
+    for (size_t at = 0; at < size && found < nvr; found++) {
+        value[found] = strings + at;
+        at += strlen(strings + at) + 1;
+    }
+    if (found != nvr || (size && strings[size - 1] != '\0')) {
+        free(strings);
+        return (fmi2Status)fail(&g->common, "fmi2GetString: the FMU's Python side gave %zu strings for %zu value "
+                                            "references", found, nvr);
+    }
+    free(g->strings); /* the values of the last call: the host may use them until now */
+    g->strings = strings;
+    return status;
+}
+
+FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
+                                     const fmi2String value[]) {
+    BEGIN_MASKED(SetString, MASK_SET);
+    ACCESS_CHECKS(SetString);
+    size_t size = 0;
+    for (size_t k = 0; k < nvr; k++) {
+        REQUIRE(value[k], "fmi2SetString: value[%zu] (vr = %u) is NULL", k, vr[k]);
+        long bad = guard_utf8_error(value[k]);
+        REQUIRE(bad < 0, "fmi2SetString: value[%zu] (vr = %u) is not UTF-8 (byte %ld is 0x%02x; an fmi2String is "
+                "UTF-8 encoded)", k, vr[k], bad, (unsigned char)value[k][bad]);
+        size += strlen(value[k]) + 1;
+    }
+    char *joined = malloc(size ? size : 1), *at = joined;
+    REQUIRE(joined, "fmi2SetString: out of memory");
+    for (size_t k = 0; k < nvr; k++) at = stpcpy(at, value[k]) + 1;
+    fmi2Status status = settle(g, bridge_call(&g->common, NO_PAYLOAD, "set_strings", "(y#y#)", (const char *)vr,
+                                              (ssize_t)(nvr * sizeof *vr), joined, (ssize_t)size));
+    free(joined);
+    return status;
+}
 
 /* -------------------------------------------------------------------------------- FMU states */
 
-/* Into *FMUstate (a new state if NULL, else a live one, overwritten) the library's state `backend`
- * at position `at`; `backend` is freed if that fails. */
-static fmi2Status deliver_state(guarded *g, fmi2FMUstate *FMUstate, fmi2FMUstate backend, guard_position at) {
-    guard_state *s = *FMUstate;
-    if (s) {
-        if (s->backend) backend_fmi2FreeFMUstate(g->backend, (fmi2FMUstate *)&s->backend);
-        s->backend = backend;
-        s->at = at;
-        return fmi2OK;
-    }
-    if (!(s = guard_state_new(&g->common, backend, at))) {
-        backend_fmi2FreeFMUstate(g->backend, &backend);
-        return (fmi2Status)fail(&g->common, "%s: out of memory", g->common.function);
-    }
-    *FMUstate = s;
-    return fmi2OK;
-}
-
 FMI2_Export fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     BEGIN(GetFMUstate);
-    REQUIRE(FMUstate, "fmi2GetFMUstate: FMUstate is NULL");
-    if (*FMUstate && !guard_state_known(&g->common, *FMUstate, "fmi2GetFMUstate")) return fmi2Error;
-    fmi2FMUstate backend = NULL;
-    fmi2Status status = settle(g, backend_fmi2GetFMUstate(g->backend, &backend));
-    return status > fmi2Warning ? status : deliver_state(g, FMUstate, backend, g->common.at);
+    return (fmi2Status)guard_get_state(&g->common, FMUstate);
 }
 
 FMI2_Export fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate) {
     BEGIN(SetFMUstate);
-    guard_state *s = guard_state_known(&g->common, FMUstate, "fmi2SetFMUstate");
-    if (!s) return fmi2Error;
-    fmi2Status status = settle(g, backend_fmi2SetFMUstate(g->backend, s->backend));
-    if (status <= fmi2Warning) g->common.at = s->at;
-    return status;
+    return (fmi2Status)guard_set_state(&g->common, FMUstate);
 }
 
 FMI2_Export fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *FMUstate) {
     BEGIN(FreeFMUstate);
-    REQUIRE(FMUstate, "fmi2FreeFMUstate: FMUstate is NULL");
-    if (!*FMUstate) return fmi2OK; /* nothing to free */
-    guard_state *s = guard_state_known(&g->common, *FMUstate, "fmi2FreeFMUstate");
-    if (!s) return fmi2Error;
-    free_state(g, s);
-    *FMUstate = NULL;
-    return fmi2OK;
-}
-
-/* The size of the library's serialized state `s`. */
-static fmi2Status backend_size(guarded *g, guard_state *s, size_t *size) {
-    *size = 0;
-    return settle(g, backend_fmi2SerializedFMUstateSize(g->backend, s->backend, size));
+    return (fmi2Status)guard_free_state(&g->common, FMUstate);
 }
 
 FMI2_Export fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size) {
     BEGIN(SerializedFMUstateSize);
-    REQUIRE(size, "fmi2SerializedFMUstateSize: size is NULL");
-    guard_state *s = guard_state_known(&g->common, FMUstate, "fmi2SerializedFMUstateSize");
-    if (!s) return fmi2Error;
-    size_t inner = 0;
-    fmi2Status status = backend_size(g, s, &inner);
-    if (status <= fmi2Warning) *size = sizeof(guard_state_header) + inner;
-    return status;
+    return (fmi2Status)guard_serialized_size(&g->common, FMUstate, size);
 }
 
 FMI2_Export fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[],
                                              size_t size) {
     BEGIN(SerializeFMUstate);
-    REQUIRE(serializedState, "fmi2SerializeFMUstate: serializedState is NULL");
-    guard_state *s = guard_state_known(&g->common, FMUstate, "fmi2SerializeFMUstate");
-    if (!s) return fmi2Error;
-    size_t inner = 0;
-    fmi2Status status = backend_size(g, s, &inner);
-    if (status > fmi2Warning) return status;
-    REQUIRE(size == sizeof(guard_state_header) + inner,
-            "fmi2SerializeFMUstate: size = %zu, but fmi2SerializedFMUstateSize gives %zu", size,
-            sizeof(guard_state_header) + inner);
-    guard_state_header header;
-    guard_header_write(&header, STATE_MAGIC, FMU_GUID, s->at);
-    memcpy(serializedState, &header, sizeof header);
-    return settle(g, backend_fmi2SerializeFMUstate(g->backend, s->backend, serializedState + sizeof header, inner));
+    return (fmi2Status)guard_serialize_state(&g->common, FMUstate, (unsigned char *)serializedState, size);
 }
 
 FMI2_Export fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
                                                fmi2FMUstate *FMUstate) {
     BEGIN(DeSerializeFMUstate);
-    REQUIRE(serializedState, "fmi2DeSerializeFMUstate: serializedState is NULL");
-    REQUIRE(FMUstate, "fmi2DeSerializeFMUstate: FMUstate is NULL");
-    if (*FMUstate && !guard_state_known(&g->common, *FMUstate, "fmi2DeSerializeFMUstate")) return fmi2Error;
-    guard_state_header header;
-    guard_position at;
-    REQUIRE(size > sizeof header, "fmi2DeSerializeFMUstate: %zu bytes are not a serialized state of this FMU", size);
-    memcpy(&header, serializedState, sizeof header);
-    REQUIRE(guard_header_read(&header, STATE_MAGIC, FMU_GUID, ANY_STATE, &at),
-            "fmi2DeSerializeFMUstate: the bytes are not a state serialized by this FMU (GUID %s)", FMU_GUID);
-    fmi2FMUstate backend = NULL;
-    fmi2Status status = settle(g, backend_fmi2DeSerializeFMUstate(g->backend, serializedState + sizeof header,
-                                                                   size - sizeof header, &backend));
-    return status > fmi2Warning ? status : deliver_state(g, FMUstate, backend, at);
+    return (fmi2Status)guard_deserialize_state(&g->common, (const unsigned char *)serializedState, size, FMUstate);
 }
 
 /* ----------------------------------------------------------------- what this FMU does not offer */
@@ -492,14 +371,9 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
                                   fmi2Real communicationStepSize, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     BEGIN(DoStep);
     guard_position *at = &g->common.at;
-    REQUIRE(isfinite(communicationStepSize) && communicationStepSize > 0,
-            "fmi2DoStep: communicationStepSize = %g s must be finite and > 0", communicationStepSize);
-    REQUIRE(isfinite(currentCommunicationPoint) &&
-                fabs(currentCommunicationPoint - at->time) <= 1e-9 * fmax(1.0, fabs(at->time)),
-            "fmi2DoStep: currentCommunicationPoint = %.17g s is not the FMU's time %.17g s (the end of the last "
-            "step, or of the FMU state set)", currentCommunicationPoint, at->time);
-    fmi2Status status = backend_fmi2DoStep(g->backend, currentCommunicationPoint, communicationStepSize,
-                                           noSetFMUStatePriorToCurrentPoint);
+    if (!guard_check_step(&g->common, currentCommunicationPoint, communicationStepSize)) return fmi2Error;
+    int status = bridge_call(&g->common, NO_PAYLOAD, "do_step", "(ddi)", currentCommunicationPoint,
+                             communicationStepSize, (int)noSetFMUStatePriorToCurrentPoint);
     if (status == fmi2Discard) { /* the solver gave up: the FMU stays where the step began */
         at->state = STEP_FAILED;
         at->last_successful_time = at->time;
@@ -508,7 +382,7 @@ FMI2_Export fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunication
     }
     status = settle(g, status);
     if (status <= fmi2Warning) at->time = at->last_successful_time = currentCommunicationPoint + communicationStepSize;
-    return status;
+    return (fmi2Status)status;
 }
 
 /* ----------------------------------------------------------------------------------- status */
@@ -527,7 +401,7 @@ static fmi2Status not_given(guarded *g, fmi2StatusKind s) {
     char message[256];
     guard_format(message, sizeof message, "%s: %s is not given by this function%s", g->common.function,
                  STATUS_KINDS[s], s <= fmi2PendingStatus ? " (this FMU never returns fmi2Pending)" : "");
-    guard_emit(&g->common, fmi2Discard, "logStatusDiscard", message);
+    guard_emit(&g->common, fmi2Discard, "logAll", message); /* informative: debug logging */
     return fmi2Discard;
 }
 

@@ -1,33 +1,27 @@
-/* The FMU's binary for FMI 3.0 (Model Exchange and Co-Simulation): a guard in front of pythonfmu3's
- * library, which lies beside it as libpythonfmu3-export.so (python_runtime.c makes a CPython
- * available first).  What it guarantees is what fmi2_guard.c does for FMI 2, after FMI 3.0
- * (sections 2.2.4, 3.2 and 4.2: the Model Exchange and Co-Simulation state machines): the state
- * machine of the interface the instance was made for, argument checks (NULL arrays, nValues against
- * the value references, String values that are not UTF-8, the step size and communication point, every
- * out-argument), instantiation checks (instantiation token, instance name, resource path), the host's
- * logger given text, errors logged from instantiation on, Error instead of pythonfmu3's Fatal,
- * instantiation and reset serialised across threads.  Where pythonfmu3 0.3.4 falls short it also stands in:
- *  - fmi3UpdateDiscreteStates, fmi3DoStep and fmi3CompletedIntegratorStep: every out-argument is
- *    given its "nothing to do" value first (pythonfmu3 leaves some unwritten, and a strict host that
- *    initialised discreteStatesNeedUpdate = true would iterate its Event Mode forever);
- *  - fmi3EnterInitializationMode: pythonfmu3 drops the start time, so the guard passes it on
- *    through fmi3SetTime first (the adapter takes it as the start time before initialisation);
- *  - what this FMU does not have (other variable types, clocks, binaries, structural parameters,
- *    dependencies, derivatives, Scheduled Execution, Event Mode in Co-Simulation): fmi3Error and a
- *    log line, where pythonfmu3 throws a C++ exception that aborts the host. */
+/* The FMU's binary for FMI 3.0 (Model Exchange and Co-Simulation): the FMI functions, which call the
+ * FMU's Python side (fmu_src/fmi_bridge.py) through bridge.c, in a CPython that python_runtime.c makes
+ * available.  What it guarantees is what fmi2_guard.c does for FMI 2, after FMI 3.0 (sections 2.2.4, 3.2
+ * and 4.2: the Model Exchange and Co-Simulation state machines): the state machine of the interface the
+ * instance was made for, argument checks (NULL arrays, nValues against the value references, String
+ * values that are not UTF-8, the step size and communication point, every out-argument, continuous
+ * states that are not finite), instantiation checks (instantiation token, instance name, resource path
+ * and whose resources they are), the host's logger given text with no lock held, errors logged from
+ * instantiation on, an exception on the Python side an fmi3Error of this instance only.  Every
+ * out-argument is written on success; derivatives that are not finite are fmi3Discard with a line that
+ * says so; what this FMU does not have (other variable types, clocks, binaries, structural parameters,
+ * dependencies, derivatives, Scheduled Execution, Event Mode in Co-Simulation) is fmi3Error and a log
+ * line. */
 #define _GNU_SOURCE
 #include "glibc_compat.h"
 
-#include <dlfcn.h>
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "bridge.h"
 #include "fmi3Functions.h"
 #include "guard.h"
-#include "python_runtime.h"
 
 #ifndef FMU_GUID
 #error "the build defines FMU_GUID, the instantiationToken of the FMU's modelDescription.xml"
@@ -40,44 +34,8 @@
 #endif
 #define N_EVENT_INDICATORS 0 /* a smooth right-hand side (component/model_exchange.py) */
 
-#define BACKEND_FILE "libpythonfmu3-export.so"
-#define STATE_MAGIC "DPFMU3S1"
-
-/* ------------------------------------------------------------------------ pythonfmu3's library */
-
-#define FMI3_FORWARDED(X)                                                                                         \
-    X(fmi3InstantiateModelExchange) X(fmi3InstantiateCoSimulation) X(fmi3FreeInstance)                           \
-    X(fmi3EnterInitializationMode) X(fmi3ExitInitializationMode) X(fmi3EnterEventMode) X(fmi3Terminate)          \
-    X(fmi3Reset) X(fmi3GetFloat64) X(fmi3GetInt32) X(fmi3GetInt64) X(fmi3GetUInt64) X(fmi3GetBoolean)             \
-    X(fmi3GetString) X(fmi3SetFloat64) X(fmi3SetInt32) X(fmi3SetInt64) X(fmi3SetUInt64) X(fmi3SetBoolean)        \
-    X(fmi3SetString) X(fmi3GetFMUState) X(fmi3SetFMUState) X(fmi3FreeFMUState) X(fmi3SerializedFMUStateSize)    \
-    X(fmi3SerializeFMUState) X(fmi3DeserializeFMUState) X(fmi3UpdateDiscreteStates)                             \
-    X(fmi3EnterContinuousTimeMode) X(fmi3CompletedIntegratorStep) X(fmi3SetTime) X(fmi3SetContinuousStates)      \
-    X(fmi3GetContinuousStateDerivatives) X(fmi3GetEventIndicators) X(fmi3GetContinuousStates)                   \
-    X(fmi3GetNominalsOfContinuousStates) X(fmi3EnterStepMode) X(fmi3DoStep)
-
-#define DECLARE(name) static name##TYPE *backend_##name;
-FMI3_FORWARDED(DECLARE)
-static pthread_mutex_t resolve_lock = PTHREAD_MUTEX_INITIALIZER;
-static int resolved;
-
-static int resolve(void *backend, char *error, size_t size) {
-    pthread_mutex_lock(&resolve_lock);
-    if (!resolved) {
-        error[0] = '\0';
-#define RESOLVE(name)                                                                                             \
-    backend_##name = (name##TYPE *)dlsym(backend, #name);                                                        \
-    if (!backend_##name) guard_format(error, size, "pythonfmu3's library lacks %s", #name);
-        FMI3_FORWARDED(RESOLVE)
-        resolved = !error[0];
-    }
-    int ok = resolved;
-    pthread_mutex_unlock(&resolve_lock);
-    return ok;
-}
-
-/* Instantiation and reset run the Python side's imports and its sys.path hygiene: one at a time. */
-static pthread_mutex_t python_lock = PTHREAD_MUTEX_INITIALIZER;
+#define MODEL_EXCHANGE "ModelExchange"
+#define CO_SIMULATION "CoSimulation"
 
 /* ----------------------------------------------------------------------------------- states */
 
@@ -137,16 +95,25 @@ static const char *state_name(int state) {
 #define MASK_DoStep STEP
 #define MASK_ANY ANY_STATE
 
-enum { MODEL_EXCHANGE = 1, CO_SIMULATION = 2, BOTH = 3 };
+
+#define ME_STATES (INSTANTIATED | CONFIGURATION | INITIALIZATION | EVENT | CONTINUOUS_TIME | TERMINATED | ERROR_STATE)
+#define CS_STATES (INSTANTIATED | CONFIGURATION | INITIALIZATION | STEP | STEP_DISCARDED | TERMINATED | ERROR_STATE)
+
+static int state_allowed(const char *interface, int state) {
+    return (state & (strcmp(interface, MODEL_EXCHANGE) == 0 ? ME_STATES : CS_STATES)) != 0;
+}
+
+static const guard_version FMI3 = {"fmi3", MODEL_IDENTIFIER, FMU_GUID, "instantiationToken", "resourcePath",
+                                   ANY_STATE, ERROR_STATE, INSTANTIATED, "FMUState", state_name, state_allowed};
 
 /* --------------------------------------------------------------------------------- instances */
 
 typedef struct {
     guard_instance common; /* first: a guarded* is a guard_instance* */
-    fmi3Instance backend;
-    int interface;                    /* MODEL_EXCHANGE or CO_SIMULATION */
+    int model_exchange;    /* 1: made for Model Exchange, 0: Co-Simulation */
     fmi3InstanceEnvironment environment;
     fmi3LogMessageCallback host_logger; /* may be NULL: errors then go to stderr */
+    char *strings;                      /* the values of the last fmi3GetString (valid until the next call) */
 } guarded;
 
 static void host_log(guard_instance *common, int status, const char *category, const char *message) {
@@ -155,30 +122,31 @@ static void host_log(guard_instance *common, int status, const char *category, c
     else if (status >= fmi3Error) guard_orphan(MODEL_IDENTIFIER, common->name, "%s", message);
 }
 
-/* The logger pythonfmu3 gets (its environment is the guarded instance). */
-static void library_logger(fmi3InstanceEnvironment environment, fmi3Status status, fmi3String category,
-                           fmi3String message) {
-    if (environment) guard_library_message_logged(environment, (int)status, category, message);
+static void destroy(guard_instance *common) {
+    guarded *g = (guarded *)common;
+    guard_free_common(common);
+    free(g->strings);
+    free(g);
 }
 
 #define fail guard_fail
 #define settle(g, status) ((fmi3Status)guard_settle(&(g)->common, (int)(status)))
+#define CALL(payload, ...) bridge_call(&g->common, payload, __VA_ARGS__)
 
-static const char *interface_name(int interface) {
-    return interface == MODEL_EXCHANGE ? "Model Exchange" : "Co-Simulation";
-}
+enum { ME = 1, CS = 2, BOTH = 3 };
 
-/* Begin function F (fmi3F) of interface(s) INTERFACE on instance: look it up, check interface and state. */
+/* Begin function F (fmi3F) of interface(s) INTERFACE on instance: look it up (held until the function
+ * returns), check interface and state. */
 #define BEGIN_FOR(F, MASK, INTERFACE)                                                                             \
-    guarded *g = (guarded *)guard_lookup(instance, MODEL_IDENTIFIER, "fmi3" #F);                                  \
+    guarded *g GUARD_CALL = (guarded *)guard_acquire(instance, MODEL_IDENTIFIER, "fmi3" #F);                      \
     if (!g) return fmi3Error;                                                                                     \
-    if (!(g->interface & (INTERFACE)))                                                                            \
+    g->common.function = "fmi3" #F;                                                                               \
+    if (!((g->model_exchange ? ME : CS) & (INTERFACE)))                                                           \
         return (fmi3Status)fail(&g->common, "fmi3" #F ": not a function of %s, which this instance was made for", \
-                                interface_name(g->interface));                                                  \
+                                g->model_exchange ? "Model Exchange" : "Co-Simulation");                        \
     if (!(g->common.at.state & (MASK)))                                                                           \
         return (fmi3Status)fail(&g->common, "fmi3" #F ": illegal call sequence: not allowed in state %s",        \
-                                state_name(g->common.at.state));                                                 \
-    g->common.function = "fmi3" #F
+                                state_name(g->common.at.state))
 #define BEGIN(F) BEGIN_FOR(F, MASK_##F, BOTH)
 
 #define REQUIRE(condition, ...)                                                                                   \
@@ -188,89 +156,45 @@ static const char *interface_name(int interface) {
 
 FMI3_Export const char *fmi3GetVersion(void) { return fmi3Version; }
 
-static void free_guarded(guarded *g) {
-    free(g->common.name);
-    free(g);
-}
-
-/* A guarded instance for the host (NULL and a line on stderr if out of memory). */
-static guarded *new_guarded(fmi3String name, int interface, fmi3Boolean loggingOn,
-                            fmi3InstanceEnvironment environment, fmi3LogMessageCallback logger) {
+/* A new instance for the host, or NULL (logged; stderr without a logger). `refusal` is a reason to refuse
+ * that only the caller knows (or NULL). */
+static guarded *instantiate(fmi3String name, fmi3String token, fmi3String resourcePath, fmi3Boolean visible,
+                            fmi3Boolean loggingOn, fmi3InstanceEnvironment environment,
+                            fmi3LogMessageCallback logger, int model_exchange, const char *function,
+                            const char *refusal) {
     guarded *g = calloc(1, sizeof *g);
-    char *copy = strdup(name && name[0] && guard_utf8_error(name) < 0 ? name : "?");
-    if (!g || !copy) {
-        guard_orphan(MODEL_IDENTIFIER, "fmi3Instantiate", "out of memory");
-        free(g), free(copy);
+    if (!g || !guard_init_instance(&g->common, &FMI3, model_exchange ? MODEL_EXCHANGE : CO_SIMULATION, name,
+                                   loggingOn, host_log, destroy)) {
+        guard_orphan(MODEL_IDENTIFIER, function, "out of memory");
+        if (g) free(g->common.name), free(g);
         return NULL;
     }
-    g->common = (guard_instance){.at = {INSTANTIATED, 0.0, 0.0, 0}, .error_state = ERROR_STATE,
-                                 .categories = loggingOn ? CATEGORIES_EVERY : CATEGORIES_ERRORS,
-                                 .function = "fmi3Instantiate", .name = copy, .log = host_log};
-    g->interface = interface;
+    g->model_exchange = model_exchange;
     g->environment = environment;
     g->host_logger = logger;
+    g->common.function = function;
+    char why[2048] = "", resources[4096];
+    if (refusal) guard_format(why, sizeof why, "%s", refusal);
+    else guard_check_instantiation(&FMI3, name, token, resourcePath, resources, sizeof resources, why, sizeof why);
+    if (why[0]) fail(&g->common, "%s: %s", function, why);
+    if (why[0] || !guard_start_python(&g->common, resources, visible)) {
+        destroy(&g->common);
+        return NULL;
+    }
+    if (!guard_register(&g->common)) {
+        fail(&g->common, "%s: out of memory", function);
+        destroy(&g->common);
+        return NULL;
+    }
     return g;
-}
-
-/* Check what every fmi3Instantiate* is given and load the library; 0 (logged) if that fails. */
-static int ready_to_instantiate(guarded *g, fmi3String name, fmi3String token, fmi3String resourcePath,
-                                const char *function) {
-    char why[2048] = "", resources[4096], marker[4200];
-    void *backend = NULL;
-    long bad;
-    if (!name || !name[0]) guard_format(why, sizeof why, "instanceName is %s", name ? "empty" : "NULL");
-    else if ((bad = guard_utf8_error(name)) >= 0)
-        guard_format(why, sizeof why, "instanceName is not UTF-8 (byte %ld is 0x%02x; an fmi3String is UTF-8 encoded)",
-                     bad, (unsigned char)name[bad]);
-    else if (!token || strcmp(token, FMU_GUID) != 0)
-        guard_format(why, sizeof why,
-                     "instantiationToken %s%.100s%s is not this FMU's %s: the binary and its modelDescription.xml "
-                     "come from different builds", token ? "\"" : "", token ? token : "NULL", token ? "\"" : "",
-                     FMU_GUID);
-    else if (!resourcePath || !resourcePath[0])
-        guard_format(why, sizeof why, "resourcePath is %s: the FMU needs its resources folder",
-                     resourcePath ? "empty" : "NULL");
-    else if (!guard_uri_to_path(resourcePath, resources, sizeof resources) || !guard_is_directory(resources))
-        guard_format(why, sizeof why, "resourcePath \"%.1000s\": there is no such folder", resourcePath);
-    else if (guard_format(marker, sizeof marker, "%s/slavemodule.txt", resources), !guard_is_file(marker))
-        guard_format(why, sizeof why, "resourcePath \"%.1000s\" is not this FMU's resources folder (no "
-                     "slavemodule.txt in it)", resourcePath);
-    else if ((bad = guard_utf8_error(resourcePath)) >= 0)
-        guard_format(why, sizeof why, "resourcePath \"%.1000s\" is not UTF-8 (byte %ld; an fmi3String is UTF-8 "
-                     "encoded)", resourcePath, bad);
-    else if ((backend = python_runtime_load_backend(resourcePath, BACKEND_FILE, why, sizeof why)) &&
-             resolve(backend, why, sizeof why))
-        return 1;
-    fail(&g->common, "%s: %s", function, why);
-    return 0;
-}
-
-/* Register the library's instance, or free everything (logged) if the library made none. */
-static fmi3Instance registered(guarded *g, fmi3Instance backend, const char *function) {
-    g->backend = backend;
-    if (backend && guard_register(&g->common)) return g;
-    fail(&g->common, "%s: the FMU's Python side could not be instantiated%s", function,
-         backend ? " (out of memory)" : " (the message before says why)");
-    if (backend) backend_fmi3FreeInstance(backend);
-    free_guarded(g);
-    return NULL;
 }
 
 FMI3_Export fmi3Instance fmi3InstantiateModelExchange(fmi3String instanceName, fmi3String instantiationToken,
                                                       fmi3String resourcePath, fmi3Boolean visible,
                                                       fmi3Boolean loggingOn, fmi3InstanceEnvironment environment,
                                                       fmi3LogMessageCallback logMessage) {
-    guarded *g = new_guarded(instanceName, MODEL_EXCHANGE, loggingOn, environment, logMessage);
-    if (!g) return NULL;
-    if (!ready_to_instantiate(g, instanceName, instantiationToken, resourcePath, "fmi3InstantiateModelExchange")) {
-        free_guarded(g);
-        return NULL;
-    }
-    guard_lock_python(&python_lock);
-    fmi3Instance backend = backend_fmi3InstantiateModelExchange(instanceName, instantiationToken, resourcePath,
-                                                                visible, fmi3True, g, library_logger);
-    pthread_mutex_unlock(&python_lock);
-    return registered(g, backend, "fmi3InstantiateModelExchange");
+    return instantiate(instanceName, instantiationToken, resourcePath, visible, loggingOn, environment, logMessage, 1,
+                       "fmi3InstantiateModelExchange", NULL);
 }
 
 FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(
@@ -279,28 +203,14 @@ FMI3_Export fmi3Instance fmi3InstantiateCoSimulation(
     const fmi3ValueReference requiredIntermediateVariables[], size_t nRequiredIntermediateVariables,
     fmi3InstanceEnvironment environment, fmi3LogMessageCallback logMessage,
     fmi3IntermediateUpdateCallback intermediateUpdate) {
-    (void)earlyReturnAllowed, (void)intermediateUpdate; /* no intermediate updates, never an early return */
-    guarded *g = new_guarded(instanceName, CO_SIMULATION, loggingOn, environment, logMessage);
-    if (!g) return NULL;
-    const char *function = "fmi3InstantiateCoSimulation";
-    if (eventModeUsed || nRequiredIntermediateVariables > 0) {
-        fail(&g->common, "%s: %s", function,
-             eventModeUsed ? "eventModeUsed = true, but this FMU has no Event Mode in Co-Simulation (hasEventMode = "
-                             "false)"
-                           : "nRequiredIntermediateVariables > 0, but this FMU provides no intermediate updates");
-        free_guarded(g);
-        return NULL;
-    }
-    if (!ready_to_instantiate(g, instanceName, instantiationToken, resourcePath, function)) {
-        free_guarded(g);
-        return NULL;
-    }
-    guard_lock_python(&python_lock);
-    fmi3Instance backend = backend_fmi3InstantiateCoSimulation(
-        instanceName, instantiationToken, resourcePath, visible, fmi3True, fmi3False, fmi3False,
-        requiredIntermediateVariables, 0, g, library_logger, NULL);
-    pthread_mutex_unlock(&python_lock);
-    return registered(g, backend, function);
+    (void)earlyReturnAllowed, (void)intermediateUpdate, (void)requiredIntermediateVariables;
+    const char *refusal =
+        eventModeUsed ? "eventModeUsed = true, but this FMU has no Event Mode in Co-Simulation (hasEventMode = false)"
+        : nRequiredIntermediateVariables > 0 ? "nRequiredIntermediateVariables > 0, but this FMU provides no "
+                                               "intermediate updates"
+                                             : NULL;
+    return instantiate(instanceName, instantiationToken, resourcePath, visible, loggingOn, environment, logMessage, 0,
+                       "fmi3InstantiateCoSimulation", refusal);
 }
 
 FMI3_Export fmi3Instance fmi3InstantiateScheduledExecution(
@@ -308,41 +218,21 @@ FMI3_Export fmi3Instance fmi3InstantiateScheduledExecution(
     fmi3Boolean loggingOn, fmi3InstanceEnvironment environment, fmi3LogMessageCallback logMessage,
     fmi3ClockUpdateCallback clockUpdate, fmi3LockPreemptionCallback lockPreemption,
     fmi3UnlockPreemptionCallback unlockPreemption) {
-    (void)instantiationToken, (void)resourcePath, (void)visible, (void)loggingOn;
-    (void)clockUpdate, (void)lockPreemption, (void)unlockPreemption;
-    guarded *g = new_guarded(instanceName, CO_SIMULATION, fmi3False, environment, logMessage);
-    if (g) {
-        fail(&g->common, "fmi3InstantiateScheduledExecution: this FMU offers Model Exchange and Co-Simulation only");
-        free_guarded(g);
-    }
-    return NULL;
-}
-
-static void free_state(guarded *g, guard_state *s) {
-    guard_state_forget(s);
-    if (s->backend) backend_fmi3FreeFMUState(g->backend, (fmi3FMUState *)&s->backend);
-    free(s);
+    (void)loggingOn, (void)clockUpdate, (void)lockPreemption, (void)unlockPreemption;
+    return instantiate(instanceName, instantiationToken, resourcePath, visible, fmi3False, environment, logMessage, 0,
+                       "fmi3InstantiateScheduledExecution", "this FMU offers Model Exchange and Co-Simulation only");
 }
 
 FMI3_Export void fmi3FreeInstance(fmi3Instance instance) {
-    if (!instance) return;
-    if (!guard_unregister(instance)) {
+    if (instance && !guard_unregister(instance))
         guard_orphan(MODEL_IDENTIFIER, "fmi3FreeInstance", "%p is not a live instance of this FMU (freed twice?)",
                      instance);
-        return;
-    }
-    guarded *g = (guarded *)instance;
-    g->common.function = "fmi3FreeInstance";
-    while (g->common.states) free_state(g, g->common.states); /* the FMU states the host did not free */
-    backend_fmi3FreeInstance(g->backend);
-    free_guarded(g);
 }
 
 FMI3_Export fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
                                            const fmi3String categories[]) {
     BEGIN(SetDebugLogging);
-    return (fmi3Status)guard_set_debug_logging(&g->common, loggingOn, nCategories, categories,
-                                               "fmi3SetDebugLogging");
+    return (fmi3Status)guard_set_debug_logging(&g->common, loggingOn, nCategories, categories);
 }
 
 /* --------------------------------------------------------------------------------- the modes */
@@ -357,42 +247,31 @@ FMI3_Export fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Bo
             startTime);
     REQUIRE(!toleranceDefined || (isfinite(tolerance) && tolerance > 0),
             "fmi3EnterInitializationMode: tolerance = %g must be finite and > 0", tolerance);
-    fmi3Status status = settle(g, backend_fmi3SetTime(g->backend, startTime)); /* pythonfmu3 drops it */
+    fmi3Status status = settle(g, CALL(NO_PAYLOAD, "setup_experiment", "(didid)", startTime, (int)stopTimeDefined,
+                                       stopTime, (int)toleranceDefined, tolerance));
     if (status > fmi3Warning) return status;
-    status = settle(g, backend_fmi3EnterInitializationMode(g->backend, toleranceDefined, tolerance, startTime,
-                                                            stopTimeDefined, stopTime));
+    status = settle(g, CALL(NO_PAYLOAD, "enter_initialization_mode", "()"));
     if (status <= fmi3Warning) g->common.at = (guard_position){INITIALIZATION, startTime, startTime, 0};
     return status;
 }
 
-FMI3_Export fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
-    BEGIN(ExitInitializationMode);
-    fmi3Status status = settle(g, backend_fmi3ExitInitializationMode(g->backend));
-    if (status <= fmi3Warning) g->common.at.state = g->interface == MODEL_EXCHANGE ? EVENT : STEP;
-    return status;
-}
-
-FMI3_Export fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
-    BEGIN_FOR(EnterEventMode, MASK_EnterEventMode, MODEL_EXCHANGE);
-    fmi3Status status = settle(g, backend_fmi3EnterEventMode(g->backend));
-    if (status <= fmi3Warning) g->common.at.state = EVENT;
-    return status;
-}
-
-FMI3_Export fmi3Status fmi3Terminate(fmi3Instance instance) {
-    BEGIN(Terminate);
-    fmi3Status status = settle(g, backend_fmi3Terminate(g->backend));
-    if (status <= fmi3Warning) g->common.at.state = TERMINATED;
-    return status;
-}
+/* Run a mode change of the Python side; on success the instance is in state `next`. */
+#define MODE_CHANGE(F, INTERFACE, method, next)                                                                   \
+    FMI3_Export fmi3Status fmi3##F(fmi3Instance instance) {                                                       \
+        BEGIN_FOR(F, MASK_##F, INTERFACE);                                                                        \
+        fmi3Status status = settle(g, CALL(NO_PAYLOAD, method, "()"));                                           \
+        if (status <= fmi3Warning) g->common.at.state = (next);                                                  \
+        return status;                                                                                            \
+    }
+MODE_CHANGE(ExitInitializationMode, BOTH, "exit_initialization_mode", g->model_exchange ? EVENT : STEP)
+MODE_CHANGE(EnterEventMode, ME, "enter_event_mode", EVENT)
+MODE_CHANGE(Terminate, BOTH, "terminate", TERMINATED)
+MODE_CHANGE(EnterContinuousTimeMode, ME, "enter_continuous_time_mode", CONTINUOUS_TIME)
+MODE_CHANGE(EnterStepMode, CS, "enter_step_mode", STEP)
 
 FMI3_Export fmi3Status fmi3Reset(fmi3Instance instance) {
     BEGIN(Reset);
-    guard_lock_python(&python_lock); /* the Python side is made anew */
-    fmi3Status status = settle(g, backend_fmi3Reset(g->backend));
-    pthread_mutex_unlock(&python_lock);
-    if (status <= fmi3Warning) g->common.at = (guard_position){INSTANTIATED, 0.0, 0.0, 0};
-    return status;
+    return (fmi3Status)guard_reset(&g->common);
 }
 
 /* No structural parameters: Configuration Mode has nothing to configure, but its calls are legal. */
@@ -410,7 +289,8 @@ FMI3_Export fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
 
 /* ------------------------------------------------------------------------ getting and setting */
 
-/* Every variable of this FMU is a scalar: nValues must equal nValueReferences. */
+/* Every variable of this FMU is a scalar: nValues must equal nValueReferences. Values cross as bytes of
+ * packed values, named by their FMI type. */
 #define CHECK_ARRAYS(F)                                                                                           \
     if (nValueReferences == 0 && nValues == 0) return fmi3OK;                                                     \
     REQUIRE(valueReferences, "fmi3" #F ": valueReferences is NULL with nValueReferences = %zu", nValueReferences); \
@@ -419,133 +299,115 @@ FMI3_Export fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
             "fmi3" #F ": nValues = %zu, but %zu value references of scalar variables need %zu", nValues,          \
             nValueReferences, nValueReferences)
 
-#define ACCESS(F, TYPE, MASK, VALUES_CONST, CHECK_VALUES)                                                        \
+#define GET(F, TYPE, MASK, NAME)                                                                                  \
     FMI3_Export fmi3Status fmi3##F(fmi3Instance instance, const fmi3ValueReference valueReferences[],            \
-                                   size_t nValueReferences, VALUES_CONST TYPE values[], size_t nValues) {        \
+                                   size_t nValueReferences, TYPE values[], size_t nValues) {                    \
         BEGIN_FOR(F, MASK, BOTH);                                                                                 \
         CHECK_ARRAYS(F);                                                                                          \
-        CHECK_VALUES                                                                                              \
-        return settle(g, backend_fmi3##F(g->backend, valueReferences, nValueReferences, values, nValues));       \
+        bridge_payload payload = {PAYLOAD_EXACT, values, nValues * sizeof *values, NULL, NULL, NULL};            \
+        return settle(g, CALL(payload, "get", "(sy#)", NAME, (const char *)valueReferences,                       \
+                              (ssize_t)(nValueReferences * sizeof *valueReferences)));                            \
     }
-#define NO_CHECK
-#define STRINGS_PRESENT                                                                                           \
-    for (size_t k = 0; k < nValues; k++) {                                                                        \
-        REQUIRE(values[k], "fmi3SetString: values[%zu] (valueReference %u) is NULL", k, valueReferences[k]);      \
-        long bad = guard_utf8_error(values[k]);                                                                   \
-        REQUIRE(bad < 0, "fmi3SetString: values[%zu] (valueReference %u) is not UTF-8 (byte %ld is 0x%02x; an "    \
-                "fmi3String is UTF-8 encoded)", k, valueReferences[k], bad, (unsigned char)values[k][bad]);       \
+#define SET(F, TYPE, MASK, NAME)                                                                                  \
+    FMI3_Export fmi3Status fmi3##F(fmi3Instance instance, const fmi3ValueReference valueReferences[],            \
+                                   size_t nValueReferences, const TYPE values[], size_t nValues) {              \
+        BEGIN_FOR(F, MASK, BOTH);                                                                                 \
+        CHECK_ARRAYS(F);                                                                                          \
+        return settle(g, CALL(NO_PAYLOAD, "set", "(sy#y#)", NAME, (const char *)valueReferences,                  \
+                              (ssize_t)(nValueReferences * sizeof *valueReferences), (const char *)values,       \
+                              (ssize_t)(nValues * sizeof *values)));                                             \
     }
 
-ACCESS(GetFloat64, fmi3Float64, MASK_GET, , NO_CHECK)
-ACCESS(GetInt32, fmi3Int32, MASK_GET, , NO_CHECK)
-ACCESS(GetInt64, fmi3Int64, MASK_GET, , NO_CHECK)
-ACCESS(GetUInt64, fmi3UInt64, MASK_GET, , NO_CHECK)
-ACCESS(GetBoolean, fmi3Boolean, MASK_GET, , NO_CHECK)
-ACCESS(GetString, fmi3String, MASK_GET, , NO_CHECK)
-ACCESS(SetFloat64, fmi3Float64, MASK_SET_FLOAT64, const, NO_CHECK)
-ACCESS(SetInt32, fmi3Int32, MASK_SET, const, NO_CHECK)
-ACCESS(SetInt64, fmi3Int64, MASK_SET, const, NO_CHECK)
-ACCESS(SetUInt64, fmi3UInt64, MASK_SET, const, NO_CHECK)
-ACCESS(SetBoolean, fmi3Boolean, MASK_SET, const, NO_CHECK)
-ACCESS(SetString, fmi3String, MASK_SET, const, STRINGS_PRESENT)
+GET(GetFloat64, fmi3Float64, MASK_GET, "Float64")
+GET(GetInt32, fmi3Int32, MASK_GET, "Int32")
+GET(GetInt64, fmi3Int64, MASK_GET, "Int64")
+GET(GetUInt64, fmi3UInt64, MASK_GET, "UInt64")
+GET(GetBoolean, fmi3Boolean, MASK_GET, "Boolean")
+SET(SetFloat64, fmi3Float64, MASK_SET_FLOAT64, "Float64")
+SET(SetInt32, fmi3Int32, MASK_SET, "Int32")
+SET(SetInt64, fmi3Int64, MASK_SET, "Int64")
+SET(SetUInt64, fmi3UInt64, MASK_SET, "UInt64")
+SET(SetBoolean, fmi3Boolean, MASK_SET, "Boolean")
+
+/* Strings cross as their UTF-8 bytes, each ended by a NUL. */
+FMI3_Export fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                     size_t nValueReferences, fmi3String values[], size_t nValues) {
+    BEGIN_FOR(GetString, MASK_GET, BOTH);
+    CHECK_ARRAYS(GetString);
+    char *strings = NULL;
+    size_t size = 0;
+    bridge_payload payload = {PAYLOAD_COPY, NULL, 0, &strings, &size, NULL};
+    fmi3Status status = settle(g, CALL(payload, "get_strings", "(y#)", (const char *)valueReferences,
+                                       (ssize_t)(nValueReferences * sizeof *valueReferences)));
+    if (status > fmi3Warning) return status;
+    size_t found = 0;
+    for (size_t at = 0; at < size && found < nValues; found++) {
+        values[found] = strings + at;
+        at += strlen(strings + at) + 1;
+    }
+    if (found != nValues) {
+        free(strings);
+        return (fmi3Status)fail(&g->common, "fmi3GetString: the FMU's Python side gave %zu strings for %zu value "
+                                            "references", found, nValues);
+    }
+    free(g->strings); /* the values of the last call: the host may use them until now */
+    g->strings = strings;
+    return status;
+}
+
+FMI3_Export fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference valueReferences[],
+                                     size_t nValueReferences, const fmi3String values[], size_t nValues) {
+    BEGIN_FOR(SetString, MASK_SET, BOTH);
+    CHECK_ARRAYS(SetString);
+    size_t size = 0;
+    for (size_t k = 0; k < nValues; k++) {
+        REQUIRE(values[k], "fmi3SetString: values[%zu] (valueReference %u) is NULL", k, valueReferences[k]);
+        long bad = guard_utf8_error(values[k]);
+        REQUIRE(bad < 0, "fmi3SetString: values[%zu] (valueReference %u) is not UTF-8 (byte %ld is 0x%02x; an "
+                "fmi3String is UTF-8 encoded)", k, valueReferences[k], bad, (unsigned char)values[k][bad]);
+        size += strlen(values[k]) + 1;
+    }
+    char *joined = malloc(size ? size : 1), *at = joined;
+    REQUIRE(joined, "fmi3SetString: out of memory");
+    for (size_t k = 0; k < nValues; k++) at = stpcpy(at, values[k]) + 1;
+    fmi3Status status = settle(g, CALL(NO_PAYLOAD, "set_strings", "(y#y#)", (const char *)valueReferences,
+                                       (ssize_t)(nValueReferences * sizeof *valueReferences), joined, (ssize_t)size));
+    free(joined);
+    return status;
+}
 
 /* -------------------------------------------------------------------------------- FMU states */
 
-static fmi3Status deliver_state(guarded *g, fmi3FMUState *FMUState, fmi3FMUState backend, guard_position at) {
-    guard_state *s = *FMUState;
-    if (s) {
-        if (s->backend) backend_fmi3FreeFMUState(g->backend, (fmi3FMUState *)&s->backend);
-        s->backend = backend;
-        s->at = at;
-        return fmi3OK;
-    }
-    if (!(s = guard_state_new(&g->common, backend, at))) {
-        backend_fmi3FreeFMUState(g->backend, &backend);
-        return (fmi3Status)fail(&g->common, "%s: out of memory", g->common.function);
-    }
-    *FMUState = s;
-    return fmi3OK;
-}
-
 FMI3_Export fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
     BEGIN_FOR(GetFMUState, MASK_FMU_STATE, BOTH);
-    REQUIRE(FMUState, "fmi3GetFMUState: FMUState is NULL");
-    if (*FMUState && !guard_state_known(&g->common, *FMUState, "fmi3GetFMUState")) return fmi3Error;
-    fmi3FMUState backend = NULL;
-    fmi3Status status = settle(g, backend_fmi3GetFMUState(g->backend, &backend));
-    return status > fmi3Warning ? status : deliver_state(g, FMUState, backend, g->common.at);
+    return (fmi3Status)guard_get_state(&g->common, FMUState);
 }
 
 FMI3_Export fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState FMUState) {
     BEGIN_FOR(SetFMUState, MASK_FMU_STATE, BOTH);
-    guard_state *s = guard_state_known(&g->common, FMUState, "fmi3SetFMUState");
-    if (!s) return fmi3Error;
-    fmi3Status status = settle(g, backend_fmi3SetFMUState(g->backend, s->backend));
-    if (status <= fmi3Warning) g->common.at = s->at;
-    return status;
+    return (fmi3Status)guard_set_state(&g->common, FMUState);
 }
 
 FMI3_Export fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState *FMUState) {
     BEGIN_FOR(FreeFMUState, MASK_FMU_STATE, BOTH);
-    REQUIRE(FMUState, "fmi3FreeFMUState: FMUState is NULL");
-    if (!*FMUState) return fmi3OK; /* nothing to free */
-    guard_state *s = guard_state_known(&g->common, *FMUState, "fmi3FreeFMUState");
-    if (!s) return fmi3Error;
-    free_state(g, s);
-    *FMUState = NULL;
-    return fmi3OK;
-}
-
-static fmi3Status backend_size(guarded *g, guard_state *s, size_t *size) {
-    *size = 0;
-    return settle(g, backend_fmi3SerializedFMUStateSize(g->backend, s->backend, size));
+    return (fmi3Status)guard_free_state(&g->common, FMUState);
 }
 
 FMI3_Export fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState FMUState, size_t *size) {
     BEGIN_FOR(SerializedFMUStateSize, MASK_FMU_STATE, BOTH);
-    REQUIRE(size, "fmi3SerializedFMUStateSize: size is NULL");
-    guard_state *s = guard_state_known(&g->common, FMUState, "fmi3SerializedFMUStateSize");
-    if (!s) return fmi3Error;
-    size_t inner = 0;
-    fmi3Status status = backend_size(g, s, &inner);
-    if (status <= fmi3Warning) *size = sizeof(guard_state_header) + inner;
-    return status;
+    return (fmi3Status)guard_serialized_size(&g->common, FMUState, size);
 }
 
 FMI3_Export fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState FMUState, fmi3Byte serializedState[],
                                              size_t size) {
     BEGIN_FOR(SerializeFMUState, MASK_FMU_STATE, BOTH);
-    REQUIRE(serializedState, "fmi3SerializeFMUState: serializedState is NULL");
-    guard_state *s = guard_state_known(&g->common, FMUState, "fmi3SerializeFMUState");
-    if (!s) return fmi3Error;
-    size_t inner = 0;
-    fmi3Status status = backend_size(g, s, &inner);
-    if (status > fmi3Warning) return status;
-    REQUIRE(size == sizeof(guard_state_header) + inner,
-            "fmi3SerializeFMUState: size = %zu, but fmi3SerializedFMUStateSize gives %zu", size,
-            sizeof(guard_state_header) + inner);
-    guard_state_header header;
-    guard_header_write(&header, STATE_MAGIC, FMU_GUID, s->at);
-    memcpy(serializedState, &header, sizeof header);
-    return settle(g, backend_fmi3SerializeFMUState(g->backend, s->backend, serializedState + sizeof header, inner));
+    return (fmi3Status)guard_serialize_state(&g->common, FMUState, serializedState, size);
 }
 
 FMI3_Export fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
                                                fmi3FMUState *FMUState) {
     BEGIN_FOR(DeserializeFMUState, MASK_FMU_STATE, BOTH);
-    REQUIRE(serializedState, "fmi3DeserializeFMUState: serializedState is NULL");
-    REQUIRE(FMUState, "fmi3DeserializeFMUState: FMUState is NULL");
-    if (*FMUState && !guard_state_known(&g->common, *FMUState, "fmi3DeserializeFMUState")) return fmi3Error;
-    guard_state_header header;
-    guard_position at;
-    REQUIRE(size > sizeof header, "fmi3DeserializeFMUState: %zu bytes are not a serialized state of this FMU", size);
-    memcpy(&header, serializedState, sizeof header);
-    REQUIRE(guard_header_read(&header, STATE_MAGIC, FMU_GUID, ANY_STATE, &at),
-            "fmi3DeserializeFMUState: the bytes are not a state serialized by this FMU (token %s)", FMU_GUID);
-    fmi3FMUState backend = NULL;
-    fmi3Status status = settle(g, backend_fmi3DeserializeFMUState(g->backend, serializedState + sizeof header,
-                                                                   size - sizeof header, &backend));
-    return status > fmi3Warning ? status : deliver_state(g, FMUState, backend, at);
+    return (fmi3Status)guard_deserialize_state(&g->common, serializedState, size, FMUState);
 }
 
 /* ---------------------------------------------------------------------------- Model Exchange */
@@ -557,48 +419,42 @@ FMI3_Export fmi3Status fmi3UpdateDiscreteStates(fmi3Instance instance, fmi3Boole
                                                 fmi3Boolean *nominalsOfContinuousStatesChanged,
                                                 fmi3Boolean *valuesOfContinuousStatesChanged,
                                                 fmi3Boolean *nextEventTimeDefined, fmi3Float64 *nextEventTime) {
-    BEGIN_FOR(UpdateDiscreteStates, MASK_UpdateDiscreteStates, MODEL_EXCHANGE);
+    BEGIN_FOR(UpdateDiscreteStates, MASK_UpdateDiscreteStates, ME);
     REQUIRE_OUT(UpdateDiscreteStates, discreteStatesNeedUpdate);
     REQUIRE_OUT(UpdateDiscreteStates, terminateSimulation);
     REQUIRE_OUT(UpdateDiscreteStates, nominalsOfContinuousStatesChanged);
     REQUIRE_OUT(UpdateDiscreteStates, valuesOfContinuousStatesChanged);
     REQUIRE_OUT(UpdateDiscreteStates, nextEventTimeDefined);
     REQUIRE_OUT(UpdateDiscreteStates, nextEventTime);
-    fmi3Boolean update = fmi3False, terminate = fmi3False, nominals = fmi3False, values = fmi3False;
-    fmi3Boolean defined = fmi3False;
-    fmi3Float64 next = 0.0;
-    fmi3Status status = settle(g, backend_fmi3UpdateDiscreteStates(g->backend, &update, &terminate, &nominals,
-                                                                    &values, &defined, &next));
+    unsigned char answer[5 + sizeof(double)]; /* five flags, then the next event's time */
+    bridge_payload payload = {PAYLOAD_EXACT, answer, sizeof answer, NULL, NULL, NULL};
+    fmi3Status status = settle(g, CALL(payload, "update_discrete_states", "()"));
     if (status > fmi3Warning) return status;
-    *discreteStatesNeedUpdate = update, *terminateSimulation = terminate;
-    *nominalsOfContinuousStatesChanged = nominals, *valuesOfContinuousStatesChanged = values;
-    *nextEventTimeDefined = defined, *nextEventTime = defined ? next : 0.0;
-    return status;
-}
-
-FMI3_Export fmi3Status fmi3EnterContinuousTimeMode(fmi3Instance instance) {
-    BEGIN_FOR(EnterContinuousTimeMode, MASK_EnterContinuousTimeMode, MODEL_EXCHANGE);
-    fmi3Status status = settle(g, backend_fmi3EnterContinuousTimeMode(g->backend));
-    if (status <= fmi3Warning) g->common.at.state = CONTINUOUS_TIME;
+    double next;
+    memcpy(&next, answer + 5, sizeof next);
+    *discreteStatesNeedUpdate = answer[0] != 0, *terminateSimulation = answer[1] != 0;
+    *nominalsOfContinuousStatesChanged = answer[2] != 0, *valuesOfContinuousStatesChanged = answer[3] != 0;
+    *nextEventTimeDefined = answer[4] != 0, *nextEventTime = answer[4] ? next : 0.0;
     return status;
 }
 
 FMI3_Export fmi3Status fmi3CompletedIntegratorStep(fmi3Instance instance, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
                                                    fmi3Boolean *enterEventMode, fmi3Boolean *terminateSimulation) {
-    BEGIN_FOR(CompletedIntegratorStep, MASK_CompletedIntegratorStep, MODEL_EXCHANGE);
+    BEGIN_FOR(CompletedIntegratorStep, MASK_CompletedIntegratorStep, ME);
     REQUIRE_OUT(CompletedIntegratorStep, enterEventMode);
     REQUIRE_OUT(CompletedIntegratorStep, terminateSimulation);
-    fmi3Boolean event = fmi3False, terminate = fmi3False;
-    fmi3Status status = settle(g, backend_fmi3CompletedIntegratorStep(g->backend, noSetFMUStatePriorToCurrentPoint,
-                                                                       &event, &terminate));
-    if (status <= fmi3Warning) *enterEventMode = event, *terminateSimulation = terminate;
+    unsigned char answer[2];
+    bridge_payload payload = {PAYLOAD_EXACT, answer, sizeof answer, NULL, NULL, NULL};
+    fmi3Status status = settle(g, CALL(payload, "completed_integrator_step", "(i)",
+                                       (int)noSetFMUStatePriorToCurrentPoint));
+    if (status <= fmi3Warning) *enterEventMode = answer[0] != 0, *terminateSimulation = answer[1] != 0;
     return status;
 }
 
 FMI3_Export fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
-    BEGIN_FOR(SetTime, MASK_SetTime, MODEL_EXCHANGE);
+    BEGIN_FOR(SetTime, MASK_SetTime, ME);
     REQUIRE(isfinite(time), "fmi3SetTime: time = %g s must be finite", time);
-    return settle(g, backend_fmi3SetTime(g->backend, time));
+    return settle(g, CALL(NO_PAYLOAD, "set_time", "(d)", time));
 }
 
 /* A state vector of the host: not NULL, exactly `expected` long. */
@@ -608,21 +464,48 @@ FMI3_Export fmi3Status fmi3SetTime(fmi3Instance instance, fmi3Float64 time) {
 
 FMI3_Export fmi3Status fmi3SetContinuousStates(fmi3Instance instance, const fmi3Float64 continuousStates[],
                                                size_t nContinuousStates) {
-    BEGIN_FOR(SetContinuousStates, MASK_SetContinuousStates, MODEL_EXCHANGE);
+    BEGIN_FOR(SetContinuousStates, MASK_SetContinuousStates, ME);
     CHECK_VECTOR(SetContinuousStates, continuousStates, nContinuousStates, N_CONTINUOUS_STATES);
-    return settle(g, backend_fmi3SetContinuousStates(g->backend, continuousStates, nContinuousStates));
+    for (size_t k = 0; k < nContinuousStates; k++)
+        REQUIRE(isfinite(continuousStates[k]), "fmi3SetContinuousStates: continuousStates[%zu] = %g is not finite", k,
+                continuousStates[k]);
+    return settle(g, CALL(NO_PAYLOAD, "set_continuous_states", "(y#)", (const char *)continuousStates,
+                          (ssize_t)(nContinuousStates * sizeof *continuousStates)));
 }
 
-#define STATE_VECTOR(F, array, n, expected)                                                                       \
+/* Get a vector of `n` values of the Python side into `array`. */
+static fmi3Status get_vector(guarded *g, const char *method, fmi3Float64 array[], size_t n) {
+    if (n == 0) return fmi3OK;
+    bridge_payload payload = {PAYLOAD_EXACT, array, n * sizeof *array, NULL, NULL, NULL};
+    return settle(g, CALL(payload, method, "()"));
+}
+
+FMI3_Export fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, fmi3Float64 derivatives[],
+                                                         size_t nContinuousStates) {
+    BEGIN_FOR(GetContinuousStateDerivatives, MASK_STATE_VECTORS, ME);
+    CHECK_VECTOR(GetContinuousStateDerivatives, derivatives, nContinuousStates, N_CONTINUOUS_STATES);
+    fmi3Status status = get_vector(g, "get_continuous_state_derivatives", derivatives, nContinuousStates);
+    for (size_t k = 0; status <= fmi3Warning && k < nContinuousStates; k++)
+        if (!isfinite(derivatives[k])) { /* the states are outside the model's domain: the host steps back */
+            char message[256];
+            guard_format(message, sizeof message, "fmi3GetContinuousStateDerivatives: derivatives[%zu] = %g is not "
+                         "finite at these continuous states (outside the model's domain)", k, derivatives[k]);
+            guard_emit(&g->common, fmi3Discard, "logStatusDiscard", message);
+            return fmi3Discard;
+        }
+    return status;
+}
+
+#define STATE_VECTOR(F, method, array, n, expected)                                                               \
     FMI3_Export fmi3Status fmi3##F(fmi3Instance instance, fmi3Float64 array[], size_t n) {                       \
-        BEGIN_FOR(F, MASK_STATE_VECTORS, MODEL_EXCHANGE);                                                         \
+        BEGIN_FOR(F, MASK_STATE_VECTORS, ME);                                                                     \
         CHECK_VECTOR(F, array, n, expected);                                                                      \
-        return n == 0 ? fmi3OK : settle(g, backend_fmi3##F(g->backend, array, n));                               \
+        return get_vector(g, method, array, n);                                                                   \
     }
-STATE_VECTOR(GetContinuousStateDerivatives, derivatives, nContinuousStates, N_CONTINUOUS_STATES)
-STATE_VECTOR(GetContinuousStates, continuousStates, nContinuousStates, N_CONTINUOUS_STATES)
-STATE_VECTOR(GetNominalsOfContinuousStates, nominals, nContinuousStates, N_CONTINUOUS_STATES)
-STATE_VECTOR(GetEventIndicators, eventIndicators, nEventIndicators, N_EVENT_INDICATORS)
+STATE_VECTOR(GetContinuousStates, "get_continuous_states", continuousStates, nContinuousStates, N_CONTINUOUS_STATES)
+STATE_VECTOR(GetNominalsOfContinuousStates, "get_nominals_of_continuous_states", nominals, nContinuousStates,
+             N_CONTINUOUS_STATES)
+STATE_VECTOR(GetEventIndicators, "get_event_indicators", eventIndicators, nEventIndicators, N_EVENT_INDICATORS)
 
 FMI3_Export fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *nContinuousStates) {
     BEGIN_FOR(GetNumberOfContinuousStates, MASK_NUMBERS, BOTH);
@@ -640,33 +523,19 @@ FMI3_Export fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, siz
 
 /* ----------------------------------------------------------------------------- Co-Simulation */
 
-FMI3_Export fmi3Status fmi3EnterStepMode(fmi3Instance instance) {
-    BEGIN_FOR(EnterStepMode, MASK_EnterStepMode, CO_SIMULATION);
-    fmi3Status status = settle(g, backend_fmi3EnterStepMode(g->backend));
-    if (status <= fmi3Warning) g->common.at.state = STEP;
-    return status;
-}
-
 FMI3_Export fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint,
                                   fmi3Float64 communicationStepSize, fmi3Boolean noSetFMUStatePriorToCurrentPoint,
                                   fmi3Boolean *eventHandlingNeeded, fmi3Boolean *terminateSimulation,
                                   fmi3Boolean *earlyReturn, fmi3Float64 *lastSuccessfulTime) {
-    BEGIN_FOR(DoStep, MASK_DoStep, CO_SIMULATION);
+    BEGIN_FOR(DoStep, MASK_DoStep, CS);
     guard_position *at = &g->common.at;
     REQUIRE_OUT(DoStep, eventHandlingNeeded);
     REQUIRE_OUT(DoStep, terminateSimulation);
     REQUIRE_OUT(DoStep, earlyReturn);
     REQUIRE_OUT(DoStep, lastSuccessfulTime);
-    REQUIRE(isfinite(communicationStepSize) && communicationStepSize > 0,
-            "fmi3DoStep: communicationStepSize = %g s must be finite and > 0", communicationStepSize);
-    REQUIRE(isfinite(currentCommunicationPoint) &&
-                fabs(currentCommunicationPoint - at->time) <= 1e-9 * fmax(1.0, fabs(at->time)),
-            "fmi3DoStep: currentCommunicationPoint = %.17g s is not the FMU's time %.17g s (the end of the last "
-            "step, or of the FMU state set)", currentCommunicationPoint, at->time);
-    fmi3Boolean event = fmi3False, terminate = fmi3False, early = fmi3False;
-    fmi3Float64 reached = currentCommunicationPoint;
-    fmi3Status status = backend_fmi3DoStep(g->backend, currentCommunicationPoint, communicationStepSize,
-                                           noSetFMUStatePriorToCurrentPoint, &event, &terminate, &early, &reached);
+    if (!guard_check_step(&g->common, currentCommunicationPoint, communicationStepSize)) return fmi3Error;
+    int status = CALL(NO_PAYLOAD, "do_step", "(ddi)", currentCommunicationPoint, communicationStepSize,
+                      (int)noSetFMUStatePriorToCurrentPoint);
     *eventHandlingNeeded = fmi3False, *earlyReturn = fmi3False;
     if (status == fmi3Discard) { /* the solver gave up: the FMU stays where the step began */
         at->state = STEP_DISCARDED;
@@ -678,14 +547,14 @@ FMI3_Export fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentComm
     status = settle(g, status);
     if (status <= fmi3Warning) at->time = at->last_successful_time = currentCommunicationPoint + communicationStepSize;
     *terminateSimulation = fmi3False, *lastSuccessfulTime = at->last_successful_time;
-    return status;
+    return (fmi3Status)status;
 }
 
 FMI3_Export fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                                                 size_t nValueReferences, const fmi3Int32 orders[], fmi3Float64 values[],
                                                 size_t nValues) {
     (void)valueReferences, (void)nValueReferences, (void)orders, (void)values, (void)nValues;
-    BEGIN_FOR(GetOutputDerivatives, MASK_GetOutputDerivatives, CO_SIMULATION);
+    BEGIN_FOR(GetOutputDerivatives, MASK_GetOutputDerivatives, CS);
     return (fmi3Status)fail(&g->common, "fmi3GetOutputDerivatives: this FMU gives no output derivatives "
                                         "(maxOutputDerivativeOrder = 0)");
 }

@@ -1,106 +1,182 @@
-/* What the FMI 2 and FMI 3 guards share (see guard.h). */
+/* What the FMI 2 and FMI 3 layers share (see guard.h): instances, instantiation, logging, checks. */
 #define _GNU_SOURCE
 #include "glibc_compat.h"
 
 #include "guard.h"
 
-#include <dlfcn.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
-#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-/* ------------------------------------------------------------------------- live pointers */
+#include "bridge.h"
 
-#define TOMBSTONE ((void *)1)
-
-static size_t slot_of(const void *pointer, size_t capacity) {
-    uint64_t x = (uint64_t)(uintptr_t)pointer;
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdULL;
-    x ^= x >> 33;
-    return (size_t)x & (capacity - 1);
-}
-
-/* Rebuild with room for twice the live entries (at least 16 slots), dropping the tombstones. */
-static int rehash(pointer_set *set) {
-    size_t capacity = 16;
-    while (capacity < 4 * (set->count + 1)) capacity *= 2;
-    void **slots = calloc(capacity, sizeof *slots);
-    if (!slots) return 0;
-    for (size_t k = 0; k < set->capacity; k++) {
-        void *p = set->slots[k];
-        if (!p || p == TOMBSTONE) continue;
-        size_t at = slot_of(p, capacity);
-        while (slots[at]) at = (at + 1) & (capacity - 1);
-        slots[at] = p;
-    }
-    free(set->slots);
-    set->slots = slots;
-    set->capacity = capacity;
-    set->used = set->count;
-    return 1;
-}
-
-int pointer_set_add(pointer_set *set, void *pointer) {
-    pthread_mutex_lock(&set->lock);
-    int ok = 1;
-    if (2 * (set->used + 1) > set->capacity) ok = rehash(set);
-    if (ok) {
-        size_t at = slot_of(pointer, set->capacity);
-        while (set->slots[at] && set->slots[at] != TOMBSTONE) at = (at + 1) & (set->capacity - 1);
-        if (!set->slots[at]) set->used++;
-        set->slots[at] = pointer;
-        set->count++;
-    }
-    pthread_mutex_unlock(&set->lock);
-    return ok;
-}
-
-/* The slot holding `pointer`, or NULL (called with the lock held). */
-static void **find(pointer_set *set, const void *pointer) {
-    if (!set->capacity || !pointer || pointer == TOMBSTONE) return NULL;
-    for (size_t at = slot_of(pointer, set->capacity);; at = (at + 1) & (set->capacity - 1)) {
-        if (!set->slots[at]) return NULL;
-        if (set->slots[at] == pointer) return &set->slots[at];
-    }
-}
-
-int pointer_set_remove(pointer_set *set, void *pointer) {
-    pthread_mutex_lock(&set->lock);
-    void **slot = find(set, pointer);
-    if (slot) {
-        *slot = TOMBSTONE;
-        set->count--;
-        if (set->count == 0) { /* empty: start afresh, so tombstones never pile up */
-            memset(set->slots, 0, set->capacity * sizeof *set->slots);
-            set->used = 0;
-        }
-    }
-    pthread_mutex_unlock(&set->lock);
-    return slot != NULL;
-}
-
-int pointer_set_has(pointer_set *set, void *pointer) {
-    pthread_mutex_lock(&set->lock);
-    int found = find(set, pointer) != NULL;
-    pthread_mutex_unlock(&set->lock);
-    return found;
-}
+#define IDENTITY_FILE "identity.cfg" /* in resources/, written by the build: model, token, entry */
 
 /* ------------------------------------------------------------------------------- instances */
 
-static pointer_set instances = POINTER_SET_INIT;
-static pointer_set fmu_states = POINTER_SET_INIT;
-static pthread_mutex_t states_lock = PTHREAD_MUTEX_INITIALIZER; /* the instances' lists of states */
+static pointer_set instances = POINTER_SET_INIT; /* its lock also guards every instance's references */
 
-int guard_register(guard_instance *g) { return pointer_set_add(&instances, g); }
-int guard_unregister(guard_instance *g) { return pointer_set_remove(&instances, g); }
+int guard_register(guard_instance *g) {
+    g->references = 1; /* the host's */
+    return pointer_set_add(&instances, g);
+}
+
+guard_instance *guard_acquire(void *c, const char *model_identifier, const char *function) {
+    if (!c) {
+        guard_orphan(model_identifier, function, "the instance is NULL");
+        return NULL;
+    }
+    pthread_mutex_lock(&instances.lock);
+    int live = pointer_set_has_locked(&instances, c);
+    if (live) ((guard_instance *)c)->references++;
+    pthread_mutex_unlock(&instances.lock);
+    if (!live) {
+        guard_orphan(model_identifier, function,
+                     "%p is not a live instance of this FMU (freed, or never instantiated here)", c);
+        return NULL;
+    }
+    return (guard_instance *)c;
+}
+
+void guard_release(guard_instance *g) {
+    pthread_mutex_lock(&instances.lock);
+    int last = --g->references == 0;
+    pthread_mutex_unlock(&instances.lock);
+    if (last) g->destroy(g);
+}
+
+void guard_release_variable(void *variable) {
+    guard_instance *g = *(guard_instance **)variable;
+    if (g) guard_release(g);
+}
+
+int guard_unregister(void *c) {
+    pthread_mutex_lock(&instances.lock);
+    int live = c && pointer_set_remove_locked(&instances, c);
+    pthread_mutex_unlock(&instances.lock);
+    if (live) guard_release(c); /* the host's reference */
+    return live;
+}
+
+int guard_init_instance(guard_instance *g, const guard_version *version, const char *interface,
+                        const char *name, int logging_on,
+                        void (*log)(guard_instance *, int, const char *, const char *),
+                        void (*destroy)(guard_instance *)) {
+    g->name = strdup(name && name[0] && guard_utf8_error(name) < 0 ? name : "?");
+    g->at = (guard_position){version->instantiated_state, 0.0, 0.0, 0};
+    g->version = version;
+    g->interface = interface;
+    g->categories = logging_on ? CATEGORIES_EVERY : CATEGORIES_DEFAULT;
+    g->function = NULL;
+    g->log = log;
+    g->destroy = destroy;
+    return g->name != NULL;
+}
+
+void guard_free_common(guard_instance *g) {
+    while (g->states) guard_free_state(g, (void **)&(void *){g->states}); /* the ones the host did not free */
+    if (g->python) bridge_call(g, NO_PAYLOAD, "release", "()"), bridge_release(g, g->python);
+    g->python = NULL;
+    free(g->name);
+    g->name = NULL;
+}
+
+/* ---------------------------------------------------------------------------- instantiation */
+
+/* resources/identity.cfg: the model, token, package and entry module of the FMU whose resources these are. */
+typedef struct {
+    char model[256], token[256], package[256], entry[256];
+} identity;
+
+static int read_identity(const char *resources, identity *id) {
+    char path[PATH_MAX], line[512];
+    memset(id, 0, sizeof *id);
+    if (snprintf(path, sizeof path, "%s/%s", resources, IDENTITY_FILE) >= (int)sizeof path) return 0;
+    FILE *file = fopen(path, "re");
+    if (!file) return 0;
+    while (fgets(line, sizeof line, file)) {
+        line[strcspn(line, "\r\n")] = '\0';
+        char *value = strchr(line, '=');
+        if (!value || line[0] == '#') continue;
+        *value++ = '\0';
+        char *field = strcmp(line, "model") == 0 ? id->model : strcmp(line, "token") == 0 ? id->token
+                      : strcmp(line, "entry") == 0 ? id->entry : strcmp(line, "package") == 0 ? id->package : NULL;
+        if (field) guard_format(field, sizeof id->model, "%s", value);
+    }
+    fclose(file);
+    return id->model[0] && id->token[0] && id->package[0] && id->entry[0];
+}
+
+int guard_check_instantiation(const guard_version *v, const char *name, const char *token, const char *location,
+                              char *resources, size_t size, char *why, size_t why_size) {
+    long bad;
+    identity id;
+    if (!name || !name[0]) guard_format(why, why_size, "instanceName is %s", name ? "empty" : "NULL");
+    else if ((bad = guard_utf8_error(name)) >= 0)
+        guard_format(why, why_size, "instanceName is not UTF-8 (byte %ld is 0x%02x; an %sString is UTF-8 encoded)",
+                     bad, (unsigned char)name[bad], v->prefix);
+    else if (!token || strcmp(token, v->token) != 0)
+        guard_format(why, why_size, "%s %s%.100s%s is not this FMU's %s: the binary and its modelDescription.xml "
+                     "come from different builds", v->token_name, token ? "\"" : "", token ? token : "NULL",
+                     token ? "\"" : "", v->token);
+    else if (!location || !location[0])
+        guard_format(why, why_size, "%s is %s: the FMU needs its resources folder", v->resources_name,
+                     location ? "empty" : "NULL");
+    else if ((bad = guard_utf8_error(location)) >= 0)
+        guard_format(why, why_size, "%s \"%.1000s\" is not UTF-8 (byte %ld; an %sString is UTF-8 encoded)",
+                     v->resources_name, location, bad, v->prefix);
+    else if (!guard_uri_to_path(location, resources, size))
+        guard_format(why, why_size, "%s \"%.1000s\" is not a file URI or path of this machine", v->resources_name,
+                     location);
+    else if ((bad = guard_utf8_error(resources)) >= 0)
+        guard_format(why, why_size, "%s \"%.1000s\": the folder's path is not UTF-8 (byte %ld), which the FMU's "
+                     "Python side cannot take", v->resources_name, location, bad);
+    else if (!guard_is_directory(resources))
+        guard_format(why, why_size, "%s \"%.1000s\": there is no folder %.1000s", v->resources_name, location,
+                     resources);
+    else if (!read_identity(resources, &id))
+        guard_format(why, why_size, "%s \"%.1000s\" is not this FMU's resources folder (no %s in %.1000s)",
+                     v->resources_name, location, IDENTITY_FILE, resources);
+    else if (strcmp(id.model, v->model_identifier) != 0 || strcmp(id.token, v->token) != 0)
+        guard_format(why, why_size, "%s \"%.1000s\" is the resources folder of another FMU (%.100s, %s %.100s), "
+                     "not of %s (%s %s)", v->resources_name, location, id.model, v->token_name, id.token,
+                     v->model_identifier, v->token_name, v->token);
+    else
+        return 1;
+    return 0;
+}
+
+int guard_start_python(guard_instance *g, const char *resources, int visible) {
+    char why[2048] = "";
+    identity id;
+    const python_api *py = python_runtime_start(resources, why, sizeof why);
+    if (!py) return guard_fail(g, "%s: %s", g->function, why), 0;
+    if (!read_identity(resources, &id))
+        return guard_fail(g, "%s: %s/%s cannot be read", g->function, resources, IDENTITY_FILE), 0;
+    PyObject *python = NULL;
+    int status = bridge_instantiate(g, py, resources, id.package, id.entry, g->interface, visible, &python);
+    if (status > STATUS_WARNING || !python) {
+        if (python) bridge_release(g, python);
+        return guard_fail(g, "%s: the FMU's Python side could not be instantiated (the message before says why)",
+                          g->function), 0;
+    }
+    g->python = python;
+    return 1;
+}
+
+int guard_reset(guard_instance *g) {
+    int status = guard_settle(g, bridge_call(g, NO_PAYLOAD, "reset", "()"));
+    if (status <= STATUS_WARNING) g->at = (guard_position){g->version->instantiated_state, 0.0, 0.0, 0};
+    return status;
+}
+
+/* ----------------------------------------------------------------------------- logging */
 
 void guard_orphan(const char *model_identifier, const char *function, const char *format, ...) {
     char message[2048];
@@ -111,19 +187,6 @@ void guard_orphan(const char *model_identifier, const char *function, const char
     if (n < 0) message[0] = '\0';
     fprintf(stderr, "[%s] %s: %s\n", model_identifier, function, message);
     fflush(stderr);
-}
-
-guard_instance *guard_lookup(void *c, const char *model_identifier, const char *function) {
-    if (!c) {
-        guard_orphan(model_identifier, function, "the instance is NULL");
-        return NULL;
-    }
-    if (!pointer_set_has(&instances, c)) {
-        guard_orphan(model_identifier, function,
-                     "%p is not a live instance of this FMU (freed, or never instantiated here)", c);
-        return NULL;
-    }
-    return (guard_instance *)c;
 }
 
 void guard_emit(guard_instance *g, int status, const char *category, const char *message) {
@@ -143,130 +206,40 @@ int guard_fail(guard_instance *g, const char *format, ...) {
     va_end(args);
     if (n < 0) message[0] = '\0';
     guard_emit(g, STATUS_ERROR, "logStatusError", message);
-    g->at.state = g->error_state;
+    g->at.state = g->version->error_state;
     return STATUS_ERROR;
 }
 
 int guard_settle(guard_instance *g, int status) {
     if (status >= STATUS_ERROR) {
-        g->at.state = g->error_state;
+        g->at.state = g->version->error_state;
         return STATUS_ERROR;
     }
     return status;
 }
 
-void guard_library_message_logged(guard_instance *g, int status, const char *category, const char *message) {
-    char text[2048], line[2200];
-    guard_library_message(message, text, sizeof text);
-    if (status == STATUS_FATAL) status = STATUS_ERROR;
-    if (!category || !category[0] || strcmp(category, "logStatusFatal") == 0) category = guard_category_of(status);
-    if (status >= STATUS_ERROR) {
-        guard_format(line, sizeof line, "%s: %s", g->function ? g->function : "FMU", text);
-        guard_emit(g, status, category, line);
-    } else {
-        guard_emit(g, status, category, text);
-    }
-}
-
-int guard_set_debug_logging(guard_instance *g, int on, size_t n, const char *const categories[],
-                            const char *function) {
+int guard_set_debug_logging(guard_instance *g, int on, size_t n, const char *const categories[]) {
     char why[512];
     int mask = g->categories;
     if (!guard_debug_categories(&mask, on, n, categories, why, sizeof why)) {
-        g->categories |= CATEGORIES_ERRORS; /* so that this error is seen */
-        return guard_fail(g, "%s: %s", function, why);
+        g->categories |= CATEGORY_ERROR; /* so that this error is seen */
+        return guard_fail(g, "%s: %s", g->function, why);
     }
     g->categories = mask;
     return STATUS_OK;
 }
 
-/* ------------------------------------------------------------------------------ FMU states */
-
-guard_state *guard_state_known(guard_instance *g, void *s, const char *function) {
-    if (!s) {
-        guard_fail(g, "%s: the FMU state is NULL", function);
-        return NULL;
-    }
-    if (!pointer_set_has(&fmu_states, s)) {
-        guard_fail(g, "%s: FMU state %p is not a live state of this FMU (freed, or from another FMU)", function, s);
-        return NULL;
-    }
-    return (guard_state *)s;
-}
-
-guard_state *guard_state_new(guard_instance *g, void *backend, guard_position at) {
-    guard_state *s = calloc(1, sizeof *s);
-    if (!s || !pointer_set_add(&fmu_states, s)) {
-        free(s);
-        return NULL;
-    }
-    *s = (guard_state){g, backend, at, NULL, NULL};
-    pthread_mutex_lock(&states_lock);
-    s->next = g->states;
-    if (g->states) g->states->previous = s;
-    g->states = s;
-    pthread_mutex_unlock(&states_lock);
-    return s;
-}
-
-void guard_state_forget(guard_state *s) {
-    pointer_set_remove(&fmu_states, s);
-    pthread_mutex_lock(&states_lock);
-    if (s->previous) s->previous->next = s->next;
-    else s->owner->states = s->next;
-    if (s->next) s->next->previous = s->previous;
-    s->previous = s->next = NULL;
-    pthread_mutex_unlock(&states_lock);
-}
-
-void guard_header_write(guard_state_header *header, const char *magic, const char *token, guard_position at) {
-    memset(header, 0, sizeof *header);
-    memcpy(header->magic, magic, sizeof header->magic);
-    snprintf(header->token, sizeof header->token, "%s", token);
-    header->state = at.state;
-    header->wants_to_terminate = at.wants_to_terminate;
-    header->time = at.time;
-    header->last_successful_time = at.last_successful_time;
-}
-
-int guard_header_read(const guard_state_header *header, const char *magic, const char *token, int states,
-                      guard_position *at) {
-    if (memcmp(header->magic, magic, sizeof header->magic) != 0) return 0;
-    if (strncmp(header->token, token, sizeof header->token) != 0) return 0;
-    if (!(header->state & states) || (header->state & (header->state - 1))) return 0;
-    if (!isfinite(header->time) || !isfinite(header->last_successful_time)) return 0;
-    *at = (guard_position){header->state, header->time, header->last_successful_time, header->wants_to_terminate};
+int guard_check_step(guard_instance *g, double current, double step) {
+    double t = g->at.time;
+    if (!(isfinite(step) && step > 0))
+        return guard_fail(g, "%s: communicationStepSize = %g s must be finite and > 0", g->function, step), 0;
+    /* a master's own sum of the steps differs from the FMU's by rounding only: a millionth of the step,
+     * and a few units in the last place of t (which grow with |t|; a skipped step never hides in them) */
+    double tolerance = 1e-6 * step + 16 * (nextafter(fabs(t), INFINITY) - fabs(t));
+    if (!isfinite(current) || fabs(current - t) > tolerance)
+        return guard_fail(g, "%s: currentCommunicationPoint = %.17g s is not the FMU's time %.17g s (the end of the "
+                          "last step, or of the FMU state set)", g->function, current, t), 0;
     return 1;
-}
-
-/* --------------------------------------------------------------------------------- threads */
-
-typedef int (*gil_check_fn)(void);
-typedef void *(*save_thread_fn)(void);
-typedef void (*restore_thread_fn)(void *);
-
-static gil_check_fn gil_check;
-static save_thread_fn save_thread;
-static restore_thread_fn restore_thread;
-static pthread_once_t python_functions_once = PTHREAD_ONCE_INIT;
-
-static void resolve_python_functions(void) {
-    /* The loader has made the process's CPython global (python_runtime.c) before any instance exists. */
-    gil_check = (gil_check_fn)dlsym(RTLD_DEFAULT, "PyGILState_Check");
-    save_thread = (save_thread_fn)dlsym(RTLD_DEFAULT, "PyEval_SaveThread");
-    restore_thread = (restore_thread_fn)dlsym(RTLD_DEFAULT, "PyEval_RestoreThread");
-}
-
-void guard_lock_python(pthread_mutex_t *lock) {
-    if (pthread_mutex_trylock(lock) == 0) return;
-    pthread_once(&python_functions_once, resolve_python_functions);
-    if (gil_check && save_thread && restore_thread && gil_check()) {
-        void *thread_state = save_thread();
-        pthread_mutex_lock(lock);
-        restore_thread(thread_state);
-        return;
-    }
-    pthread_mutex_lock(lock);
 }
 
 /* ---------------------------------------------------------------------------- messages */
@@ -321,25 +294,6 @@ int guard_debug_categories(int *mask, int on, size_t n, const char *const catego
     return 1;
 }
 
-void guard_library_message(const char *message, char *out, size_t size) {
-    static const char prefix[] = "Fatal py exception encountered: ";
-    if (!message) message = "";
-    if (strncmp(message, prefix, sizeof prefix - 1) != 0) {
-        guard_format(out, size, "%s", message);
-        return;
-    }
-    const char *repr = strchr(message, '\n');
-    repr = repr ? repr + 1 : message + sizeof prefix - 1;
-    /* the repr of the exception: Name('text') or Name("text") */
-    size_t n = strlen(repr);
-    const char *open = strchr(repr, '(');
-    if (open && n >= 4 && repr[n - 1] == ')' && (open[1] == '\'' || open[1] == '"') && repr[n - 2] == open[1] &&
-        open + 2 <= repr + n - 2)
-        guard_format(out, size, "%.*s: %.*s", (int)(open - repr), repr, (int)(repr + n - 2 - (open + 2)), open + 2);
-    else
-        guard_format(out, size, "%s", repr);
-}
-
 void guard_format(char *out, size_t size, const char *format, ...) {
     if (!size) return;
     va_list args;
@@ -387,6 +341,10 @@ int guard_is_file(const char *path) {
     return errno == ENOTDIR;
 }
 
+static int hex_value(char c) {
+    return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
+}
+
 int guard_uri_to_path(const char *uri, char *path, size_t size) {
     const char *p = uri;
     int is_uri = strncmp(p, "file:", 5) == 0;
@@ -400,10 +358,12 @@ int guard_uri_to_path(const char *uri, char *path, size_t size) {
         return 0; /* another scheme */
     }
     size_t n = 0;
-    for (; *p && n + 1 < size; p++) {
-        unsigned int code;
-        if (is_uri && p[0] == '%' && p[1] && p[2] && sscanf(p + 1, "%2x", &code) == 1) {
-            path[n++] = (char)code;
+    for (; *p; p++) {
+        if (n + 1 >= size) return 0; /* too long: never a path cut short */
+        if (is_uri && p[0] == '%') {
+            int high = hex_value(p[1]), low = high < 0 ? -1 : hex_value(p[2]);
+            if (low < 0 || (high == 0 && low == 0)) return 0; /* not two hex digits, or a NUL byte */
+            path[n++] = (char)(16 * high + low);
             p += 2;
         } else {
             path[n++] = *p;

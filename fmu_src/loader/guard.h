@@ -1,18 +1,21 @@
-/* What the FMI 2 and FMI 3 guards (fmi2_guard.c, fmi3_guard.c) share.
+/* What the FMI 2 and FMI 3 layers (fmi2_guard.c, fmi3_guard.c) share: everything but the functions'
+ * signatures and the state machines.
  *
- * Each guard stands in front of the FMI library's binary (pythonfmu's, pythonfmu3's) and gives the
- * host the standard's behaviour whatever the Python side does (docs/fmu.md, "How the FMU answers a
- * master"): a per-instance state machine from the standard's tables, argument checks, instantiation
- * checks, a logger only ever called with the message as data, statuses that say what is lost.  This
- * file holds the pieces both need: sets of live pointers (an instance or an FMU state the host
- * passes is looked up before it is used), the lock that serialises what must be serialised across
- * threads (imports and the host hygiene of instantiation), log categories, the library's error
- * messages in words, and path checks. */
+ * Each layer gives the host the standard's behaviour whatever the Python side does (docs/fmu.md, "How
+ * the FMU answers a master"): a per-instance state machine from the standard's tables, argument checks,
+ * instantiation checks, a logger only ever called with the message as data and with no lock held,
+ * statuses that say what is lost.  This file holds what both need, behind a small table per FMI version
+ * (guard_version): sets of live pointers (an instance or an FMU state the host passes is looked up
+ * before it is used, and an instance is freed only when no call is using it), instantiation (checks,
+ * Python, the bridge), FMU states (owned by their instance, validated when deserialised), log
+ * categories and messages, the time check of doStep, path and UTF-8 checks. */
 #ifndef GUARD_H
 #define GUARD_H
 
 #include <pthread.h>
 #include <stddef.h>
+
+#include "python_runtime.h"
 
 /* ------------------------------------------------------------------------- live pointers */
 
@@ -29,16 +32,37 @@ typedef struct {
 int pointer_set_add(pointer_set *set, void *pointer);    /* 0 if out of memory */
 int pointer_set_remove(pointer_set *set, void *pointer); /* 1 if it was in the set */
 int pointer_set_has(pointer_set *set, void *pointer);
+/* The same with set->lock held by the caller. */
+int pointer_set_add_locked(pointer_set *set, void *pointer);
+int pointer_set_remove_locked(pointer_set *set, void *pointer);
+int pointer_set_has_locked(pointer_set *set, void *pointer);
 
-/* ------------------------------------------------------------------------------- instances */
+/* ------------------------------------------------------------------------------- versions */
 
 /* FMI 2 and FMI 3 number their statuses alike: OK 0, Warning 1, Discard 2, Error 3, Fatal 4. */
 enum { STATUS_OK = 0, STATUS_WARNING = 1, STATUS_DISCARD = 2, STATUS_ERROR = 3, STATUS_FATAL = 4 };
 
+/* What differs between the FMI versions in the shared logic. */
+typedef struct {
+    const char *prefix;           /* "fmi2", "fmi3" */
+    const char *model_identifier; /* MODEL_IDENTIFIER */
+    const char *token;            /* FMU_GUID: the GUID (FMI 2) or instantiationToken (FMI 3) */
+    const char *token_name;       /* "fmuGUID", "instantiationToken" */
+    const char *resources_name;   /* "fmuResourceLocation", "resourcePath" */
+    int any_state;                /* the bits of every state */
+    int error_state;              /* the bit of the Error state */
+    int instantiated_state;       /* the bit of Instantiated (after a reset) */
+    const char *state_word;       /* "FMUstate", "FMUState": as the version spells it */
+    const char *(*state_name)(int state);
+    int (*state_allowed)(const char *interface, int state); /* can an instance of `interface` be in it? */
+} guard_version;
+
+/* ------------------------------------------------------------------------------- instances */
+
 typedef struct guard_instance guard_instance;
 typedef struct guard_state guard_state;
 
-/* Where an instance is: what an FMU state restores besides the FMI library's own state. */
+/* Where an instance is: what an FMU state restores besides the Python side's own state. */
 typedef struct {
     int state;                   /* one bit of the FMI version's states */
     double time;                 /* the FMU's time: where the next doStep starts [s] */
@@ -46,80 +70,89 @@ typedef struct {
     int wants_to_terminate;      /* a step was discarded: the FMU cannot go on from there */
 } guard_position;
 
-/* What every guarded instance has, first in the FMI version's own struct. */
+/* What every instance has, first in the FMI version's own struct. */
 struct guard_instance {
     guard_position at;
-    int error_state;      /* the FMI version's Error state (its bit) */
-    int categories;       /* the log categories that reach the host's logger */
-    const char *function; /* the FMI function being run, for the library's messages */
+    const guard_version *version;
+    const char *interface; /* "CoSimulation" or "ModelExchange": what it was made for */
+    int categories;        /* the log categories that reach the host's logger */
+    const char *function;  /* the FMI function being run, for messages */
     char *name;
-    guard_state *states;  /* the FMU states it made */
+    guard_state *states;   /* the FMU states it made */
+    int references;        /* the host's (until it frees the instance) and one per call running */
+    const python_api *api; /* the process's Python */
+    PyObject *python;      /* the instance's Python object (fmu_src/fmi_bridge.py) */
     /* give one message to the host's logger, or stderr if it has none */
     void (*log)(guard_instance *g, int status, const char *category, const char *message);
+    void (*destroy)(guard_instance *g); /* free the version's struct (its Python object is released) */
 };
 
-/* Register a new instance (0 if out of memory) / forget it (1 if it was live). */
+/* Register a new instance with the host's reference (0 if out of memory). */
 int guard_register(guard_instance *g);
-int guard_unregister(guard_instance *g);
-/* The live instance `c` for the FMI function `function`, or NULL (one line on stderr: no logger). */
-guard_instance *guard_lookup(void *c, const char *model_identifier, const char *function);
+/* The host frees `c`: it is no longer live (1 if it was); it is destroyed when no call uses it. */
+int guard_unregister(void *c);
+/* The live instance `c` for the FMI function `function`, with a reference for the call, or NULL (one
+ * line on stderr: no logger).  The reference is given back by guard_release. */
+guard_instance *guard_acquire(void *c, const char *model_identifier, const char *function);
+void guard_release(guard_instance *g);
+/* For __attribute__((cleanup)): release the instance a variable holds (if any) when it goes out of scope. */
+void guard_release_variable(void *variable);
+#define GUARD_CALL __attribute__((cleanup(guard_release_variable)))
+
+/* Fill in `g` (calloc'ed, first in the version's struct) for a new instance. */
+int guard_init_instance(guard_instance *g, const guard_version *version, const char *interface,
+                        const char *name, int logging_on,
+                        void (*log)(guard_instance *, int, const char *, const char *),
+                        void (*destroy)(guard_instance *));
+/* The checks every instantiation needs (instance name; the token; the resource location: a file URI or a
+ * path, decoded into `resources`, a folder of this machine, UTF-8, and this FMU's: resources/identity.cfg
+ * names its model and token).  Returns 0 and writes why to `why` if one fails. */
+int guard_check_instantiation(const guard_version *v, const char *name, const char *token, const char *location,
+                              char *resources, size_t size, char *why, size_t why_size);
+/* Start Python (once per process) and make g's Python object; 0 (logged) if that fails. */
+int guard_start_python(guard_instance *g, const char *resources, int visible);
+/* Release g's Python object and its FMU states, free its name: what every destroy does first. */
+void guard_free_common(guard_instance *g);
+/* fmiXReset: the Python object made anew, the FMU states kept. */
+int guard_reset(guard_instance *g);
 
 /* Give `message` to the host's logger if its category is on (the status's category if NULL). */
 void guard_emit(guard_instance *g, int status, const char *category, const char *message);
 /* Log an error, put the instance into its Error state, return STATUS_ERROR. */
 int guard_fail(guard_instance *g, const char *format, ...) __attribute__((format(printf, 2, 3)));
-/* The FMI library's status as the host gets it: Fatal, for a Python exception, is an error of this
- * instance only, which a reset recovers; an error puts the instance into its Error state. */
+/* A status of the Python side as the host gets it: an error puts the instance into its Error state. */
 int guard_settle(guard_instance *g, int status);
-/* A message of the FMI library (its text, never a format), with its Fatal made an Error. */
-void guard_library_message_logged(guard_instance *g, int status, const char *category, const char *message);
 /* fmiXSetDebugLogging as specified; STATUS_OK or a failure. */
-int guard_set_debug_logging(guard_instance *g, int on, size_t n, const char *const categories[],
-                            const char *function);
+int guard_set_debug_logging(guard_instance *g, int on, size_t n, const char *const categories[]);
 /* One line on stderr for a call that has no instance to log through. */
 void guard_orphan(const char *model_identifier, const char *function, const char *format, ...)
     __attribute__((format(printf, 3, 4)));
+/* doStep's currentCommunicationPoint and communicationStepSize: 1 if they are right, else logged. */
+int guard_check_step(guard_instance *g, double current, double step);
 
 /* ------------------------------------------------------------------------------ FMU states */
 
-/* An FMU state as the host holds it: the library's state and the instance's position. */
+/* An FMU state as the host holds it: the Python side's state and the instance's position. */
 struct guard_state {
-    guard_instance *owner; /* the instance that made it, which frees it if the host does not */
-    void *backend;
+    guard_instance *owner; /* the instance that made it: the only one that may use or free it */
+    PyObject *python;
     guard_position at;
+    char *serialized; /* the serialized form, once asked for (its size first, then the bytes) */
+    size_t serialized_size;
     guard_state *previous, *next; /* the owner's states */
 };
 
-/* The state `s`, if it is a live state of this FMU; else NULL and an error on g. */
-guard_state *guard_state_known(guard_instance *g, void *s, const char *function);
-/* A new live state of g; NULL if out of memory. */
-guard_state *guard_state_new(guard_instance *g, void *backend, guard_position at);
-/* Forget state s (the caller frees its library state, then s). */
-void guard_state_forget(guard_state *s);
-
-/* A serialized FMU state: this header, then the library's bytes. */
-typedef struct {
-    char magic[8];
-    char token[64]; /* the FMU's GUID / instantiation token */
-    int state, wants_to_terminate;
-    double time, last_successful_time;
-} guard_state_header;
-
-void guard_header_write(guard_state_header *header, const char *magic, const char *token, guard_position at);
-/* 1 if `header` is one this FMU wrote (magic, token, a single valid state bit within `states`). */
-int guard_header_read(const guard_state_header *header, const char *magic, const char *token, int states,
-                      guard_position *at);
-
-/* --------------------------------------------------------------------------------- threads */
-
-/* Lock `lock`, which guards Python work (instantiation and reset import modules and edit sys.path).
- * A thread that holds the GIL (a host that calls the FMU from Python without releasing it) releases
- * it while it waits, so that the thread holding `lock` can take the GIL and finish. */
-void guard_lock_python(pthread_mutex_t *lock);
+/* The FMU-state functions of both versions (FMUstate is the host's fmiXFMUState*). */
+int guard_get_state(guard_instance *g, void **FMUstate);
+int guard_set_state(guard_instance *g, void *FMUstate);
+int guard_free_state(guard_instance *g, void **FMUstate);
+int guard_serialized_size(guard_instance *g, void *FMUstate, size_t *size);
+int guard_serialize_state(guard_instance *g, void *FMUstate, unsigned char *bytes, size_t size);
+int guard_deserialize_state(guard_instance *g, const unsigned char *bytes, size_t size, void **FMUstate);
 
 /* ---------------------------------------------------------------------------- messages */
 
-/* The log categories of the FMUs' modelDescription (pythonfmu's and pythonfmu3's), as bits. */
+/* The log categories of the FMUs' modelDescription, as bits. */
 enum {
     CATEGORY_ALL = 1 << 0,     /* logAll: messages with status OK */
     CATEGORY_WARNING = 1 << 1, /* logStatusWarning */
@@ -128,7 +161,8 @@ enum {
     CATEGORY_FATAL = 1 << 4,   /* logStatusFatal */
 };
 #define CATEGORIES_EVERY (CATEGORY_ALL | CATEGORY_WARNING | CATEGORY_DISCARD | CATEGORY_ERROR | CATEGORY_FATAL)
-#define CATEGORIES_ERRORS (CATEGORY_ERROR | CATEGORY_FATAL) /* logged from instantiation on */
+/* logged from instantiation on: why a step was discarded, and every error */
+#define CATEGORIES_DEFAULT (CATEGORY_DISCARD | CATEGORY_ERROR | CATEGORY_FATAL)
 #define CATEGORY_NAMES "logAll, logStatusWarning, logStatusDiscard, logStatusError, logStatusFatal"
 
 /* The bit of category `name`, 0 if it is not one of this FMU's. */
@@ -141,17 +175,12 @@ int guard_category_bit_of(int status);
  * none named: all of them).  Returns 0 and writes why to `why` if an argument is wrong. */
 int guard_debug_categories(int *mask, int on, size_t n, const char *const categories[], char *why, size_t size);
 
-/* The FMI library's message for a Python exception ("Fatal py exception encountered: [doStep]
- * PyObject_CallMethod\nValueError('...')") in words: "ValueError: ...".  Other messages are copied. */
-void guard_library_message(const char *message, char *out, size_t size);
-
 /* Like snprintf, never fails: a message cut at `size` ends in "...". */
 void guard_format(char *out, size_t size, const char *format, ...) __attribute__((format(printf, 3, 4)));
 
 /* The offset of the first byte of `text` that is not strict UTF-8 (what CPython's decoder accepts: no
- * overlong forms, no surrogates, nothing above U+10FFFF), or -1 if all of it is.  FMI strings are UTF-8 (fmi2TypesPlatform.h,
- * fmi3PlatformTypes.h); pythonfmu's libraries decode them as such, and a name that does not decode crashed
- * the host (the instance name) or reached Python with its exception pending (a String value). */
+ * overlong forms, no surrogates, nothing above U+10FFFF), or -1 if all of it is.  FMI strings are UTF-8
+ * (fmi2TypesPlatform.h, fmi3PlatformTypes.h), and the Python side decodes them as such. */
 long guard_utf8_error(const char *text);
 
 /* ------------------------------------------------------------------------------- paths */
@@ -159,7 +188,8 @@ long guard_utf8_error(const char *text);
 int guard_is_directory(const char *path);
 int guard_is_file(const char *path); /* a readable file that is not a folder */
 /* A file URI (file:///p, file://localhost/p, file:/p), %XX decoded, or a plain path, to a path
- * without a trailing slash.  Returns 0 for a URI of another scheme or host. */
+ * without a trailing slash.  Returns 0 for a URI of another scheme or host, a malformed %-escape, a
+ * NUL byte, or a path that does not fit. */
 int guard_uri_to_path(const char *uri, char *path, size_t size);
 
 #endif

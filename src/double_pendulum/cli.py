@@ -30,6 +30,7 @@ from pathlib import Path
 from . import __version__
 from .component.variables import INTERFACES
 from .fmu.build import DEFAULT_FMU_PATH, build_all
+from .fmu.loader import LoaderUnavailable
 from .runs.interrupts import acknowledge, handling_interrupts, interrupted
 from .runs.lines import failed_line, header_line, wrote_line
 from .scenarios import SCENARIOS
@@ -157,6 +158,8 @@ def _load_fmu(path: str, rebuild: bool):
         print(f"building the FMUs next to {fmu} (missing or older than the sources) ...", flush=True)
         try:
             build_all(fmu)
+        except LoaderUnavailable as error:
+            raise CliError(f"cannot build the FMUs: {error}") from None
         except OSError as error:
             raise CliError(f"cannot build the FMU at {fmu}: {error.strerror or error} "
                            "(pass --fmu PATH to build it elsewhere)") from None
@@ -232,6 +235,8 @@ def cmd_build(args: argparse.Namespace) -> int:
     print(f"building the FMUs next to {args.output} ...", flush=True)
     try:
         paths = build_all(args.output)
+    except LoaderUnavailable as error:
+        raise CliError(f"cannot build the FMUs: {error}") from None
     except OSError as error:
         raise CliError(f"cannot build the FMUs at {args.output}: {error.strerror or error}") from None
     for path in paths:

@@ -17,13 +17,13 @@ modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the buil
 * states each output's direct dependencies on the inputs under ``ModelStructure/Outputs``
   (the interface's ``output_dependencies``; ``dependencies=""`` for none),
   which pythonfmu leaves open (open means: depends on every input);
-* on Linux, makes the FMU's binary the loader and guard of :mod:`double_pendulum.fmu.loader`
-  (compiled from source with the FMU's GUID; pythonfmu's library goes beside it), so the FMU runs
-  in hosts that are not Python and answers every FMI call as the standard says, and records the
-  building CPython in ``resources/python.cfg``;
-* writes ``resources/bundle.json`` (a hash of the bundled code, and whether the guard is the
-  binary), which makes the FMU import its bundled code under private names
-  (``fmu_src/slave_common.py``);
+* makes the FMU's one binary the loader of :mod:`double_pendulum.fmu.loader` (compiled from source
+  with the FMU's GUID), which calls the Python side itself (pythonfmu's binaries are left out), so
+  the FMU runs in hosts that are not Python and answers every FMI call as the standard says, and
+  records the building CPython in ``resources/python.cfg``;
+* writes ``resources/identity.cfg`` (model, GUID, entry module: the loader refuses another FMU's
+  resources) and ``resources/bundle.json`` (a hash of the bundled code), which makes the FMU import
+  its bundled code under private names (``fmu_src/slave_common.py``);
 * bakes in the start values it is given (:mod:`double_pendulum.fmu.presets`);
 * adds what a tool shows of the FMU: ``documentation/``, the icon and ``terminalsAndIcons/``
   (:mod:`double_pendulum.fmu.presentation`).
@@ -49,7 +49,7 @@ from typing import Any
 from xml.etree import ElementTree as ET
 
 from ..component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
-from . import bundle, elf_needs, loader, presets
+from . import bundle, loader, presets
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
@@ -213,27 +213,10 @@ def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
         return cached, cfile.read_bytes()
 
 
-@functools.cache
-def _loader_binary(fmi_version: int, defines: tuple[tuple[str, str], ...]) -> bytes | None:
-    """The compiled loader for one FMU (``defines``: its GUID, ...), or None (said once on stderr) where it
-    cannot be built."""
-    try:
-        return loader.compiled_loader(fmi_version, dict(defines))
-    except loader.LoaderUnavailable as why:
-        _note(str(why))
-        return None
-
-
 def instantiation_token(model_description: bytes) -> str:
     """The FMU's GUID (FMI 2) or instantiation token (FMI 3), which the guard checks at instantiation."""
     root = ET.fromstring(model_description)
     return root.get("guid") or root.get("instantiationToken") or ""
-
-
-@functools.cache
-def _note(message: str) -> None:
-    """Say ``message`` on stderr, once per process (both FMI versions' builds meet the same missing compiler)."""
-    print(f"note: {message}", file=sys.stderr, flush=True)
 
 
 def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], bytes], fmi_version: int = 2,
@@ -253,19 +236,16 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
                                                                start_values or {})
     if start_values:
         files[presets.PRESET_FILE] = presets.preset_file(start_values)
-    platform = loader.PLATFORMS[fmi_version]
-    binary = f"binaries/{platform}/{model_identifier}.so"
-    loader_binary = None
-    if binary in files:
-        guard_defines = {"MODEL_IDENTIFIER": model_identifier,
-                         "FMU_GUID": instantiation_token(files["modelDescription.xml"]),
-                         "BACKEND_NEEDS": elf_needs.describe(files[binary]), **(defines or {})}
-        loader_binary = _loader_binary(fmi_version, tuple(sorted(guard_defines.items())))
-    if loader_binary is not None:  # the library's binary goes behind the loader
-        files[f"binaries/{platform}/{loader.BACKEND_NAMES[fmi_version]}"] = files[binary]
-        files[binary] = loader_binary
-        files[f"resources/{loader.CONFIG_NAME}"] = loader.python_record().encode()
-    files[BUNDLE_FILE] = json.dumps({"id": identity, "guard": loader_binary is not None}).encode()
+    token = instantiation_token(files["modelDescription.xml"])
+    # The FMI library's binaries (pythonfmu's C++ layer, for every platform it ships) are left out: the
+    # FMU's one binary is the loader, built here from source, which calls the Python side itself.
+    files = {name: data for name, data in files.items() if not name.startswith("binaries/")}
+    binary = f"binaries/{loader.PLATFORMS[fmi_version]}/{model_identifier}.so"
+    files[binary] = loader.compiled_loader(fmi_version, {"MODEL_IDENTIFIER": model_identifier, "FMU_GUID": token,
+                                                         **(defines or {})})
+    files[f"resources/{loader.CONFIG_NAME}"] = loader.python_record().encode()
+    files[bundle.IDENTITY_FILE] = bundle.identity_record(model_identifier, token, identity)
+    files[BUNDLE_FILE] = json.dumps({"id": identity}).encode()
     from .presentation import presentation_files  # here: matplotlib and numpy only when building
 
     files.update(presentation_files(model_identifier, fmi_version, files, start_values))

@@ -4,8 +4,10 @@ Every module an FMU runs is imported under a private name (``fmu_src/slave_commo
 so that FMUs of another author with the same model identifier, an older build of this one, or a
 host that imports ``double_pendulum`` or ``pythonfmu`` itself never meet it in ``sys.modules``::
 
-    resources/slavemodule.txt              _dp_fmu_<id>_<Model>: what the FMI library imports
-    resources/_dp_fmu_<id>_<Model>.py      the entry module (ENTRY_FMI2 / ENTRY_FMI3 below)
+    resources/slavemodule.txt              _dp_fmu_<id>_<Model>: the entry module (pythonfmu's convention)
+    resources/_dp_fmu_<id>_<Model>.py      the entry module (ENTRY_FMI2 / ENTRY_FMI3 below): its
+                                           ``fmi_bridge`` is what the FMU's binary calls
+    resources/identity.cfg                 the model, its GUID and the entry module (identity_record)
     resources/_dp_fmu_<id>_adapters/       fmu_src's adapters, a package (ADAPTERS)
     resources/double_pendulum/             the runtime, imported as _dp_fmu_<id>
     resources/pythonfmu/ or pythonfmu3/    the FMI library's Python part
@@ -28,8 +30,9 @@ BUILDER_ADAPTERS = "adapters"  # the adapters' folder as the builder writes it i
 # fmu_src's modules each FMI version's FMUs bundle: every FMI 2 FMU carries all FMI 2 adapters, so
 # that DoublePendulum and Suspension bundle the same code (one id, one private package).
 ADAPTERS = {
-    2: ("__init__.py", "slave_common.py", "double_pendulum_slave.py", *(f"{name}.py" for name in INTERFACES)),
-    3: ("__init__.py", "slave_common.py", "DoublePendulumFmi3.py"),
+    2: ("__init__.py", "fmi_bridge.py", "slave_common.py", "double_pendulum_slave.py",
+        *(f"{name}.py" for name in INTERFACES)),
+    3: ("__init__.py", "fmi_bridge.py", "slave_common.py", "DoublePendulumFmi3.py"),
 }
 ADAPTER_MODULES = {2: {name: name for name in INTERFACES}, 3: {"DoublePendulum": "DoublePendulumFmi3"}}
 
@@ -43,22 +46,28 @@ another extraction of the same FMU, is instantiated (fmpy extracts an FMU anew f
 from . import {modules}  # noqa: F401
 '''
 
-ENTRY_FMI2 = '''"""Entry module of {model}.fmu, which pythonfmu imports (written by double_pendulum.fmu.bundle)."""
+ENTRY_FMI2 = '''"""Entry module of {model}.fmu, which its binary imports (written by double_pendulum.fmu.bundle)."""
 
 from {package}.{adapter} import {model}
-from {package}.slave_common import entry_module_executed
+from {package}.fmi_bridge import Bridge
 
-{model} = entry_module_executed(globals(), locals(), {model})  # pythonfmu runs this file twice: see there
+fmi_bridge = Bridge({model}, fmi_version=2)
 '''
 
-ENTRY_FMI3 = '''"""Entry module of {model}.fmu, which pythonfmu3 imports (written by double_pendulum.fmu.bundle)."""
+ENTRY_FMI3 = '''"""Entry module of {model}.fmu, which its binary imports (written by double_pendulum.fmu.bundle)."""
 
 from {package} import {adapter} as _adapter
+from {package}.fmi_bridge import Bridge
 
 
 class {model}(_adapter.{model}, _adapter.Fmi3SlaveBase):
-    """The adapter's class. pythonfmu3 finds an FMU's class by a line like the one above."""
+    """The adapter's class. pythonfmu3's builder finds an FMU's class by a line like the one above."""
+
+
+fmi_bridge = Bridge({model}, fmi_version=3)
 '''
+
+IDENTITY_FILE = "resources/identity.cfg"
 
 
 def builder_stem(model_identifier: str) -> str:
@@ -96,8 +105,7 @@ def bundled_entries(files: dict[str, bytes], model_identifier: str,
     """The FMU's files with the builder's layout turned into the private one (see the top of this module),
     and the bundle's id."""
     identity = bundle_id(files, model_identifier)
-    package = f"{PRIVATE_MARK}{identity}_adapters"
-    entry = f"{PRIVATE_MARK}{identity}_{model_identifier}"
+    package, entry = package_name(identity), entry_name(identity, model_identifier)
     adapters_folder = f"resources/{BUILDER_ADAPTERS}/"
     out: dict[str, bytes] = {}
     for name, data in files.items():
@@ -112,6 +120,25 @@ def bundled_entries(files: dict[str, bytes], model_identifier: str,
         out[name] = data
     out[f"resources/{entry}.py"] = entry_source(model_identifier, fmi_version, package).encode()
     return out, identity
+
+
+def package_name(identity: str) -> str:
+    """The private name of the adapters' package of the bundle ``identity``."""
+    return f"{PRIVATE_MARK}{identity}_adapters"
+
+
+def entry_name(identity: str, model_identifier: str) -> str:
+    """The private name of the entry module of ``model_identifier`` in the bundle ``identity``."""
+    return f"{PRIVATE_MARK}{identity}_{model_identifier}"
+
+
+def identity_record(model_identifier: str, token: str, identity: str) -> bytes:
+    """``resources/identity.cfg``: whose resources these are, read by the FMU's binary, which refuses
+    another FMU's resources folder (fmu_src/loader/guard.c), and what it imports: the adapters' package
+    (``resources/<package>/``) and the entry module (``resources/<entry>.py``)."""
+    package, entry = package_name(identity), entry_name(identity, model_identifier)
+    return (f"# The FMU these resources belong to (written by double_pendulum.fmu.bundle).\n"
+            f"model={model_identifier}\ntoken={token}\npackage={package}\nentry={entry}\n").encode()
 
 
 def entry_module(files: dict[str, bytes]) -> str:

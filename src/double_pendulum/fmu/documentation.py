@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import html
 import importlib
-import json
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import fields
@@ -149,26 +148,16 @@ def about_table(root: ET.Element, start_values: Mapping[str, object]) -> str:
     return "<table>\n" + "\n".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in rows) + "\n</table>"
 
 
-def _role(name: str, guarded: bool) -> str:
-    """What a binary of the FMU is, by its file name (``guarded``: the build compiled the loader)."""
+def _role(name: str) -> str:
+    """What a binary of the FMU is, by its file name."""
     file = name.rpartition("/")[2]
     if file.startswith("container_fmu"):
         return "fmpy's container binary (no Python)"
-    if file.startswith("libpythonfmu"):
-        return "the FMI library's binary (pythonfmu), behind the guard"
-    if file.endswith(".so") and not guarded:
-        return "pythonfmu's plain library: runs only in a Python host (built without a C compiler)"
     if file.endswith(".so"):
-        return "the loader and guard: starts a CPython >= 3.11 with a shared libpython (below)"
+        return "the loader: the FMI functions; starts a CPython >= 3.11 with a shared libpython (below)"
     if file.endswith(".dll"):
-        return "pythonfmu's binary for Windows: links python3.dll, a CPython >= 3.11 must be on the DLL search path"
-    return "binary for macOS"
-
-
-def _guarded(binary: str, bundles: Mapping[str, dict]) -> bool:
-    """Whether the FMU (or the container's component) holding ``binary`` has the loader as its binary."""
-    prefix = binary.rpartition("binaries/")[0]
-    return bool(bundles.get(prefix, {}).get("guard", True))
+        return "fmpy's container binary for Windows"
+    return "fmpy's container binary for macOS"
 
 
 def _needs(data: bytes) -> str:
@@ -179,12 +168,10 @@ def machine_section(files: Mapping[str, bytes], model: str) -> str:
     """What a target machine needs: every binary in the FMU (a container's components too), the CPython
     the build recorded, and how the loader finds a Python (its docstring)."""
     rows = []
-    bundles = {name.rpartition("resources/")[0]: json.loads(data) for name, data in files.items()
-               if name.endswith("resources/bundle.json")}
     for name in sorted(files):
         parts = name.split("/")
         if "binaries" in parts and name.endswith((".so", ".dll", ".dylib")):
-            role = _role(name, _guarded(name, bundles))
+            role = _role(name)
             rows.append(f"<tr><td><code>{html.escape(name)}</code></td><td>{html.escape(role)}</td>"
                         f"<td>{_needs(files[name])}</td></tr>")
     record = [f for f in sorted(files) if f.endswith("resources/python.cfg")]

@@ -1,24 +1,24 @@
-"""The FMU's binary on Linux: a small C loader and guard, compiled from source when the FMU is built.
+"""The FMU's binary on Linux: a small C loader, compiled from source when the FMU is built.
 
-pythonfmu's Linux library (and pythonfmu3's, for FMI 3) calls the CPython C API without linking
-libpython, so on its own it runs only inside a Python process, and it answers misuse with crashes,
-leaks and fmi2Fatal. The loader (``fmu_src/loader/``: ``python_runtime.c`` finds, loads and starts
-a CPython; ``fmi2_guard.c`` and ``fmi3_guard.c`` stand in front of the FMI library with the
-standard's state machine and checks, sharing ``guard.c``) becomes the FMU's
-``binaries/<platform>/<model identifier>.so``; the FMI library's own lies beside it
-(:data:`BACKEND_NAMES`). Each FMU's loader is compiled with its GUID (``FMU_GUID``) and what the
-library's binary needs of the system (``BACKEND_NEEDS``, for the message where it cannot load).
-In a Python host the loader uses the host's interpreter and changes
-nothing; in any other host it finds a CPython >= 3.11 with a shared libpython: the one named by
-``DOUBLE_PENDULUM_FMU_PYTHON``, else the one the FMU was built with (``resources/python.cfg``,
-:func:`python_record`), else ``python3`` on PATH (docs/fmu.md, "Use the FMU in other FMI tools").
-That Python needs nothing installed: the loader starts it without ``site`` (no site-packages), and
-everything the FMU runs in it (the model code and pythonfmu's Python part) is bundled under
-``resources/`` and imports only the standard library.
+The loader (``fmu_src/loader/``) is the FMU's whole native side: ``fmi2_guard.c`` and ``fmi3_guard.c``
+give the FMI functions with the standard's state machine and checks, sharing ``guard.c`` (instances,
+instantiation, logging), ``fmu_state.c`` (FMU states) and ``pointer_set.c``; ``bridge.c`` calls the
+FMU's Python side (``fmu_src/fmi_bridge.py``) through CPython's C API, and ``python_runtime.c``
+finds, loads and starts a CPython where the host has none. No FMI library's binary is involved
+(docs/architecture.md says why pythonfmu's C++ layer was replaced). The loader becomes the FMU's
+``binaries/<platform>/<model identifier>.so``, compiled with the FMU's GUID (``FMU_GUID``).
+In a Python host the loader uses the host's interpreter and changes nothing; in any other host it
+finds a CPython >= 3.11 with a shared libpython: the one named by ``DOUBLE_PENDULUM_FMU_PYTHON``,
+else the one the FMU was built with (``resources/python.cfg``, :func:`python_record`), else
+``python3`` on PATH (docs/fmu.md, "Use the FMU in other FMI tools"). That Python needs nothing
+installed: the loader starts it without ``site`` (no site-packages), and everything the FMU runs in
+it (the model code and pythonfmu's Python part) is bundled under ``resources/`` and imports only the
+standard library.
 
 The loader is compiled with the system C compiler (``$CC``, else ``cc``, ``gcc`` or ``clang``)
-against the FMI 2 and FMI 3 headers fmpy ships (``fmpy/c-code``); nothing compiled is committed. Without a
-compiler the FMU keeps pythonfmu's plain library (Python hosts only) and the build says so once.
+against the FMI 2 and FMI 3 headers fmpy ships (``fmpy/c-code``), with every warning an error;
+nothing compiled is committed. Building the FMUs needs that compiler and Linux: elsewhere the build
+stops with one line saying so (:class:`LoaderUnavailable`).
 """
 
 from __future__ import annotations
@@ -35,24 +35,24 @@ import tempfile
 from pathlib import Path
 
 LOADER_FOLDER = "loader"  # in fmu_src/ (installed as double_pendulum.adapters)
-LOADER_SOURCES = {2: ("python_runtime.c", "guard.c", "fmi2_guard.c"),
-                  3: ("python_runtime.c", "guard.c", "fmi3_guard.c")}
-LOADER_HEADERS = ("python_runtime.h", "guard.h", "glibc_compat.h")
-# The FMI library's own binary in the FMU, beside the loader: pythonfmu's (FMI 2), pythonfmu3's (FMI 3).
-BACKEND_NAMES = {2: "libpythonfmu-export.so", 3: "libpythonfmu3-export.so"}
-# The one platform whose library needs the loader, as each FMI version names its binaries folder.
+_SHARED_SOURCES = ("python_runtime.c", "pointer_set.c", "guard.c", "fmu_state.c", "bridge.c")
+LOADER_SOURCES = {2: (*_SHARED_SOURCES, "fmi2_guard.c"), 3: (*_SHARED_SOURCES, "fmi3_guard.c")}
+LOADER_HEADERS = ("python_runtime.h", "guard.h", "bridge.h", "glibc_compat.h")
+# The platform of the loader, as each FMI version names its binaries folder.
 PLATFORMS = {2: "linux64", 3: "x86_64-linux"}
-BACKEND_NAME, PLATFORM = BACKEND_NAMES[2], PLATFORMS[2]
+PLATFORM = PLATFORMS[2]
 CONFIG_NAME = "python.cfg"  # in resources/: the CPython the FMU was built with
 OVERRIDE_VARIABLE = "DOUBLE_PENDULUM_FMU_PYTHON"
-CFLAGS = ("-shared", "-fPIC", "-O2", "-std=gnu11", "-fvisibility=hidden")
+CFLAGS = ("-shared", "-fPIC", "-O2", "-std=gnu11", "-fvisibility=hidden", "-Wall", "-Wextra", "-Werror",
+          "-Wformat-truncation=2")
 # libdl and libpthread by file name and as needed: where the old glibc versions the loader binds
 # (glibc_compat.h) live on systems older than glibc 2.34 (there -ldl would find an empty libdl.a).
 LIBS = ("-Wl,--no-as-needed", "-l:libdl.so.2", "-l:libpthread.so.0", "-l:libm.so.6")
 
 
 class LoaderUnavailable(RuntimeError):
-    """The loader cannot be built here (no C compiler, or not Linux); the message says why in one line."""
+    """The loader cannot be built here (no C compiler, or not Linux): the FMUs cannot be built; the message
+    says why in one line."""
 
 
 def loader_sources(fmi_version: int = 2) -> list[Path]:
@@ -96,19 +96,19 @@ def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tupl
 
 def compiled_loader(fmi_version: int, defines: dict[str, str]) -> bytes:
     """The FMI ``fmi_version`` loader's shared library for this machine and one FMU (compiled once per
-    process, compiler, source version and ``defines``: the C string macros ``MODEL_IDENTIFIER``,
-    ``FMU_GUID``, ``BACKEND_NEEDS``, and for FMI 3 the number ``N_CONTINUOUS_STATES``).
+    process, compiler, source version and ``defines``: the C string macros ``MODEL_IDENTIFIER`` and
+    ``FMU_GUID``, and for FMI 3 the number ``N_CONTINUOUS_STATES``).
 
     Raises :class:`LoaderUnavailable` where it cannot be built (no C compiler; not Linux), and
     ``RuntimeError`` with the compiler's output if compiling fails.
     """
     if not sys.platform.startswith("linux"):
-        raise LoaderUnavailable(f"the loader is for Linux; on {sys.platform} the FMU keeps pythonfmu's binary")
+        raise LoaderUnavailable(f"the FMUs' binary (a C loader) is for Linux; they cannot be built on {sys.platform}")
     compiler = c_compiler()
     if compiler is None:
         raise LoaderUnavailable(
-            "no C compiler found ($CC, cc, gcc or clang): the FMUs keep the FMI library's plain binary, "
-            "which runs only in Python hosts (docs/fmu.md)"
+            "no C compiler found ($CC, cc, gcc or clang): building the FMUs compiles their binary from "
+            "source (fmu_src/loader/); install one (e.g. apt-get install gcc) and build again"
         )
     bad = {name: value for name, value in defines.items() if any(c in str(value) for c in '"\\\n')}
     if bad:

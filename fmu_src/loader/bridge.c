@@ -1,0 +1,277 @@
+/* The C half of the bridge to the FMU's Python side (see bridge.h). */
+#define _GNU_SOURCE
+#include "glibc_compat.h"
+
+#include "bridge.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define PY_FILE_INPUT 257 /* Py_file_input */
+
+/* Load the FMU's package `package` (the folder resources/<package>/) and its entry module `entry`
+ * (resources/<entry>.py) under their own (private) names, once per process, and take the entry's
+ * bridge.  Nothing is put on sys.path; the modules stay in sys.modules, so an FMU unloaded and loaded
+ * again, or extracted again elsewhere, finds them there.  One thread at a time loads (the lock lives in
+ * sys.modules, shared by every FMU of this project): another sees a module only once it is complete. */
+static const char BOOTSTRAP[] =
+    "import sys, threading, types\n"
+    "loading = sys.modules.setdefault('_dp_fmu_loading', types.ModuleType('_dp_fmu_loading'))\n"
+    "with vars(loading).setdefault('lock', threading.RLock()):\n"
+    "    for name, path, folder in ((package, resources + '/' + package + '/__init__.py', [resources + '/' + package]),\n"
+    "                               (entry, resources + '/' + entry + '.py', None)):\n"
+    "        if name not in sys.modules:\n"
+    "            import importlib.util\n"
+    "            spec = importlib.util.spec_from_file_location(name, path, submodule_search_locations=folder)\n"
+    "            module = importlib.util.module_from_spec(spec)\n"
+    "            sys.modules[name] = module\n"
+    "            try:\n"
+    "                spec.loader.exec_module(module)\n"
+    "            except BaseException:\n"
+    "                del sys.modules[name]\n"
+    "                raise\n"
+    "    bridge = sys.modules[entry].fmi_bridge\n";
+
+/* ----------------------------------------------------------------------------- messages */
+
+typedef struct {
+    int status;
+    char *category, *text;
+} message;
+
+typedef struct {
+    message *items;
+    size_t n, capacity;
+    char failure[1024]; /* what went wrong in the bridge itself ("" if nothing) */
+    int interrupted;
+} answer_notes;
+
+static void note_failure(answer_notes *notes, const char *format, ...) __attribute__((format(printf, 2, 3)));
+static void note_failure(answer_notes *notes, const char *format, ...) {
+    if (notes->failure[0]) return; /* the first one says it */
+    char text[sizeof notes->failure];
+    va_list args;
+    va_start(args, format);
+    int n = vsnprintf(text, sizeof text, format, args);
+    va_end(args);
+    guard_format(notes->failure, sizeof notes->failure, "%s", n >= 0 ? text : "unknown failure");
+}
+
+static void add_message(answer_notes *notes, int status, const char *category, const char *text) {
+    if (notes->n == notes->capacity) {
+        size_t capacity = notes->capacity ? 2 * notes->capacity : 4;
+        message *items = realloc(notes->items, capacity * sizeof *items);
+        if (!items) return note_failure(notes, "out of memory for the FMU's messages");
+        notes->items = items, notes->capacity = capacity;
+    }
+    message *m = &notes->items[notes->n];
+    m->status = status;
+    m->category = strdup(category ? category : "");
+    m->text = strdup(text ? text : "");
+    if (!m->category || !m->text) {
+        free(m->category), free(m->text);
+        return note_failure(notes, "out of memory for the FMU's messages");
+    }
+    notes->n++;
+}
+
+/* Give the messages to the host's logger (no lock held: the GIL is released) and free them. */
+static void emit_notes(guard_instance *g, answer_notes *notes) {
+    for (size_t k = 0; k < notes->n; k++) {
+        message *m = &notes->items[k];
+        char line[4200];
+        int status = m->status < STATUS_OK || m->status > STATUS_ERROR ? STATUS_ERROR : m->status;
+        if (status >= STATUS_DISCARD)
+            guard_format(line, sizeof line, "%s: %s", g->function ? g->function : "FMU", m->text);
+        else
+            guard_format(line, sizeof line, "%s", m->text);
+        guard_emit(g, status, m->category, line);
+        free(m->category), free(m->text);
+    }
+    free(notes->items);
+    notes->items = NULL, notes->n = notes->capacity = 0;
+    if (notes->failure[0]) {
+        char line[sizeof notes->failure + 200];
+        guard_format(line, sizeof line, "%s: %s", g->function ? g->function : "FMU", notes->failure);
+        guard_emit(g, STATUS_ERROR, "logStatusError", line);
+    }
+}
+
+/* ----------------------------------------------------------------------------- with the GIL */
+
+/* The pending Python exception in words ("ValueError: ..."), cleared; notes a KeyboardInterrupt. */
+static void take_exception(const python_api *py, answer_notes *notes, const char *what) {
+    if (!py->Err_Occurred()) return note_failure(notes, "%s failed without saying why", what);
+    PyObject *type = NULL, *value = NULL, *traceback = NULL;
+    py->Err_Fetch(&type, &value, &traceback);
+    PyObject *name = type ? py->Object_GetAttrString(type, "__name__") : NULL;
+    PyObject *text = value ? py->Object_Str(value) : NULL;
+    const char *name_text = name ? py->Unicode_AsUTF8AndSize(name, NULL) : NULL;
+    const char *value_text = text ? py->Unicode_AsUTF8AndSize(text, NULL) : NULL;
+    py->Err_Clear(); /* whatever describing it raised */
+    if (name_text && strcmp(name_text, "KeyboardInterrupt") == 0) notes->interrupted = 1;
+    note_failure(notes, "%s raised %s: %s", what, name_text ? name_text : "an exception",
+                 value_text ? value_text : "(no message)");
+    if (name) py->DecRef(name);
+    if (text) py->DecRef(text);
+    if (type) py->DecRef(type);
+    if (value) py->DecRef(value);
+    if (traceback) py->DecRef(traceback);
+}
+
+/* A str item of a tuple, as UTF-8 (borrowed from the object), or NULL (no exception left). */
+static const char *text_item(const python_api *py, PyObject *tuple, ssize_t k) {
+    PyObject *item = py->Tuple_GetItem(tuple, k);
+    const char *text = item ? py->Unicode_AsUTF8AndSize(item, NULL) : NULL;
+    if (!text) py->Err_Clear();
+    return text;
+}
+
+/* Read the answer (status, payload, messages) into `payload` and `notes`; returns the status. */
+static int take_answer(const python_api *py, PyObject *answer, bridge_payload payload, answer_notes *notes,
+                       const char *method) {
+    if (py->Tuple_Size(answer) != 3) {
+        py->Err_Clear();
+        note_failure(notes, "the FMU's Python side answered %s with something that is not (status, payload, "
+                            "messages)", method);
+        return STATUS_ERROR;
+    }
+    long status = py->Long_AsLong(py->Tuple_GetItem(answer, 0));
+    if (status == -1 && py->Err_Occurred()) py->Err_Clear(), status = STATUS_ERROR;
+    PyObject *messages = py->Tuple_GetItem(answer, 2);
+    ssize_t n = messages ? py->Tuple_Size(messages) : -1;
+    for (ssize_t k = 0; k < n; k++) {
+        PyObject *m = py->Tuple_GetItem(messages, k);
+        long level = m && py->Tuple_Size(m) == 3 ? py->Long_AsLong(py->Tuple_GetItem(m, 0)) : -1;
+        const char *category = level >= 0 ? text_item(py, m, 1) : NULL;
+        const char *text = category ? text_item(py, m, 2) : NULL;
+        if (text) add_message(notes, (int)level, category, text);
+        else py->Err_Clear(), note_failure(notes, "the FMU's Python side gave a malformed message");
+    }
+    if (n < 0) py->Err_Clear();
+    if (status == BRIDGE_INTERRUPTED) {
+        notes->interrupted = 1;
+        return STATUS_ERROR;
+    }
+    if (status < STATUS_OK || status > STATUS_ERROR) status = STATUS_ERROR;
+    if (status > STATUS_WARNING || payload.kind == PAYLOAD_NONE) return (int)status;
+    PyObject *value = py->Tuple_GetItem(answer, 1);
+    if (payload.kind == PAYLOAD_OBJECT) {
+        py->IncRef(value);
+        *payload.object = value;
+        return (int)status;
+    }
+    char *bytes = NULL;
+    ssize_t size = 0;
+    if (!value || py->Bytes_AsStringAndSize(value, &bytes, &size) != 0) {
+        py->Err_Clear();
+        note_failure(notes, "the FMU's Python side answered %s without bytes", method);
+        return STATUS_ERROR;
+    }
+    if (payload.kind == PAYLOAD_EXACT) {
+        if ((size_t)size != payload.size) {
+            note_failure(notes, "the FMU's Python side answered %s with %zd bytes, not %zu", method, size,
+                         payload.size);
+            return STATUS_ERROR;
+        }
+        if (size) memcpy(payload.buffer, bytes, (size_t)size);
+        return (int)status;
+    }
+    char *copy = malloc((size_t)size + 1);
+    if (!copy) {
+        note_failure(notes, "out of memory (%zd bytes)", size);
+        return STATUS_ERROR;
+    }
+    memcpy(copy, bytes, (size_t)size);
+    copy[size] = '\0';
+    *payload.copy = copy, *payload.copy_size = (size_t)size;
+    return (int)status;
+}
+
+/* Call target.method(*arguments) with the GIL, then log what it said without it. */
+static int call_object(guard_instance *g, PyObject *target, bridge_payload payload, const char *method,
+                       const char *format, va_list args) {
+    const python_api *py = g->api;
+    answer_notes notes = {0};
+    int gil = py->GILState_Ensure();
+    PyObject *arguments = py->VaBuildValue(format, args);
+    PyObject *callable = arguments ? py->Object_GetAttrString(target, method) : NULL;
+    PyObject *answer = callable ? py->Object_Call(callable, arguments, NULL) : NULL;
+    int status = STATUS_ERROR;
+    if (answer) status = take_answer(py, answer, payload, &notes, method);
+    else take_exception(py, &notes, method);
+    if (answer) py->DecRef(answer);
+    if (callable) py->DecRef(callable);
+    if (arguments) py->DecRef(arguments);
+    py->GILState_Release(gil);
+    if (notes.interrupted) {
+        py->Err_SetInterrupt(); /* the host's interrupt, raised again for the host (async-signal-safe) */
+        status = STATUS_ERROR;
+    }
+    emit_notes(g, &notes);
+    return status;
+}
+
+int bridge_call(guard_instance *g, bridge_payload payload, const char *method, const char *format, ...) {
+    va_list args;
+    va_start(args, format);
+    int status = call_object(g, g->python, payload, method, format, args);
+    va_end(args);
+    return status;
+}
+
+static int call_bridge(guard_instance *g, PyObject *bridge, bridge_payload payload, const char *format, ...) {
+    va_list args;
+    va_start(args, format);
+    int status = call_object(g, bridge, payload, "instantiate", format, args);
+    va_end(args);
+    return status;
+}
+
+int bridge_instantiate(guard_instance *g, const python_api *py, const char *resources, const char *package,
+                       const char *entry, const char *interface, int visible, PyObject **instance) {
+    g->api = py;
+    answer_notes notes = {0};
+    int gil = py->GILState_Ensure();
+    PyObject *globals = py->Dict_New();
+    PyObject *resources_text = py->Unicode_FromString(resources);
+    PyObject *entry_text = py->Unicode_FromString(entry);
+    PyObject *package_text = py->Unicode_FromString(package);
+    PyObject *code = py->CompileString(BOOTSTRAP, "<double-pendulum-fmu loader>", PY_FILE_INPUT);
+    PyObject *bridge = NULL;
+    if (globals && resources_text && entry_text && package_text && code &&
+        py->Dict_SetItemString(globals, "resources", resources_text) == 0 &&
+        py->Dict_SetItemString(globals, "package", package_text) == 0 &&
+        py->Dict_SetItemString(globals, "entry", entry_text) == 0) {
+        PyObject *done = py->Eval_EvalCode(code, globals, globals);
+        if (done) {
+            py->DecRef(done);
+            bridge = py->Dict_GetItemString(globals, "bridge");
+            if (bridge) py->IncRef(bridge);
+        }
+    }
+    if (!bridge) take_exception(py, &notes, "loading the FMU's Python code");
+    if (globals) py->Dict_Clear(globals), py->DecRef(globals); /* no cycle through the module's namespace */
+    if (code) py->DecRef(code);
+    if (entry_text) py->DecRef(entry_text);
+    if (package_text) py->DecRef(package_text);
+    if (resources_text) py->DecRef(resources_text);
+    py->GILState_Release(gil);
+    if (!bridge) {
+        emit_notes(g, &notes);
+        return STATUS_ERROR;
+    }
+    bridge_payload payload = {PAYLOAD_OBJECT, NULL, 0, NULL, NULL, instance};
+    int status = call_bridge(g, bridge, payload, "(sssi)", resources, g->name, interface, visible);
+    bridge_release(g, bridge);
+    return status;
+}
+
+void bridge_release(guard_instance *g, PyObject *object) {
+    if (!object) return;
+    int gil = g->api->GILState_Ensure();
+    g->api->DecRef(object);
+    g->api->GILState_Release(gil);
+}

@@ -1,0 +1,55 @@
+/* The C half of the bridge to the FMU's Python side (its Python half: fmu_src/fmi_bridge.py).
+ *
+ * The loader calls the FMU's Python objects itself; no FMI library's binary stands between them.
+ * Every call has one shape: a method of the instance's Python object, given numbers, bytes or text,
+ * answers a tuple (status, payload, messages) and never raises (it catches everything, Ctrl-C too).
+ * Arrays cross as bytes of packed values (struct's native formats), strings as UTF-8 bytes.  The
+ * loader takes the GIL only for the call itself: the messages are copied out and given to the host's
+ * logger after the GIL is released, so no lock is held while the host's callback runs and a logger
+ * may call the FMU again. */
+#ifndef BRIDGE_H
+#define BRIDGE_H
+
+#include <stddef.h>
+
+#include "guard.h"
+#include "python_runtime.h"
+
+/* What a call gives back besides its status. */
+typedef enum {
+    PAYLOAD_NONE,   /* nothing (the payload is ignored) */
+    PAYLOAD_EXACT,  /* bytes of exactly `size` bytes, copied into `buffer` */
+    PAYLOAD_COPY,   /* bytes of any length, copied into a new malloc'ed `*copy` of `*copy_size` bytes */
+    PAYLOAD_OBJECT, /* the object itself: a new reference in `*object` (release with bridge_release) */
+} payload_kind;
+
+typedef struct {
+    payload_kind kind;
+    void *buffer;
+    size_t size;
+    char **copy;
+    size_t *copy_size;
+    PyObject **object;
+} bridge_payload;
+
+#define NO_PAYLOAD ((bridge_payload){PAYLOAD_NONE, NULL, 0, NULL, NULL, NULL})
+
+/* Python's statuses beyond FMI's: the call was interrupted (KeyboardInterrupt): an error, and the host's
+ * own interrupt is raised again once the call returns (a Python host then sees KeyboardInterrupt). */
+#define BRIDGE_INTERRUPTED 5
+
+/* Make the Python instance of g: load the FMU's package `package` and entry module `entry` from
+ * `resources` (once per process) and call the entry's bridge's instantiate(resources, name, interface,
+ * visible).  Returns the status; on success *instance is the new Python object. */
+int bridge_instantiate(guard_instance *g, const python_api *api, const char *resources, const char *package,
+                       const char *entry, const char *interface, int visible, PyObject **instance);
+
+/* Call method `method` of g's Python object with the arguments `format` (Py_BuildValue's, always a
+ * tuple: "()", "(dd)", "(y#)" with Py_ssize_t lengths ...) and take its payload.  Returns the status
+ * (FMI's numbers; an interruption is STATUS_ERROR); the messages have reached the host's logger. */
+int bridge_call(guard_instance *g, bridge_payload payload, const char *method, const char *format, ...);
+
+/* Release a Python object (an FMU state, an instance) of g's Python. */
+void bridge_release(guard_instance *g, PyObject *object);
+
+#endif
