@@ -28,6 +28,7 @@ jump, so ``energy_residual`` keeps measuring only the integration error.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import fields
@@ -46,10 +47,20 @@ from ..model.parameters import (
     SuspensionParameters,
     check_value,
 )
-from ..model.vector_field import Model, ModelConfig, ModelError, build_model, build_vector_field, energies
+from ..model.vector_field import (
+    Model,
+    ModelConfig,
+    ModelError,
+    build_model,
+    build_vector_field,
+    energies,
+    state_layout,
+)
 from ..solvers import Integrator, SolverError, make_integrator
+from . import state_check as check
 from .pivot_motion import PositionOnlyWatch, PositionSamples
 from .settings import InputSettings, SolverSettings
+from .state_check import StateError
 
 PARAMETER_GROUPS: tuple[type, ...] = (
     PendulumParameters,
@@ -114,6 +125,32 @@ def _parameter_rules() -> dict[str, tuple[str, str]]:
 def default_parameter_values() -> dict[str, Any]:
     """Return every parameter's default, by name."""
     return {f.name: f.default for group in PARAMETER_GROUPS for f in fields(group)}
+
+
+def parameter_group(cls: type, values: Mapping[str, Any]) -> Any:
+    """The parameter dataclass ``cls`` of the parameter ``values`` (by name)."""
+    return cls(**{f.name: values[f.name] for f in fields(cls)})
+
+
+def scene_config(values: Mapping[str, Any], inputs: bool) -> ModelConfig:
+    """The scene of the parameter ``values`` (by name), with inputs if ``inputs``."""
+    return ModelConfig(
+        pendulum=parameter_group(PendulumParameters, values),
+        air=parameter_group(AirDragParameters, values),
+        bearing=parameter_group(BearingParameters, values),
+        suspension=parameter_group(SuspensionParameters, values),
+        inputs=inputs,
+    )
+
+
+def _scene_size(values: Mapping[str, Any], inputs: bool) -> int:
+    """The number of states of :func:`scene_config` for checked ``values`` (builds parameter records, no model)."""
+    return _scene_size_of(tuple(values.items()), inputs)
+
+
+@functools.lru_cache(maxsize=64)
+def _scene_size_of(items: tuple[tuple[str, Any], ...], inputs: bool) -> int:
+    return state_layout(scene_config(dict(items), inputs)).size
 
 
 class LazyOutputs(Mapping[str, float]):
@@ -314,7 +351,7 @@ class DoublePendulumCoSimulation:
         self.integrator.restart(t, self._y)
 
     def _group(self, cls: type) -> Any:
-        return cls(**{f.name: self.values[f.name] for f in fields(cls)})
+        return parameter_group(cls, self.values)
 
     # ------------------------------------------------------------------ life cycle
     def set_start_time(self, start_time: float) -> None:
@@ -325,13 +362,7 @@ class DoublePendulumCoSimulation:
 
     def model_config(self, inputs: bool | None = None) -> ModelConfig:
         """The scene of the parameters set so far, with inputs if ``inputs`` (default: if driven)."""
-        return ModelConfig(
-            pendulum=self._group(PendulumParameters),
-            air=self._group(AirDragParameters),
-            bearing=self._group(BearingParameters),
-            suspension=self._group(SuspensionParameters),
-            inputs=self.driven if inputs is None else inputs,
-        )
+        return scene_config(self.values, self.driven if inputs is None else inputs)
 
     def initialise(self) -> None:
         """Validate all parameters together and start the integrator at the start time."""
@@ -423,6 +454,7 @@ class DoublePendulumCoSimulation:
         Restoring it with :meth:`set_state`, in this or a fresh instance, continues bit-identically:
         the integrator's hidden state (step size, last step, stage derivatives) is included.
         """
+        watch = self._position_watch
         return {
             "version": self.STATE_VERSION,
             "values": dict(self.values),
@@ -437,18 +469,36 @@ class DoublePendulumCoSimulation:
             "y": list(self._y),
             "pivot_samples": [list(s) for s in self._pivot_samples.samples] if self._pivot_samples else None,
             "position_watch": (
-                {"last": self._position_watch.last, "warned": self._position_watch.warned}
-                if self._position_watch else None
+                {"last": list(watch.last) if watch.last is not None else None, "warned": watch.warned}
+                if watch is not None else None
             ),
         }
 
+    @classmethod
+    def check_state(cls, state: Any, *, path: str = "state") -> None:
+        """Raise :class:`StateError` unless ``state`` is one :meth:`get_state` can return; build and change nothing.
+
+        Checks the keys (none missing, none extra), the types, lengths and finiteness of every entry,
+        the parameters by their rules and names, and, initialised, the state's fit to its scene: ``y``
+        and the integrator's state (its hidden state included) sized for the scene's states, the
+        input hold and pivot readers as driven and ``pivot_input`` have them. Details:
+        :func:`~double_pendulum.component.state_check.cosimulation_state`. The message names the entry
+        by its path from ``path`` and shows its value.
+        """
+        check.cosimulation_state(path, state, cls.STATE_VERSION, cls.RULES, _scene_size)
+
     def set_state(self, state: dict[str, Any]) -> None:
-        """Restore a state from :meth:`get_state` (FMI fmi2SetFMUstate)."""
-        if state.get("version") != self.STATE_VERSION:
-            raise CoSimulationError(f"unsupported FMU state version {state.get('version')!r}")
+        """Restore a state from :meth:`get_state` (FMI fmi2SetFMUstate).
+
+        :meth:`check_state` first: a state it refuses (:class:`StateError`) changes nothing, nor does
+        one whose parameters the rebuild refuses (the attributes are put back).
+        """
+        self.check_state(state)
+        with check.restored_on_failure(self):
+            self._restore(state)
+
+    def _restore(self, state: dict[str, Any]) -> None:
         values = dict(state["values"])
-        if set(values) != set(self.values):
-            raise CoSimulationError("FMU state does not match this model's parameters")
         # A rollback to a state of this same model (coupling iterations) keeps the model and the integrator
         # object: the integrator's complete state is restored below, so only the rebuild is saved.
         model, integrator = self.model, self.integrator
@@ -520,5 +570,6 @@ __all__ = [
     "PARAMETER_GROUPS",
     "ParameterError",
     "SolverError",
+    "StateError",
     "default_parameter_values",
 ]

@@ -43,27 +43,15 @@ from __future__ import annotations
 from typing import Any
 
 from ..model import inputs as _inputs
-from ..model import parameters as _parameters
 from ..model import vector_field as _vector_field
 from . import cosimulation as _cosimulation
+from . import state_check as _state_check
 
 InputHold, InputValues, INPUT_NAMES = _inputs.InputHold, _inputs.InputValues, _inputs.INPUT_NAMES
 INPUT_ZEROS = _inputs.ZERO_INPUTS
 
 
-def _every_state() -> tuple[str, ...]:
-    """The states of the scene with every mechanism and the inputs on (``state_layout``'s order)."""
-    p = _parameters
-    scene = _vector_field.ModelConfig(
-        air=p.AirDragParameters(air_drag=True),
-        bearing=p.BearingParameters(bearing_friction=True, bearing_drag=True),
-        suspension=p.SuspensionParameters(suspension=True),
-        inputs=True,
-    )
-    return _vector_field.state_layout(scene).names
-
-
-STATES: tuple[str, ...] = _every_state()
+STATES: tuple[str, ...] = _vector_field.every_state()
 # The suspension's states are not the outputs xs, ys, vxs, vys: those report the prescribed pivot
 # (an input) in a direction without a suspension state. These are the suspension mass's own.
 LOCAL_STATES = {"xs": "suspension.x", "vxs": "suspension.vx", "ys": "suspension.y", "vys": "suspension.vy"}
@@ -199,8 +187,21 @@ class PendulumStates:
         return {"time": self.time, "x": list(self.x), "evaluations": self.evaluations, "known": dict(self._known),
                 "instant": self._instant, "left": dict(self._left), "set_here": sorted(self._set_here)}
 
+    @classmethod
+    def check_state(cls, state: Any, *, path: str = "state") -> None:
+        """Raise :class:`~double_pendulum.component.state_check.StateError` unless ``state`` is one
+        :meth:`get_state` can return; build and change nothing.
+
+        Checks the keys (none missing, none extra), the types and lengths of every entry, the inputs
+        finite and the input names; the time and the continuous states, which the host sets, may be
+        any float. Details: :func:`~double_pendulum.component.state_check.model_exchange_state`.
+        The message names the entry by its path from ``path`` and shows its value.
+        """
+        _state_check.model_exchange_state(path, state)
+
     def set_state(self, state: dict[str, Any]) -> None:
-        """Restore :meth:`get_state`."""
+        """Restore :meth:`get_state`; :meth:`check_state` first, so a state it refuses changes nothing."""
+        self.check_state(state)
         self.time, self.x, self.evaluations = float(state["time"]), [float(v) for v in state["x"]], state["evaluations"]
         self._known, self._instant = dict(state["known"]), float(state["instant"])
         self._left, self._set_here = dict(state["left"]), set(state["set_here"])

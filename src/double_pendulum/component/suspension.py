@@ -20,6 +20,7 @@ from typing import Any
 from ..model.parameters import SuspensionLoad, SuspensionParameters, check_value
 from ..model.suspension import PARAMETER_NAMES, STATE_NAMES, SuspensionModel
 from ..solvers import Integrator, SolverError, make_integrator
+from . import state_check as check
 from .cosimulation import CoSimulationError, check_step_call, checked_parameter
 from .settings import SolverSettings
 
@@ -136,10 +137,28 @@ class SuspensionCoSimulation:
             "integrator": self.integrator.get_state() if self.integrator is not None else None,
         }
 
+    @classmethod
+    def check_state(cls, state: Any, *, path: str = "state") -> None:
+        """Raise :class:`~.state_check.StateError` unless ``state`` is one :meth:`get_state` can return; change nothing.
+
+        Checks the keys (none missing, none extra), the types, lengths and finiteness of every entry,
+        the parameters by their rules, the solver by name and the integrator's state (its hidden
+        state included) for the six states. Details:
+        :func:`~double_pendulum.component.state_check.suspension_state`. The message names the entry
+        by its path from ``path`` and shows its value.
+        """
+        check.suspension_state(path, state, cls.STATE_VERSION, cls.RULES)
+
     def set_state(self, state: dict[str, Any]) -> None:
-        """Restore a state from :meth:`get_state`; the run continues bit-identically."""
-        if state.get("version") != self.STATE_VERSION:
-            raise CoSimulationError(f"unsupported FMU state version {state.get('version')!r}")
+        """Restore a state from :meth:`get_state`; the run continues bit-identically.
+
+        :meth:`check_state` first: a state it refuses (:class:`~.state_check.StateError`) changes nothing.
+        """
+        self.check_state(state)
+        with check.restored_on_failure(self):
+            self._restore(state)
+
+    def _restore(self, state: dict[str, Any]) -> None:
         self.values = dict(state["values"])
         self.inputs = {name: float(value) for name, value in state["inputs"].items()}
         self.time = float(state["time"])

@@ -134,6 +134,17 @@ def state_layout(config: ModelConfig) -> StateLayout:
     return StateLayout(tuple(names))
 
 
+def every_state() -> tuple[str, ...]:
+    """Every state any scene can have: those of the scene with every mechanism and the inputs on, in order."""
+    scene = ModelConfig(
+        air=AirDragParameters(air_drag=True),
+        bearing=BearingParameters(bearing_friction=True, bearing_drag=True),
+        suspension=SuspensionParameters(suspension=True),
+        inputs=True,
+    )
+    return state_layout(scene).names
+
+
 class Evaluation(NamedTuple):
     """Everything the equations produce at one state (units: SI)."""
 

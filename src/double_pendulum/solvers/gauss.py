@@ -99,6 +99,7 @@ class GaussLegendre:
     dense_order = 0
     evals_per_step = 0
     dense_evals = 0
+    n_stages = 0  # len(C), set by each subclass
     C: tuple[float, ...] = ()
     A: tuple[tuple[float, ...], ...] = ()
     B: tuple[float, ...] = ()
@@ -161,6 +162,7 @@ class Gauss2(GaussLegendre):
     """Implicit midpoint rule: the 1-stage Gauss-Legendre method, order 2."""
 
     name = "gauss2"
+    n_stages = 1
     order = 2
     dense_order = 2  # the Hermite interpolant inherits the O(h^3) local error of y_new
     C = (0.5,)
@@ -172,6 +174,7 @@ class Gauss4(GaussLegendre):
     """The 2-stage Gauss-Legendre method, order 4."""
 
     name = "gauss4"
+    n_stages = 2
     order = 4
     dense_order = 3
     C = (0.5 - _R3 / 6.0, 0.5 + _R3 / 6.0)

@@ -300,7 +300,8 @@ class Integrator:
         return self._interp((t_out - self.t_prev) / (self.t - self.t_prev))
 
     # ------------------------------------------------------------------ state
-    _STATE_FIELDS = (
+    # The attributes get_state saves (with ``landed``: its keys).
+    STATE_FIELDS = (
         "t0",
         "t",
         "y",
@@ -325,7 +326,7 @@ class Integrator:
                 if name == "stages"
                 else (list(value) if isinstance(value, list) else value)
             )
-            for name in self._STATE_FIELDS
+            for name in self.STATE_FIELDS
             for value in [getattr(self, name)]
         }
         state["landed"] = self.last_method is not self.method  # the last step was the landing method's
@@ -333,7 +334,7 @@ class Integrator:
 
     def set_state(self, state: dict[str, Any]) -> None:
         """Restore a state from :meth:`get_state`; later steps are bit-identical."""
-        for name in self._STATE_FIELDS:
+        for name in self.STATE_FIELDS:
             value = state[name]
             if name == "stages":
                 value = [list(s) for s in value]

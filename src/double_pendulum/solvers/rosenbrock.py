@@ -172,6 +172,7 @@ class Rodas4:
     dense_order = 3
     evals_per_step = 6
     dense_evals = 0
+    n_stages = 6  # u_1..u_6
 
     def __init__(self) -> None:
         # (t, y, J, f_t) at the start of the last step. Keyed on the identity of y: the integrator

@@ -15,7 +15,9 @@ Each method is a small object with the same interface (the integrator in
 Attributes: ``name``, ``adaptive``, ``order``, ``error_order`` (order of the error estimate),
 ``dense_order``, ``evals_per_step`` (right-hand side evaluations of one ``step`` call; the
 integrator reads it after each call, so a method whose cost varies, e.g. with a Jacobian or an
-iteration, sets it in ``step``) and ``dense_evals`` (evaluations of one ``interpolant`` call).
+iteration, sets it in ``step``), ``dense_evals`` (evaluations of one ``interpolant`` call) and
+``n_stages`` (how many vectors ``step`` returns as its stages; a saved integrator state has as many,
+:mod:`double_pendulum.component.state_check`).
 The implicit methods are in :mod:`.rosenbrock` (stiff) and :mod:`.gauss` (symplectic).
 
 Lists of floats are used instead of NumPy arrays: for a state of 4 to 11 components a Python
@@ -116,6 +118,7 @@ class Dopri5:
     error_order = 4
     dense_order = 4
     evals_per_step = 6  # the 7th stage is f_new, reused as the next step's first stage
+    n_stages = 7  # the six stages and f_new
     dense_evals = 0
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
@@ -148,6 +151,7 @@ class Dop853:
     error_order = 7
     dense_order = 7
     evals_per_step = 12
+    n_stages = 13  # twelve and f_new (twelve while f_new is deferred)
     dense_evals = 3
     deferrable_f_new = True  # the error estimate does not use f(t + h, y_new)
     landing_method = Dopri5()  # short landing steps (see double_pendulum.solvers.integrator)
@@ -187,6 +191,7 @@ class ClassicRK4:
     error_order = 0
     dense_order = 3
     evals_per_step = 4  # f_new is the next step's first stage
+    n_stages = 4
     dense_evals = 0
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
@@ -206,6 +211,7 @@ class ExplicitEuler:
     error_order = 0
     dense_order = 1
     evals_per_step = 1
+    n_stages = 1  # fy
     dense_evals = 0
 
     def step(self, f: VectorField, t: float, y: list[float], fy: list[float], h: float):
