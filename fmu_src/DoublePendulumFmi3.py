@@ -194,11 +194,11 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
                 "states": self._states.get_state() if self._states is not None else None}
 
     def _set_fmu_state(self, state):
-        self.check_fmu_state(state)
-        self._sim.set_state(state["component"])
+        """The loader hands back only states this FMU made, or deserialised after :meth:`check_fmu_state`."""
+        self._sim.set_state(state["component"], check=False)
         self._states = PendulumStates(self._sim) if state["states"] is not None else None
         if self._states is not None:
-            self._states.set_state(state["states"])
+            self._states.set_state(state["states"], check=False)
         self._model_exchange_used = bool(state["model_exchange_used"])
 
     def check_fmu_state(self, state) -> None:
@@ -208,9 +208,9 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
                              f"not {_cut(state)}")
         if not isinstance(state["model_exchange_used"], bool):
             raise ValueError(f'state["model_exchange_used"] = {_cut(state["model_exchange_used"])} is not a bool')
-        type(self._sim).check_state(state["component"])
+        type(self._sim).check_state(state["component"], path='state["component"]')
         if state["states"] is not None:
-            PendulumStates.check_state(state["states"])
+            PendulumStates.check_state(state["states"], path='state["states"]')
 
 
 def _cut(value, limit: int = 60) -> str:

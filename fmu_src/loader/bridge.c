@@ -207,7 +207,7 @@ static int call_object(guard_instance *g, PyObject *target, bridge_payload paylo
     if (arguments) py->DecRef(arguments);
     py->GILState_Release(gil);
     if (notes.interrupted) {
-        py->Err_SetInterrupt(); /* the host's interrupt, raised again for the host (async-signal-safe) */
+        g->interrupted = 1; /* raised again for the host when the FMI function returns (guard_deliver_interrupt) */
         status = STATUS_ERROR;
     }
     emit_notes(g, &notes);

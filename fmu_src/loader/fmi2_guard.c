@@ -161,11 +161,13 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
                                   sizeof why);
     if (why[0]) fail(&g->common, "fmi2Instantiate: %s", why);
     if (why[0] || !guard_start_python(&g->common, resources, visible)) {
+        guard_deliver_interrupt(&g->common);
         destroy(&g->common);
         return NULL;
     }
     if (!guard_register(&g->common)) {
         fail(&g->common, "fmi2Instantiate: out of memory");
+        guard_deliver_interrupt(&g->common);
         destroy(&g->common);
         return NULL;
     }

@@ -178,11 +178,13 @@ static guarded *instantiate(fmi3String name, fmi3String token, fmi3String resour
     else guard_check_instantiation(&FMI3, name, token, resourcePath, resources, sizeof resources, why, sizeof why);
     if (why[0]) fail(&g->common, "%s: %s", function, why);
     if (why[0] || !guard_start_python(&g->common, resources, visible)) {
+        guard_deliver_interrupt(&g->common);
         destroy(&g->common);
         return NULL;
     }
     if (!guard_register(&g->common)) {
         fail(&g->common, "%s: out of memory", function);
+        guard_deliver_interrupt(&g->common);
         destroy(&g->common);
         return NULL;
     }

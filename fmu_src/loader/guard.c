@@ -44,7 +44,14 @@ guard_instance *guard_acquire(void *c, const char *model_identifier, const char 
     return (guard_instance *)c;
 }
 
+void guard_deliver_interrupt(guard_instance *g) {
+    if (!g->interrupted) return;
+    g->interrupted = 0;
+    g->api->Err_SetInterrupt(); /* async-signal-safe, no GIL needed */
+}
+
 void guard_release(guard_instance *g) {
+    guard_deliver_interrupt(g);
     pthread_mutex_lock(&instances.lock);
     int last = --g->references == 0;
     pthread_mutex_unlock(&instances.lock);
@@ -82,6 +89,7 @@ int guard_init_instance(guard_instance *g, const guard_version *version, const c
 void guard_free_common(guard_instance *g) {
     while (g->states) guard_free_state(g, (void **)&(void *){g->states}); /* the ones the host did not free */
     if (g->python) bridge_call(g, NO_PAYLOAD, "release", "()"), bridge_release(g, g->python);
+    if (g->python) guard_deliver_interrupt(g);
     g->python = NULL;
     free(g->name);
     g->name = NULL;

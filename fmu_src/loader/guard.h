@@ -82,6 +82,7 @@ struct guard_instance {
     int references;        /* the host's (until it frees the instance) and one per call running */
     const python_api *api; /* the process's Python */
     PyObject *python;      /* the instance's Python object (fmu_src/fmi_bridge.py) */
+    int interrupted;       /* a Ctrl-C stopped a call: raised again for the host when the FMI function returns */
     /* give one message to the host's logger, or stderr if it has none */
     void (*log)(guard_instance *g, int status, const char *category, const char *message);
     void (*destroy)(guard_instance *g); /* free the version's struct (its Python object is released) */
@@ -98,6 +99,11 @@ void guard_release(guard_instance *g);
 /* For __attribute__((cleanup)): release the instance a variable holds (if any) when it goes out of scope. */
 void guard_release_variable(void *variable);
 #define GUARD_CALL __attribute__((cleanup(guard_release_variable)))
+
+/* If a Ctrl-C stopped a call of g, raise it again for the host (a Python host then sees KeyboardInterrupt):
+ * the last thing an FMI function does, after every message has been logged (a Python logger would
+ * otherwise take the interrupt, and ctypes drops exceptions in callbacks). */
+void guard_deliver_interrupt(guard_instance *g);
 
 /* Fill in `g` (calloc'ed, first in the version's struct) for a new instance. */
 int guard_init_instance(guard_instance *g, const guard_version *version, const char *interface,

@@ -199,9 +199,11 @@ class PendulumStates:
         """
         _state_check.model_exchange_state(path, state)
 
-    def set_state(self, state: dict[str, Any]) -> None:
-        """Restore :meth:`get_state`; :meth:`check_state` first, so a state it refuses changes nothing."""
-        self.check_state(state)
+    def set_state(self, state: dict[str, Any], *, check: bool = True) -> None:
+        """Restore :meth:`get_state`; :meth:`check_state` first (unless ``check`` is False, for a state this
+        process made and kept), so a state it refuses changes nothing."""
+        if check:
+            self.check_state(state)
         self.time, self.x, self.evaluations = float(state["time"]), [float(v) for v in state["x"]], state["evaluations"]
         self._known, self._instant = dict(state["known"]), float(state["instant"])
         self._left, self._set_here = dict(state["left"]), set(state["set_here"])

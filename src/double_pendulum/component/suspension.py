@@ -149,12 +149,14 @@ class SuspensionCoSimulation:
         """
         check.suspension_state(path, state, cls.STATE_VERSION, cls.RULES)
 
-    def set_state(self, state: dict[str, Any]) -> None:
+    def set_state(self, state: dict[str, Any], *, check: bool = True) -> None:
         """Restore a state from :meth:`get_state`; the run continues bit-identically.
 
-        :meth:`check_state` first: a state it refuses (:class:`~.state_check.StateError`) changes nothing.
+        :meth:`check_state` first (unless ``check`` is False, for a state this process made and kept): a
+        state it refuses (:class:`~.state_check.StateError`) changes nothing.
         """
-        self.check_state(state)
+        if check:
+            self.check_state(state)
         with check.restored_on_failure(self):
             self._restore(state)
 
