@@ -195,10 +195,10 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
 
     def _set_fmu_state(self, state):
         """The loader hands back only states this FMU made, or deserialised after :meth:`check_fmu_state`."""
-        self._sim.set_state(state["component"], check=False)
+        self._sim.set_state(state["component"], validate=False)
         self._states = PendulumStates(self._sim) if state["states"] is not None else None
         if self._states is not None:
-            self._states.set_state(state["states"], check=False)
+            self._states.set_state(state["states"], validate=False)
         self._model_exchange_used = bool(state["model_exchange_used"])
 
     def check_fmu_state(self, state) -> None:

@@ -125,7 +125,7 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
 
     def _set_fmu_state(self, state):
         """The loader hands back only states this FMU made, or deserialised after check_fmu_state."""
-        self._sim.set_state(state, check=False)
+        self._sim.set_state(state, validate=False)
 
     def do_step(self, current_time, step_size):
         return self._component_step(current_time, step_size)

@@ -487,15 +487,15 @@ class DoublePendulumCoSimulation:
         """
         check.cosimulation_state(path, state, cls.STATE_VERSION, cls.RULES, _scene_size)
 
-    def set_state(self, state: dict[str, Any], *, check: bool = True) -> None:
+    def set_state(self, state: dict[str, Any], *, validate: bool = True) -> None:
         """Restore a state from :meth:`get_state` (FMI fmi2SetFMUstate).
 
-        :meth:`check_state` first (unless ``check`` is False: a state this process made and kept, as a
+        :meth:`check_state` first (unless ``validate`` is False: a state this process made and kept, as a
         master's rollback or the FMU's own fmi2SetFMUstate, needs no second look, and the check costs
         20 to 40 us): a state it refuses (:class:`StateError`) changes nothing, nor does one whose
         parameters the rebuild refuses (the attributes are put back).
         """
-        if check:
+        if validate:
             self.check_state(state)
         with check.restored_on_failure(self):
             self._restore(state)

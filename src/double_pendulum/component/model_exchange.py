@@ -199,10 +199,10 @@ class PendulumStates:
         """
         _state_check.model_exchange_state(path, state)
 
-    def set_state(self, state: dict[str, Any], *, check: bool = True) -> None:
-        """Restore :meth:`get_state`; :meth:`check_state` first (unless ``check`` is False, for a state this
+    def set_state(self, state: dict[str, Any], *, validate: bool = True) -> None:
+        """Restore :meth:`get_state`; :meth:`check_state` first (unless ``validate`` is False, for a state this
         process made and kept), so a state it refuses changes nothing."""
-        if check:
+        if validate:
             self.check_state(state)
         self.time, self.x, self.evaluations = float(state["time"]), [float(v) for v in state["x"]], state["evaluations"]
         self._known, self._instant = dict(state["known"]), float(state["instant"])

@@ -149,13 +149,13 @@ class SuspensionCoSimulation:
         """
         check.suspension_state(path, state, cls.STATE_VERSION, cls.RULES)
 
-    def set_state(self, state: dict[str, Any], *, check: bool = True) -> None:
+    def set_state(self, state: dict[str, Any], *, validate: bool = True) -> None:
         """Restore a state from :meth:`get_state`; the run continues bit-identically.
 
-        :meth:`check_state` first (unless ``check`` is False, for a state this process made and kept): a
+        :meth:`check_state` first (unless ``validate`` is False, for a state this process made and kept): a
         state it refuses (:class:`~.state_check.StateError`) changes nothing.
         """
-        if check:
+        if validate:
             self.check_state(state)
         with check.restored_on_failure(self):
             self._restore(state)

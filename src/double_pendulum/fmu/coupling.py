@@ -207,8 +207,8 @@ class _Iterative:
         states = (pendulum.get_state(), suspension.get_state())
 
         def sweep(a_end: list[float]) -> list[float]:
-            pendulum.set_state(states[0], check=False)  # the master's own rollback states
-            suspension.set_state(states[1], check=False)
+            pendulum.set_state(states[0], validate=False)  # the master's own rollback states
+            suspension.set_state(states[1], validate=False)
             mean_a = [0.5 * (a0 + a1) for a0, a1 in zip(motion[4:], a_end)]
             write_interface(pendulum, suspension, [], motion[:4] + mean_a)
             pendulum.do_step(t, h)

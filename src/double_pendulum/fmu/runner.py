@@ -10,9 +10,8 @@ instance ``invalid l1 = -1.0 m: must be > 0``) even though fmpy itself only repo
 from __future__ import annotations
 
 import contextlib
-import os
 import shutil
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -20,8 +19,6 @@ import numpy as np
 
 from ..model.outputs import OUTPUT_NAMES
 from .build import DEFAULT_FMU_PATH, build_fmu, fmu_is_current
-
-FMU_STDERR_SWITCH = "DOUBLE_PENDULUM_FMU_STDERR"
 
 
 class FmuRunError(RuntimeError):
@@ -133,22 +130,21 @@ class FmuRunner:
             _collect(messages, call[-3], call[-1])
 
         try:
-            with _fmu_errors_to_log_only():
-                how = {"fmu_instance": self._reused_instance()} if reuse else {"debug_logging": True,
-                                                                                "logger": logger}
-                result = simulate_fmu(
-                    self.unzipdir,
-                    validate=False,  # validated once by read_model_description
-                    model_description=self.model_description,
-                    start_time=start_time,
-                    stop_time=stop_time,
-                    output_interval=output_interval,
-                    start_values=dict(start_values or {}),
-                    output=list(outputs),
-                    step_finished=step_finished,
-                    **how,
-                    **fmpy_options,
-                )
+            how = {"fmu_instance": self._reused_instance()} if reuse else {"debug_logging": True,
+                                                                            "logger": logger}
+            result = simulate_fmu(
+                self.unzipdir,
+                validate=False,  # validated once by read_model_description
+                model_description=self.model_description,
+                start_time=start_time,
+                stop_time=stop_time,
+                output_interval=output_interval,
+                start_values=dict(start_values or {}),
+                output=list(outputs),
+                step_finished=step_finished,
+                **how,
+                **fmpy_options,
+            )
         except Exception as error:
             partial = recorders[0].result() if recorders else None
             raise FmuRunError(f"{error} -- FMU says: {_summarise(messages)}", partial_result=partial) from error
@@ -236,25 +232,6 @@ def keep_fmpy_logger_alive() -> None:
     callbacks = _LIVE.setdefault("restore", fmi2CallbackFunctions())
     callbacks.logger = _dispatcher()  # the proxy takes it only from a struct not yet proxied
     addLoggerProxy(byref(callbacks))
-
-
-@contextlib.contextmanager
-def _fmu_errors_to_log_only() -> Iterator[None]:
-    """While the runner collects the FMU's log, the FMU does not also print its errors to stderr.
-
-    The runner turns every logged error into :class:`FmuRunError`, so a failure still reaches the
-    user, in the words of the scenario that expected it or not (``DOUBLE_PENDULUM_FMU_STDERR``,
-    read by the adapter ``fmu_src/DoublePendulum.py``).
-    """
-    previous = os.environ.get(FMU_STDERR_SWITCH)
-    os.environ[FMU_STDERR_SWITCH] = "0"
-    try:
-        yield
-    finally:
-        if previous is None:
-            os.environ.pop(FMU_STDERR_SWITCH, None)
-        else:
-            os.environ[FMU_STDERR_SWITCH] = previous
 
 
 def _summarise(messages: list[str]) -> str:
