@@ -116,6 +116,7 @@ def valgrind(library: Path, host: Path, function: str, folder: Path) -> tuple[in
     status and what it says."""
     xml, log = folder / f"{function}.xml", folder / f"{function}.log"
     done = subprocess.run(["valgrind", "--num-callers=24", "--error-exitcode=99", "--errors-for-leak-kinds=none",
+                           "--show-leak-kinds=none",
                            f"--suppressions={SCRIPTS / 'valgrind-python.supp'}", "--xml=yes", f"--xml-file={xml}",
                            f"--log-file={log}", str(host), str(library), function],
                           capture_output=True, text=True, timeout=60)
