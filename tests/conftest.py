@@ -11,6 +11,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+import sanitize
 
 from double_pendulum.fmu.build import build_all
 from double_pendulum.fmu.runner import FmuRunner
@@ -117,6 +118,9 @@ _SESSION_TMP: dict[str, object] = {}
 
 
 def pytest_configure(config: pytest.Config) -> None:
+    # DOUBLE_PENDULUM_SANITIZE=1 (scripts/check_memory.sh): the session's FMUs get a sanitized loader
+    # (tests/sanitize.py); set here, before any FMU is built, in the controller and in each worker.
+    sanitize.configure()
     if hasattr(config, "workerinput"):  # an xdist worker: the controller set $TMPDIR up
         return
     outer = tempfile.gettempdir()

@@ -19,6 +19,12 @@ The loader is compiled with the system C compiler (``$CC``, else ``cc``, ``gcc``
 against the FMI 2 and FMI 3 headers fmpy ships (``fmpy/c-code``), with every warning an error;
 nothing compiled is committed. Building the FMUs needs that compiler and Linux: elsewhere the build
 stops with one line saying so (:class:`LoaderUnavailable`).
+
+``DOUBLE_PENDULUM_LOADER_CFLAGS`` (:data:`EXTRA_CFLAGS_VARIABLE`), if set, holds more compiler flags
+(split as a shell would): they go at the end of the one command that compiles and links the loader,
+so they reach the linker too, and they are part of the compile cache's key. The memory check
+(``scripts/check_memory.sh``) builds a sanitized loader this way, e.g.
+``DOUBLE_PENDULUM_LOADER_CFLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -g -O1"``.
 """
 
 from __future__ import annotations
@@ -43,6 +49,7 @@ PLATFORMS = {2: "linux64", 3: "x86_64-linux"}
 PLATFORM = PLATFORMS[2]
 CONFIG_NAME = "python.cfg"  # in resources/: the CPython the FMU was built with
 OVERRIDE_VARIABLE = "DOUBLE_PENDULUM_FMU_PYTHON"
+EXTRA_CFLAGS_VARIABLE = "DOUBLE_PENDULUM_LOADER_CFLAGS"  # more flags for the loader's compile (and link) command
 CFLAGS = ("-shared", "-fPIC", "-O2", "-std=gnu11", "-fvisibility=hidden", "-Wall", "-Wextra", "-Werror",
           "-Wformat-truncation=2")
 # libdl and libpthread by file name and as needed: where the old glibc versions the loader binds
@@ -82,12 +89,13 @@ def c_compiler() -> list[str] | None:
 
 @functools.cache
 def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tuple[float, ...],
-              defines: tuple[tuple[str, str], ...]) -> bytes:
+              defines: tuple[tuple[str, str], ...], extra_flags: tuple[str, ...] = ()) -> bytes:
     c_files = [str(path) for path in sources if path.suffix == ".c"]
     with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
         output = Path(tmp) / "loader.so"
         macros = [f"-D{name}={value}" if value.isdigit() else f'-D{name}="{value}"' for name, value in defines]
-        command = [*compiler, *CFLAGS, *macros, f"-I{fmi_headers()}", "-o", str(output), *c_files, *LIBS]
+        command = [*compiler, *CFLAGS, *macros, f"-I{fmi_headers()}", "-o", str(output), *c_files, *LIBS,
+                   *extra_flags]
         done = subprocess.run(command, capture_output=True, text=True)
         if done.returncode != 0:
             raise RuntimeError(f"compiling the FMU's loader failed: {shlex.join(command)}\n{done.stderr}")
@@ -115,7 +123,7 @@ def compiled_loader(fmi_version: int, defines: dict[str, str]) -> bytes:
         raise ValueError(f"loader macros must be plain text: {bad}")
     sources = tuple(loader_sources(fmi_version))
     return _compiled(tuple(compiler), sources, tuple(path.stat().st_mtime for path in sources),
-                     tuple(sorted(defines.items())))
+                     tuple(sorted(defines.items())), tuple(shlex.split(os.environ.get(EXTRA_CFLAGS_VARIABLE, ""))))
 
 
 def python_record() -> str:
