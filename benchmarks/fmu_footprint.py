@@ -41,7 +41,7 @@ def c_host_startup(host: Path, fmu: Path, unzipdir: str, home: str) -> float:
     """CPU seconds from loading the FMU's binary to the end of its first doStep, in the C host."""
     md = read_model_description(str(fmu))
     env = {"PATH": "/usr/bin:/bin", "HOME": home}
-    if not (Path(unzipdir) / "binaries" / loader.PLATFORM / loader.BACKEND_NAME).is_file():  # pythonfmu's own
+    if not (Path(unzipdir) / "resources" / "identity.cfg").is_file():  # pythonfmu's own binary, not the loader
         libdir, soname = sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("INSTSONAME")
         env |= {"LD_PRELOAD": f"{libdir}/{soname}", "PYTHONHOME": sys.base_prefix}
     command = [str(host), unzipdir, md.coSimulation.modelIdentifier, md.guid, "1", "0.001"]
