@@ -22,6 +22,7 @@ found, with nothing installed.
 from __future__ import annotations
 
 import json
+import os
 import struct
 from typing import Any
 
@@ -63,10 +64,11 @@ class Bridge:
         self.fmi_version = fmi_version
         self.formats = FORMATS[fmi_version]
 
-    def instantiate(self, resources: str, name: str, interface: str, visible: int) -> Answer:
-        """A new :class:`Instance` (the payload), for ``interface`` ("CoSimulation", "ModelExchange")."""
+    def instantiate(self, resources: bytes, name: str, interface: str, visible: int) -> Answer:
+        """A new :class:`Instance` (the payload), for ``interface`` ("CoSimulation", "ModelExchange"); the
+        resources folder's path comes as bytes (``os.fsdecode``: the same folder in any encoding)."""
         try:
-            return OK, Instance(self, resources, name, interface, bool(visible)), ()
+            return OK, Instance(self, os.fsdecode(resources), name, interface, bool(visible)), ()
         except KeyboardInterrupt:
             return INTERRUPTED, None, ((ERROR, "logStatusError", INTERRUPTED_TEXT),)
         except BaseException as error:

@@ -13,11 +13,13 @@
 
 /* Load the FMU's package `package` (the folder resources/<package>/) and its entry module `entry`
  * (resources/<entry>.py) under their own (private) names, once per process, and take the entry's
- * bridge.  Nothing is put on sys.path; the modules stay in sys.modules, so an FMU unloaded and loaded
+ * bridge.  The folder's path crosses as bytes (os.fsdecode: it names the same folder whatever the file
+ * system encoding of a Python host).  Nothing is put on sys.path; the modules stay in sys.modules, so an FMU unloaded and loaded
  * again, or extracted again elsewhere, finds them there.  One thread at a time loads (the lock lives in
  * sys.modules, shared by every FMU of this project): another sees a module only once it is complete. */
 static const char BOOTSTRAP[] =
-    "import sys, threading, types\n"
+    "import os, sys, threading, types\n"
+    "resources = os.fsdecode(resources)  # the folder's bytes, whatever the file system encoding\n"
     "loading = sys.modules.setdefault('_dp_fmu_loading', types.ModuleType('_dp_fmu_loading'))\n"
     "with vars(loading).setdefault('lock', threading.RLock()):\n"
     "    for name, path, folder in ((package, resources + '/' + package + '/__init__.py', [resources + '/' + package]),\n"
@@ -236,7 +238,7 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
     answer_notes notes = {0};
     int gil = py->GILState_Ensure();
     PyObject *globals = py->Dict_New();
-    PyObject *resources_text = py->Unicode_FromString(resources);
+    PyObject *resources_text = py->Bytes_FromStringAndSize(resources, (ssize_t)strlen(resources));
     PyObject *entry_text = py->Unicode_FromString(entry);
     PyObject *package_text = py->Unicode_FromString(package);
     PyObject *code = py->CompileString(BOOTSTRAP, "<double-pendulum-fmu loader>", PY_FILE_INPUT);
@@ -264,7 +266,8 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
         return STATUS_ERROR;
     }
     bridge_payload payload = {PAYLOAD_OBJECT, NULL, 0, NULL, NULL, instance};
-    int status = call_bridge(g, bridge, payload, "(sssi)", resources, g->name, interface, visible);
+    int status = call_bridge(g, bridge, payload, "(y#ssi)", resources, (ssize_t)strlen(resources), g->name,
+                             interface, visible);
     bridge_release(g, bridge);
     return status;
 }

@@ -91,14 +91,14 @@ static int state_allowed(const char *interface, int state) {
 }
 
 static const guard_version FMI2 = {"fmi2", MODEL_IDENTIFIER, FMU_GUID, "fmuGUID", "fmuResourceLocation",
-                                   ANY_STATE, ERROR_STATE, INSTANTIATED, "FMUstate", state_name, state_allowed};
+                                   ANY_STATE, ERROR_STATE, INSTANTIATED, "FMUstate", "value", "vr =", state_name,
+                                   state_allowed};
 
 /* --------------------------------------------------------------------------------- instances */
 
 typedef struct {
     guard_instance common; /* first: a guarded* is a guard_instance* */
     fmi2CallbackFunctions host; /* the host's callbacks */
-    char *strings;              /* the values of the last fmi2GetString (valid until the next call) */
 } guarded;
 
 /* The host's logger, with the message as data, never as a format. */
@@ -110,7 +110,6 @@ static void host_log(guard_instance *common, int status, const char *category, c
 static void destroy(guard_instance *common) {
     guarded *g = (guarded *)common;
     guard_free_common(common);
-    free(g->strings);
     free(g);
 }
 
@@ -254,51 +253,18 @@ SET(SetReal, fmi2Real, "Real")
 SET(SetInteger, fmi2Integer, "Integer")
 SET(SetBoolean, fmi2Boolean, "Boolean")
 
-/* Strings cross as their UTF-8 bytes, each ended by a NUL. */
 FMI2_Export fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                      fmi2String value[]) {
     BEGIN_MASKED(GetString, MASK_GET);
     ACCESS_CHECKS(GetString);
-    char *strings = NULL;
-    size_t size = 0;
-    bridge_payload payload = {PAYLOAD_COPY, NULL, 0, &strings, &size, NULL};
-    fmi2Status status = settle(g, bridge_call(&g->common, payload, "get_strings", "(y#)", (const char *)vr,
-                                              (ssize_t)(nvr * sizeof *vr)));
-    if (status > fmi2Warning) return status;
-    size_t found = 0;
-    for (size_t at = 0; at < size && found < nvr; found++) {
-        value[found] = strings + at;
-        at += strlen(strings + at) + 1;
-    }
-    if (found != nvr || (size && strings[size - 1] != '\0')) {
-        free(strings);
-        return (fmi2Status)fail(&g->common, "fmi2GetString: the FMU's Python side gave %zu strings for %zu value "
-                                            "references", found, nvr);
-    }
-    free(g->strings); /* the values of the last call: the host may use them until now */
-    g->strings = strings;
-    return status;
+    return (fmi2Status)guard_get_strings(&g->common, vr, nvr, value);
 }
 
 FMI2_Export fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                      const fmi2String value[]) {
     BEGIN_MASKED(SetString, MASK_SET);
     ACCESS_CHECKS(SetString);
-    size_t size = 0;
-    for (size_t k = 0; k < nvr; k++) {
-        REQUIRE(value[k], "fmi2SetString: value[%zu] (vr = %u) is NULL", k, vr[k]);
-        long bad = guard_utf8_error(value[k]);
-        REQUIRE(bad < 0, "fmi2SetString: value[%zu] (vr = %u) is not UTF-8 (byte %ld is 0x%02x; an fmi2String is "
-                "UTF-8 encoded)", k, vr[k], bad, (unsigned char)value[k][bad]);
-        size += strlen(value[k]) + 1;
-    }
-    char *joined = malloc(size ? size : 1), *at = joined;
-    REQUIRE(joined, "fmi2SetString: out of memory");
-    for (size_t k = 0; k < nvr; k++) at = stpcpy(at, value[k]) + 1;
-    fmi2Status status = settle(g, bridge_call(&g->common, NO_PAYLOAD, "set_strings", "(y#y#)", (const char *)vr,
-                                              (ssize_t)(nvr * sizeof *vr), joined, (ssize_t)size));
-    free(joined);
-    return status;
+    return (fmi2Status)guard_set_strings(&g->common, vr, nvr, value);
 }
 
 /* -------------------------------------------------------------------------------- FMU states */

@@ -104,7 +104,8 @@ static int state_allowed(const char *interface, int state) {
 }
 
 static const guard_version FMI3 = {"fmi3", MODEL_IDENTIFIER, FMU_GUID, "instantiationToken", "resourcePath",
-                                   ANY_STATE, ERROR_STATE, INSTANTIATED, "FMUState", state_name, state_allowed};
+                                   ANY_STATE, ERROR_STATE, INSTANTIATED, "FMUState", "values", "valueReference",
+                                   state_name, state_allowed};
 
 /* --------------------------------------------------------------------------------- instances */
 
@@ -113,7 +114,6 @@ typedef struct {
     int model_exchange;    /* 1: made for Model Exchange, 0: Co-Simulation */
     fmi3InstanceEnvironment environment;
     fmi3LogMessageCallback host_logger; /* may be NULL: errors then go to stderr */
-    char *strings;                      /* the values of the last fmi3GetString (valid until the next call) */
 } guarded;
 
 static void host_log(guard_instance *common, int status, const char *category, const char *message) {
@@ -125,7 +125,6 @@ static void host_log(guard_instance *common, int status, const char *category, c
 static void destroy(guard_instance *common) {
     guarded *g = (guarded *)common;
     guard_free_common(common);
-    free(g->strings);
     free(g);
 }
 
@@ -331,51 +330,18 @@ SET(SetInt64, fmi3Int64, MASK_SET, "Int64")
 SET(SetUInt64, fmi3UInt64, MASK_SET, "UInt64")
 SET(SetBoolean, fmi3Boolean, MASK_SET, "Boolean")
 
-/* Strings cross as their UTF-8 bytes, each ended by a NUL. */
 FMI3_Export fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                                      size_t nValueReferences, fmi3String values[], size_t nValues) {
     BEGIN_FOR(GetString, MASK_GET, BOTH);
     CHECK_ARRAYS(GetString);
-    char *strings = NULL;
-    size_t size = 0;
-    bridge_payload payload = {PAYLOAD_COPY, NULL, 0, &strings, &size, NULL};
-    fmi3Status status = settle(g, CALL(payload, "get_strings", "(y#)", (const char *)valueReferences,
-                                       (ssize_t)(nValueReferences * sizeof *valueReferences)));
-    if (status > fmi3Warning) return status;
-    size_t found = 0;
-    for (size_t at = 0; at < size && found < nValues; found++) {
-        values[found] = strings + at;
-        at += strlen(strings + at) + 1;
-    }
-    if (found != nValues) {
-        free(strings);
-        return (fmi3Status)fail(&g->common, "fmi3GetString: the FMU's Python side gave %zu strings for %zu value "
-                                            "references", found, nValues);
-    }
-    free(g->strings); /* the values of the last call: the host may use them until now */
-    g->strings = strings;
-    return status;
+    return (fmi3Status)guard_get_strings(&g->common, valueReferences, nValues, values);
 }
 
 FMI3_Export fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference valueReferences[],
                                      size_t nValueReferences, const fmi3String values[], size_t nValues) {
     BEGIN_FOR(SetString, MASK_SET, BOTH);
     CHECK_ARRAYS(SetString);
-    size_t size = 0;
-    for (size_t k = 0; k < nValues; k++) {
-        REQUIRE(values[k], "fmi3SetString: values[%zu] (valueReference %u) is NULL", k, valueReferences[k]);
-        long bad = guard_utf8_error(values[k]);
-        REQUIRE(bad < 0, "fmi3SetString: values[%zu] (valueReference %u) is not UTF-8 (byte %ld is 0x%02x; an "
-                "fmi3String is UTF-8 encoded)", k, valueReferences[k], bad, (unsigned char)values[k][bad]);
-        size += strlen(values[k]) + 1;
-    }
-    char *joined = malloc(size ? size : 1), *at = joined;
-    REQUIRE(joined, "fmi3SetString: out of memory");
-    for (size_t k = 0; k < nValues; k++) at = stpcpy(at, values[k]) + 1;
-    fmi3Status status = settle(g, CALL(NO_PAYLOAD, "set_strings", "(y#y#)", (const char *)valueReferences,
-                                       (ssize_t)(nValueReferences * sizeof *valueReferences), joined, (ssize_t)size));
-    free(joined);
-    return status;
+    return (fmi3Status)guard_set_strings(&g->common, valueReferences, nValues, values);
 }
 
 /* -------------------------------------------------------------------------------- FMU states */

@@ -92,7 +92,8 @@ void guard_free_common(guard_instance *g) {
     if (g->python) guard_deliver_interrupt(g);
     g->python = NULL;
     free(g->name);
-    g->name = NULL;
+    free(g->strings);
+    g->name = g->strings = NULL;
 }
 
 /* ---------------------------------------------------------------------------- instantiation */
@@ -235,6 +236,54 @@ int guard_set_debug_logging(guard_instance *g, int on, size_t n, const char *con
     }
     g->categories = mask;
     return STATUS_OK;
+}
+
+/* ------------------------------------------------------------------------------ strings */
+
+/* Strings cross as their UTF-8 bytes, each ended by a NUL (fmi_bridge.py: get_strings, set_strings). */
+int guard_get_strings(guard_instance *g, const unsigned int vr[], size_t n, const char *values[]) {
+    char *strings = NULL;
+    size_t size = 0;
+    bridge_payload payload = {PAYLOAD_COPY, NULL, 0, &strings, &size, NULL};
+    int status = guard_settle(g, bridge_call(g, payload, "get_strings", "(y#)", (const char *)vr,
+                                             (ssize_t)(n * sizeof *vr)));
+    if (status > STATUS_WARNING) return status;
+    size_t found = 0;
+    for (size_t at = 0; at < size && found < n; found++) {
+        values[found] = strings + at;
+        at += strlen(strings + at) + 1;
+    }
+    if (found != n || (size && strings[size - 1] != '\0')) {
+        free(strings);
+        return guard_fail(g, "%s: the FMU's Python side gave %zu strings for %zu value references", g->function,
+                          found, n);
+    }
+    free(g->strings); /* the values of the last call: the host may use them until now */
+    g->strings = strings;
+    return status;
+}
+
+int guard_set_strings(guard_instance *g, const unsigned int vr[], size_t n, const char *const values[]) {
+    const guard_version *v = g->version;
+    size_t size = 0;
+    for (size_t k = 0; k < n; k++) {
+        if (!values[k])
+            return guard_fail(g, "%s: %s[%zu] (%s %u) is NULL", g->function, v->values_word, k, v->reference_word,
+                              vr[k]);
+        long bad = guard_utf8_error(values[k]);
+        if (bad >= 0)
+            return guard_fail(g, "%s: %s[%zu] (%s %u) is not UTF-8 (byte %ld is 0x%02x; an %sString is UTF-8 "
+                              "encoded)", g->function, v->values_word, k, v->reference_word, vr[k], bad,
+                              (unsigned char)values[k][bad], v->prefix);
+        size += strlen(values[k]) + 1;
+    }
+    char *joined = malloc(size ? size : 1), *at = joined;
+    if (!joined) return guard_fail(g, "%s: out of memory", g->function);
+    for (size_t k = 0; k < n; k++) at = stpcpy(at, values[k]) + 1;
+    int status = guard_settle(g, bridge_call(g, NO_PAYLOAD, "set_strings", "(y#y#)", (const char *)vr,
+                                             (ssize_t)(n * sizeof *vr), joined, (ssize_t)size));
+    free(joined);
+    return status;
 }
 
 int guard_check_step(guard_instance *g, double current, double step) {

@@ -53,6 +53,8 @@ typedef struct {
     int error_state;              /* the bit of the Error state */
     int instantiated_state;       /* the bit of Instantiated (after a reset) */
     const char *state_word;       /* "FMUstate", "FMUState": as the version spells it */
+    const char *values_word;      /* "value", "values": the name of a get/set function's values */
+    const char *reference_word;   /* "vr", "valueReference": what a value reference is called in messages */
     const char *(*state_name)(int state);
     int (*state_allowed)(const char *interface, int state); /* can an instance of `interface` be in it? */
 } guard_version;
@@ -83,6 +85,7 @@ struct guard_instance {
     const python_api *api; /* the process's Python */
     PyObject *python;      /* the instance's Python object (fmu_src/fmi_bridge.py) */
     int interrupted;       /* a Ctrl-C stopped a call: raised again for the host when the FMI function returns */
+    char *strings;         /* the values of the last get of Strings (valid until the next one) */
     /* give one message to the host's logger, or stderr if it has none */
     void (*log)(guard_instance *g, int status, const char *category, const char *message);
     void (*destroy)(guard_instance *g); /* free the version's struct (its Python object is released) */
@@ -133,6 +136,9 @@ int guard_set_debug_logging(guard_instance *g, int on, size_t n, const char *con
 /* One line on stderr for a call that has no instance to log through. */
 void guard_orphan(const char *model_identifier, const char *function, const char *format, ...)
     __attribute__((format(printf, 3, 4)));
+/* Get / set `n` String values (the values got stay valid until the next get of this instance). */
+int guard_get_strings(guard_instance *g, const unsigned int vr[], size_t n, const char *values[]);
+int guard_set_strings(guard_instance *g, const unsigned int vr[], size_t n, const char *const values[]);
 /* doStep's currentCommunicationPoint and communicationStepSize: 1 if they are right, else logged. */
 int guard_check_step(guard_instance *g, double current, double step);
 

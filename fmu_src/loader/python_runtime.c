@@ -431,9 +431,10 @@ static int start_python(const python_install *python, char *why, size_t size) {
         return 0;
     }
     int started = 1;
+    void *global = NULL;
     flockfile(stderr); /* the one lock all copies of the loader share: one starts Python at a time */
     if (!python_in_process()) {
-        if (!dlopen(python->library, RTLD_NOW | RTLD_NOLOAD | RTLD_GLOBAL)) { /* the same copy, now global */
+        if (!(global = dlopen(python->library, RTLD_NOW | RTLD_NOLOAD | RTLD_GLOBAL))) { /* the same copy, global */
             guard_format(why, size, "cannot be made global: %s", dlerror());
             started = 0;
         } else if (dlsym(library, "PyInitConfig_Create")) {
@@ -448,7 +449,10 @@ static int start_python(const python_install *python, char *why, size_t size) {
         if (started) save_thread(); /* release the GIL: every call takes it with PyGILState_Ensure */
     }
     funlockfile(stderr);
-    if (!started) dlclose(library);
+    if (!started) { /* nothing of a Python that did not start stays in the process's global scope */
+        if (global) dlclose(global);
+        dlclose(library);
+    }
     return started;
 }
 
@@ -513,6 +517,7 @@ static int resolve_api(char *error, size_t error_size) {
     RESOLVE(Object_Str, "PyObject_Str")
     RESOLVE(Unicode_AsUTF8AndSize, "PyUnicode_AsUTF8AndSize")
     RESOLVE(Unicode_FromString, "PyUnicode_FromString")
+    RESOLVE(Bytes_FromStringAndSize, "PyBytes_FromStringAndSize")
     RESOLVE(Bytes_AsStringAndSize, "PyBytes_AsStringAndSize")
     RESOLVE(Long_AsLong, "PyLong_AsLong")
     RESOLVE(Tuple_Size, "PyTuple_Size")

@@ -45,6 +45,7 @@ typedef struct {
     PyObject *(*Object_Str)(PyObject *);
     const char *(*Unicode_AsUTF8AndSize)(PyObject *, ssize_t *);
     PyObject *(*Unicode_FromString)(const char *);
+    PyObject *(*Bytes_FromStringAndSize)(const char *, ssize_t);
     int (*Bytes_AsStringAndSize)(PyObject *, char **, ssize_t *);
     long (*Long_AsLong)(PyObject *);
     ssize_t (*Tuple_Size)(PyObject *);
