@@ -10,6 +10,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -147,6 +148,28 @@ def test_without_a_usable_python_instantiate_returns_null_and_says_why_in_one_li
     assert len(logged) == 1 and logged[0].startswith("log 3 ")  # one fmi2Error line through the host's logger
     assert "no usable Python to run this FMU" in logged[0] and f"{loader.OVERRIDE_VARIABLE}={override}" in logged[0]
     assert "CPython >= 3.11 with a shared libpython" in logged[0]  # what it needs and how to point it there
+
+
+def test_an_interpreter_that_never_answers_is_given_up_in_bounded_time_and_leaves_no_process(host, extracted,
+                                                                                            tmp_path):
+    """A python3 that is a shell script hanging in a child of its own (no exec): the loader gives it up after
+    its 20 s, says so in one line, and kills its whole process group (the child is not left orphaned)."""
+    marker = f"{os.getpid()}.{time.monotonic_ns() % 10**6}"
+    script = tmp_path / "bin" / "python3"
+    script.parent.mkdir()
+    script.write_text(f"#!/bin/sh\nsleep 3{marker}\necho never\n")
+    script.chmod(0o755)
+    folder, description = extracted["DoublePendulum.fmu"]
+    env = bare_environment(tmp_path, **{loader.OVERRIDE_VARIABLE: str(script)})
+    started = time.monotonic()
+    done = run_host(host, folder, description, [], env, tmp_path)
+    took = time.monotonic() - started
+    assert done.returncode == 4, done.stdout + done.stderr
+    logged = [line for line in done.stdout.splitlines() if line.startswith("log ")]
+    assert len(logged) == 1 and "did not answer within 20 s" in logged[0], logged
+    assert 19 < took < 40, took
+    left = subprocess.run(["pgrep", "-f", f"sleep 3{marker}"], capture_output=True, text=True).stdout.split()
+    assert not left, f"the interpreter's child was left behind: {left}"
 
 
 def test_the_hosts_python_variables_do_not_reach_the_fmus_interpreter(host, extracted, tmp_path):
