@@ -15,10 +15,11 @@ installed: the loader starts it without ``site`` (no site-packages), and everyth
 it (the model code and pythonfmu's Python part) is bundled under ``resources/`` and imports only the
 standard library.
 
-The loader is compiled with the system C compiler (``$CC``, else ``cc``, ``gcc`` or ``clang``)
+The loader is compiled with the system C compiler (``$CC``, else ``cc``, ``gcc`` or ``clang``; where there is
+none, Zig's C compiler, which the ``ziglang`` package brings with pip)
 against the FMI 2 and FMI 3 headers fmpy ships (``fmpy/c-code``), with every warning an error;
-nothing compiled is committed. Building the FMUs needs that compiler and Linux: elsewhere the build
-stops with one line saying so (:class:`LoaderUnavailable`).
+nothing compiled is committed. Building the FMUs needs Linux and a compiler: elsewhere the build stops
+with one line saying so (:class:`LoaderUnavailable`).
 
 ``DOUBLE_PENDULUM_LOADER_CFLAGS`` (:data:`EXTRA_CFLAGS_VARIABLE`), if set, holds more compiler flags
 (split as a shell would): they go at the end of the one command that compiles and links the loader,
@@ -50,11 +51,14 @@ PLATFORM = PLATFORMS[2]
 CONFIG_NAME = "python.cfg"  # in resources/: the CPython the FMU was built with
 OVERRIDE_VARIABLE = "DOUBLE_PENDULUM_FMU_PYTHON"
 EXTRA_CFLAGS_VARIABLE = "DOUBLE_PENDULUM_LOADER_CFLAGS"  # more flags for the loader's compile (and link) command
-CFLAGS = ("-shared", "-fPIC", "-O2", "-std=gnu11", "-fvisibility=hidden", "-Wall", "-Wextra", "-Werror",
-          "-Wformat-truncation=2")
+CFLAGS = ("-shared", "-fPIC", "-O2", "-std=gnu11", "-fvisibility=hidden", "-Wall", "-Wextra", "-Werror")
+GCC_CFLAGS = ("-Wformat-truncation=2",)  # gcc's: a path or message that snprintf could cut is a warning too
 # libdl and libpthread by file name and as needed: where the old glibc versions the loader binds
 # (glibc_compat.h) live on systems older than glibc 2.34 (there -ldl would find an empty libdl.a).
 LIBS = ("-Wl,--no-as-needed", "-l:libdl.so.2", "-l:libpthread.so.0", "-l:libm.so.6")
+# Zig's compiler links against the glibc it bundles, of the version its target names: the same floor.
+ZIG_FLAGS = {"x86_64": ("-target", "x86_64-linux-gnu.2.17"), "aarch64": ("-target", "aarch64-linux-gnu.2.17")}
+ZIG_LIBS = ("-Wl,--no-as-needed", "-ldl", "-lpthread", "-lm")
 
 
 class LoaderUnavailable(RuntimeError):
@@ -79,12 +83,28 @@ def fmi_headers() -> Path:
 
 
 def c_compiler() -> list[str] | None:
-    """The C compiler command: ``$CC`` if set, else the first of cc, gcc, clang on PATH; None if none."""
+    """The C compiler command: ``$CC`` if set, else the first of cc, gcc, clang on PATH, else Zig's C compiler
+    from the ``ziglang`` package (a dependency on Linux: a machine with only Python and pip builds the FMUs
+    too); None if none."""
     if os.environ.get("CC"):
         command = shlex.split(os.environ["CC"])
         return command if shutil.which(command[0]) else None
     found = next((shutil.which(name) for name in ("cc", "gcc", "clang") if shutil.which(name)), None)
-    return [found] if found else None
+    if found:
+        return [found]
+    if importlib.util.find_spec("ziglang") is not None:
+        return [sys.executable, "-m", "ziglang", "cc"]
+    return None
+
+
+@functools.cache
+def _is_gcc(compiler: tuple[str, ...]) -> bool:
+    """Whether ``compiler`` is gcc (which takes :data:`GCC_CFLAGS`; clang and Zig's compiler do not)."""
+    try:
+        version = subprocess.run([*compiler, "--version"], capture_output=True, text=True, timeout=60).stdout.lower()
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return "clang" not in version and ("gcc" in version or "free software foundation" in version)
 
 
 @functools.cache
@@ -94,8 +114,10 @@ def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tupl
     with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
         output = Path(tmp) / "loader.so"
         macros = [f"-D{name}={value}" if value.isdigit() else f'-D{name}="{value}"' for name, value in defines]
-        command = [*compiler, *CFLAGS, *macros, f"-I{fmi_headers()}", "-o", str(output), *c_files, *LIBS,
-                   *extra_flags]
+        zig = "ziglang" in compiler
+        own = ZIG_FLAGS.get(os.uname().machine, ()) if zig else GCC_CFLAGS if _is_gcc(compiler) else ()
+        command = [*compiler, *CFLAGS, *own, *macros, f"-I{fmi_headers()}", "-o", str(output), *c_files,
+                   *(ZIG_LIBS if zig else LIBS), *extra_flags]
         done = subprocess.run(command, capture_output=True, text=True)
         if done.returncode != 0:
             raise RuntimeError(f"compiling the FMU's loader failed: {shlex.join(command)}\n{done.stderr}")
@@ -115,8 +137,9 @@ def compiled_loader(fmi_version: int, defines: dict[str, str]) -> bytes:
     compiler = c_compiler()
     if compiler is None:
         raise LoaderUnavailable(
-            "no C compiler found ($CC, cc, gcc or clang): building the FMUs compiles their binary from "
-            "source (fmu_src/loader/); install one (e.g. apt-get install gcc) and build again"
+            "no C compiler found ($CC, cc, gcc, clang, or the ziglang package): building the FMUs compiles their "
+            "binary from source (fmu_src/loader/); install one (pip install ziglang, or apt-get install gcc) and "
+            "build again"
         )
     bad = {name: value for name, value in defines.items() if any(c in str(value) for c in '"\\\n')}
     if bad:
