@@ -4,6 +4,7 @@ symbol versions and the C libraries (so it loads on older systems and can say wh
 
 from __future__ import annotations
 
+import importlib.util
 import sys
 import zipfile
 from pathlib import Path
@@ -56,3 +57,24 @@ def test_the_version_reader_reads_what_the_loader_was_built_with(fmu_path):
     assert elf_needs.describe(data).startswith("glibc >= 2.")
     with pytest.raises(ValueError, match="not a 64-bit"):
         elf_needs.version_needs(b"#!/bin/sh\n")
+
+
+@pytest.mark.skipif(importlib.util.find_spec("ziglang") is None, reason="the ziglang package is not installed")
+def test_zigs_compiler_builds_a_loader_that_runs_like_the_system_compilers(fmu_path, tmp_path, monkeypatch):
+    """Where a machine has no C compiler, Zig's (from pip) builds the FMUs: the same floor of glibc symbol
+    versions, the same C libraries, the same numbers."""
+    from fmpy import simulate_fmu
+
+    from double_pendulum.fmu.build import build_fmu
+
+    monkeypatch.setenv("CC", f"{sys.executable} -m ziglang cc")
+    assert "ziglang" in " ".join(loader.c_compiler())
+    built = build_fmu(tmp_path / "DoublePendulum.fmu")
+    with zipfile.ZipFile(built) as archive:
+        data = archive.read("binaries/linux64/DoublePendulum.so")
+    needs = elf_needs.version_needs(data)
+    assert set(needs) <= C_LIBRARIES
+    assert elf_needs.version_key(elf_needs.newest(needs, "GLIBC")) <= elf_needs.version_key(GLIBC_FLOOR)
+    runs = [simulate_fmu(str(path), stop_time=0.2, output_interval=0.1, start_values={"phi1_0": 1.0},
+                         output=["phi1"])["phi1"][-1] for path in (built, fmu_path)]
+    assert runs[0] == runs[1]
