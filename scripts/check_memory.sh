@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Memory safety of the FMUs' Linux binaries (the C loader and the FMI libraries behind it), proved two ways:
+# Memory safety of the FMUs' Linux binaries (the C loader, their one binary), proved two ways:
 #  1. AddressSanitizer + UndefinedBehaviorSanitizer (and LeakSanitizer): the FMUs' loader and the C torture
 #     hosts built with the sanitizers (DOUBLE_PENDULUM_SANITIZE=1, tests/sanitize.py), then every probe of
 #     tests/test_guard.py, its threads and a soak in those hosts, each started with a bare environment.

@@ -1,4 +1,4 @@
-"""The guard in front of the FMI library (``fmu_src/loader/fmi2_guard.c``, ``fmi3_guard.c``), tried as the
+"""The FMUs' C loader (``fmu_src/loader/fmi2_guard.c``, ``fmi3_guard.c``, ``guard.c``), tried as the
 test suites of FMI tools would: torture hosts in C (``tests/c_host/fmi2_torture.c``, ``fmi3_torture.c``),
 started with a bare environment, make every call a master may get wrong and check that each gets what
 the standard says (FMI 2.0 sections 2.1 and 4.2.4, FMI 3.0 sections 2.2, 3.2 and 4.2) with a log line

@@ -19,7 +19,7 @@ C_LIBRARIES = {"libc.so.6", "libdl.so.2", "libpthread.so.0", "libm.so.6"}
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the loader is for Linux"),
-    pytest.mark.skipif(loader.c_compiler() is None, reason="no C compiler: the FMUs keep pythonfmu's binary"),
+    pytest.mark.skipif(loader.c_compiler() is None, reason="no C compiler: the FMUs cannot be built"),
 ]
 
 

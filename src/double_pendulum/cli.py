@@ -602,12 +602,8 @@ def _stdout_to_devnull() -> None:
 
 
 def entry() -> None:
-    """Console-script entry point: run :func:`main` and leave without interpreter teardown.
-
-    pythonfmu (<= 0.7.0, upstream issue NTNU-IHB/PythonFMU#228) can corrupt the heap during
-    process teardown after its FMUs were used, turning a finished run into an abort. All results
-    are written by the time :func:`main` returns, so the process exits directly with its code.
-    """
+    """Console-script entry point: run :func:`main` and exit with its code, through the interpreter's
+    ordinary teardown (the FMUs' binary is safe through exit: scripts/check_memory.sh)."""
     try:
         code = main()
     except KeyboardInterrupt:  # Ctrl-C while parsing or importing
@@ -619,7 +615,7 @@ def entry() -> None:
         _stdout_to_devnull()
         code = code or 141
     sys.stderr.flush()
-    os._exit(code)
+    raise SystemExit(code)
 
 
 if __name__ == "__main__":
