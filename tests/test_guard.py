@@ -116,6 +116,26 @@ FMI2_PROBES = {
     "serialized_state_in_a_new_instance": (0, NO_LOG),
     "discarded_step_then_terminate": (2, "fmi2DoStep: the step was not completed: numerical instability at t = "),
     "do_step_after_discard": (3, "fmi2DoStep: illegal call sequence: not allowed in state Step Failed"),
+    # what the FMU leaves to the host (the first instantiation of a process: OWN_PROCESS_PROBES below)
+    "locale_unchanged": (0, NO_LOG),
+    "host_state_unchanged": (0, NO_LOG),  # environment, handlers of SIGINT ... SIGSEGV, signal mask
+    "stdio_unlocked_after_instantiate": (0, NO_LOG),  # ftrylockfile(stderr / stdout) from another thread
+    "non_ascii_folder": (1, NO_LOG),  # %-escaped URI, raw URI, plain path (a non-ASCII folder: its own test)
+    "reentrant_logger_instantiates": (0, 'fmi2Instantiate: fmuGUID "{wrong}" is not this FMU\'s'),
+    "reentrant_logger_frees_during_set_real": (3, "fmi2SetReal: ParameterError: invalid phi1_0 = nan rad"),
+    "reentrant_logger_frees_during_illegal_call": (3, "fmi2DoStep: illegal call sequence: not allowed in state "
+                                                      "Instantiated"),
+    "large_start_time_wrong_point": (3, "fmi2DoStep: currentCommunicationPoint = 1000000000.5 s is not the FMU's "
+                                        "time 1000000000 s"),
+    "large_start_time_steps": (0, NO_LOG),
+    "tampered_state_payload": (3, "fmi2DeSerializeFMUstate: the state is malformed"),
+    "tampered_state_wrong_type": (3, "fmi2DeSerializeFMUstate: the state is malformed"),
+    "tampered_state_truncated": (3, "fmi2DeSerializeFMUstate: the state is malformed"),
+    "tampered_state_truncated_header": (3, "fmi2DeSerializeFMUstate: the 100 bytes are not a serialized state of "
+                                           "this FMU (no header)"),
+    "state_of_another_instance_set": (3, "fmi2SetFMUstate: FMU state 0x"),
+    "state_of_another_instance_free": (3, "fmi2FreeFMUstate: FMU state 0x"),
+    "state_of_another_instance_size": (3, "fmi2SerializedFMUstateSize: FMU state 0x"),
 }
 # What the calls without an instance (no logger to use) say on stderr, one line each.
 ORPHANS = ["fmi2Instantiate: functions is NULL", "fmi2Instantiate: functions->logger is NULL",
@@ -171,6 +191,18 @@ FMI3_PROBES = {
     "evaluate_discrete_states": (3, "fmi3EvaluateDiscreteStates: not supported by this FMU"),
     "null_instance": (3, NO_LOG),
     "error_state_then_reset": (0, "fmi3DoStep: illegal call sequence: not allowed in state Error"),
+    "me_derivatives_in_initialization": (0, NO_LOG),  # OK, finite, equal (1e-12) to those after exit
+    "me_set_continuous_states_nan": (3, "fmi3SetContinuousStates: continuousStates[3] = nan is not finite"),
+    "me_huge_states_derivatives_discard": (2, "fmi3GetContinuousStateDerivatives: derivatives["),
+    "tampered_state_interface": (3, "fmi3DeserializeFMUState: the bytes are a ModelExchange state; this instance is "
+                                    "CoSimulation"),
+}
+# The probes' own words besides the fragments above.
+PROBE_LINES = {
+    "state_of_another_instance_set": "belongs to instance",
+    "state_of_another_instance_free": "belongs to instance",
+    "state_of_another_instance_size": "belongs to instance",
+    "me_huge_states_derivatives_discard": "is not finite at these continuous states",
 }
 
 
@@ -260,11 +292,18 @@ def test_the_sanitized_session_runs_sanitized_loaders_and_hosts(hosts, extracted
         assert b"libasan.so" in data and b"libubsan.so" in data, f"{path} is not sanitized"
 
 
+def check_probe_lines(probes: dict) -> None:
+    for name, words in PROBE_LINES.items():
+        if name in probes:
+            assert any(words in text for _, text in probes[name][1]), (name, words, probes[name])
+
+
 def test_every_fmi2_probe_gets_the_standards_answer_and_a_log_line(hosts, extracted, tmp_path):
     folder, description = extracted["fmi2"]
     done = run(host_command(hosts[2], folder, description, 2, "probes"), tmp_path)
     assert done.returncode == 0 and done.stdout.rstrip().endswith("end"), done.stdout[-3000:] + done.stderr
     check_probes(parse_probes(done.stdout), FMI2_PROBES)
+    check_probe_lines(parse_probes(done.stdout))
     errors = done.stderr.splitlines()
     assert len(errors) == 6 and all(line.startswith("[DoublePendulum] ") for line in errors), errors
     for fragment in ORPHANS:
@@ -276,6 +315,7 @@ def test_every_fmi3_probe_gets_the_standards_answer_and_a_log_line(hosts, extrac
     done = run(host_command(hosts[3], folder, description, 3, "probes"), tmp_path)
     assert done.returncode == 0 and done.stdout.rstrip().endswith("end"), done.stdout[-3000:] + done.stderr
     check_probes(parse_probes(done.stdout), FMI3_PROBES)
+    check_probe_lines(parse_probes(done.stdout))
     assert done.stderr.splitlines() == ["[DoublePendulum] fmi3DoStep: the instance is NULL"]
 
 
@@ -411,3 +451,134 @@ def test_python_threads_run_instances_at_once_in_fmpy(extracted):
     with ThreadPoolExecutor(max_workers=8) as pool:
         parallel = list(pool.map(case, starts))
     assert parallel == [case(start) for start in starts]
+
+
+# --------------------------------------------------------------------- what the FMU leaves to the host
+
+
+def probe_info(stdout: str, name: str) -> list[str]:
+    """The "  info" lines a probe printed after its "probe" line."""
+    lines, inside = [], False
+    for line in stdout.splitlines():
+        if line.startswith("probe "):
+            inside = line.split()[1] == name
+        elif inside and line.startswith("  info "):
+            lines.append(line[7:])
+    return lines
+
+
+def run_own(hosts, version: int, folder: Path, description, tmp_path: Path, name: str, env: dict | None = None,
+            options: tuple[str, ...] = (), timeout: float = 120) -> tuple[int, list, list[str], str]:
+    """One probe in a process of its own (its first instantiation), with a bare environment plus `env`:
+    its status, log lines, info lines and the host's stderr."""
+    command = host_command(hosts[version], folder, description, version, *options, "probes", name)
+    done = subprocess.run(command, capture_output=True, text=True, cwd=tmp_path, timeout=timeout,
+                          env={"PATH": "/usr/bin:/bin", "HOME": str(tmp_path), **(env or {})})
+    assert done.returncode == 0 and done.stdout.rstrip().endswith("end"), done.stdout[-3000:] + done.stderr[-3000:]
+    status, logs = parse_probes(done.stdout)[name]
+    return status, logs, probe_info(done.stdout, name), done.stderr
+
+
+@pytest.mark.parametrize("name", ["locale_unchanged", "host_state_unchanged", "stdio_unlocked_after_instantiate"])
+def test_the_first_instantiation_leaves_locale_signals_environment_and_stdio_as_the_host_had_them(
+        hosts, extracted, tmp_path, name):
+    """A C host that never called setlocale, started with LANG=C.UTF-8 (LC_ALL unset): its first
+    instantiation (Python started in it) leaves setlocale(LC_ALL, NULL) "C"; the environment, the
+    dispositions of SIGINT, SIGTERM (the host's own handlers), SIGPIPE, SIGCHLD, SIGXFSZ, SIGSEGV and the
+    signal mask are unchanged after instantiation and after free; another thread gets stderr's and
+    stdout's locks right after fmi2Instantiate returns."""
+    folder, description = extracted["fmi2"]
+    status, logs, info, _ = run_own(hosts, 2, folder, description, tmp_path, name, {"LANG": "C.UTF-8"})
+    assert (status, logs) == (0, []), (status, logs, info)
+    if name == "locale_unchanged":
+        assert info == ["LANG=C.UTF-8 LC_ALL=(unset) locale before=C after-instantiate=C after-free=C"], info
+
+
+def test_another_thread_writes_to_stderr_while_the_first_instantiation_runs(hosts, extracted, tmp_path):
+    """A thread writes a line with its time to stderr every 0.5 ms while the process's first fmi2Instantiate
+    runs (it starts Python, which holds stderr's lock only while the interpreter starts): the longest gap
+    between its lines is well under the instantiation's time (half of it at most; measured in 11 runs: gaps of
+    5 to 16 ms in instantiations of 54 to 161 ms, at most 0.18 of it)."""
+    folder, description = extracted["fmi2"]
+    status, logs, info, stderr = run_own(hosts, 2, folder, description, tmp_path,
+                                         "stderr_writable_while_instantiating", {"LANG": "C.UTF-8"})
+    assert (status, logs) == (0, []), (status, logs, info)
+    words = info[0].split()
+    gap, instantiation, writes = float(words[1]), float(words[3]), int(words[5])
+    print(f"longest stderr gap {gap:.1f} ms while instantiating for {instantiation:.1f} ms ({writes} lines)")
+    assert gap < 0.5 * instantiation, info
+    assert stderr.count("stderr-writer") >= writes
+
+
+@pytest.mark.parametrize("locale", [{"LC_ALL": "C"}, {"LANG": "C.UTF-8"}], ids=["C-locale", "C.UTF-8"])
+def test_an_fmu_in_a_folder_with_a_non_ascii_name(hosts, extracted, tmp_path, locale):
+    """The extracted FMU copied under a folder named "Ünï dir" (UTF-8): its resources named as a %-escaped
+    file URI, a file URI with the raw bytes and a plain path all instantiate and step, in a C-locale host
+    (LANG unset, LC_ALL=C) and with LANG=C.UTF-8."""
+    import shutil
+
+    folder, description = extracted["fmi2"]
+    copy = tmp_path / "Ünï dir" / "DoublePendulum"
+    shutil.copytree(folder, copy)
+    status, logs, info, stderr = run_own(hosts, 2, copy, description, tmp_path, "non_ascii_folder", locale)
+    assert (status, logs) == (1, []), (status, logs, info, stderr)
+    assert "%C3%9Cn%C3%AF%20dir" in info[0] and ": 0; raw" in info[0] and "plain path: 0" in info[0], info
+
+
+@pytest.mark.parametrize("name, other", [("foreign_resources", "(Suspension"),
+                                         ("foreign_resources_reverse", "(DoublePendulum")])
+def test_the_resources_of_the_other_fmu_are_refused_by_name(hosts, extracted, tmp_path, name, other):
+    """DoublePendulum's binary and GUID with Suspension's resources folder, and Suspension's binary and
+    GUID with DoublePendulum's: NULL, with a line that names the FMU whose resources they are."""
+    folder, description = extracted["fmi2"]
+    suspension, suspension_description = extracted["suspension"]
+    options = (f"other_dir={suspension}", "other_id=Suspension", f"other_guid={suspension_description.guid}")
+    status, logs, _, _ = run_own(hosts, 2, folder, description, tmp_path, name, options=options)
+    assert status == 0, logs
+    assert [level for level, _ in logs] == [3], logs
+    assert f"is the resources folder of another FMU {other}" in logs[0][1], logs
+
+
+@pytest.mark.xfail(strict=True, reason="the second call is fmi3OK: after the first fmi3Error the instance is in the "
+                   "loader's Error state, whose MASK_STATE_VECTORS (fmi3_guard.c) lets the Python side answer with "
+                   "the derivatives of a model never initialised (FMI 3.0.2, 2.3.1, puts an instance whose call "
+                   "returned fmi3Error in Terminated, where the call is allowed 'for debugging only')")
+def test_model_exchange_derivatives_twice_in_instantiated_are_both_refused(hosts, extracted, tmp_path):
+    folder, description = extracted["fmi3"]
+    status, logs, info, stderr = run_own(hosts, 3, folder, description, tmp_path,
+                                         "me_derivatives_twice_in_instantiated")
+    assert "Traceback" not in stderr
+    assert status == 3, (status, logs, info)
+
+
+def rss_figures(stdout: str) -> dict[int, int]:
+    return {int(k): int(kib) for _, k, kib in (line.split() for line in stdout.splitlines()
+                                               if line.startswith("rss "))}
+
+
+@pytest.mark.slow
+def test_ten_thousand_instantiate_free_cycles_cost_no_memory_after_warm_up(hosts, extracted, tmp_path):
+    """10,000 instantiate/initialise/step/free cycles (the soak mode): resident memory grows by less than
+    0.2 KiB a cycle over the 8,000 after a warm-up of 2,000 (measured: 0 KiB; from cycle 500 on 0.04)."""
+    folder, description = extracted["fmi2"]
+    done = run(host_command(hosts[2], folder, description, 2, "soak", "10000"), tmp_path)
+    assert done.returncode == 0, done.stdout[-2000:] + done.stderr
+    rss = rss_figures(done.stdout)
+    slope = (rss[10000] - rss[2000]) / 8000
+    print(f"C host soak: {slope:.3f} KiB per cycle over cycles 2000-10000 ({rss[2000]} -> {rss[10000]} KiB)")
+    assert slope < 0.2, rss
+
+
+@pytest.mark.xfail(strict=True, reason="measured 2.2 KiB a cycle over cycles 50-300 (15,600 -> 16,128 KiB); the "
+                   "same early growth with the library kept loaded (2.1 KiB a cycle), flat only after about 1,000 "
+                   "cycles; over cycles 2,000-3,000 0.35 KiB a cycle with dlclose, 0.16 with the library kept")
+def test_dlopen_instantiate_free_dlclose_cycles_are_flat_after_fifty(hosts, extracted, tmp_path):
+    """300 cycles of dlopen, fmi2Instantiate, fmi2FreeInstance, dlclose of the binary (no other handle on
+    it): less than 1 KiB a cycle after the first 50."""
+    folder, description = extracted["fmi2"]
+    done = run(host_command(hosts[2], folder, description, 2, "reload", "300"), tmp_path)
+    assert done.returncode == 0 and "reload-failed" not in done.stdout, done.stdout[-2000:] + done.stderr
+    rss = rss_figures(done.stdout)
+    slope = (rss[300] - rss[50]) / 250
+    print(f"dlopen/dlclose cycles: {slope:.2f} KiB per cycle over cycles 50-300 ({rss[50]} -> {rss[300]} KiB)")
+    assert slope < 1.0, rss
