@@ -83,7 +83,7 @@ static const char *state_name(int state) {
 #define MASK_GetRealOutputDerivatives (STEP_COMPLETE | STEP_FAILED | TERMINATED | ERROR_STATE)
 #define MASK_DoStep STEP_COMPLETE
 #define MASK_CancelStep 0 /* only while an asynchronous step is in progress: never here */
-#define MASK_STATUS (STEP_COMPLETE | STEP_FAILED | TERMINATED | ERROR_STATE)
+#define MASK_STATUS (STEP_COMPLETE | STEP_FAILED | TERMINATED) /* not in Error (4.2.4, its table) */
 
 static int state_allowed(const char *interface, int state) {
     (void)interface;

@@ -46,12 +46,11 @@ enum {
     EVENT = 1 << 3,           /* Model Exchange */
     CONTINUOUS_TIME = 1 << 4, /* Model Exchange */
     STEP = 1 << 5,            /* Co-Simulation */
-    STEP_DISCARDED = 1 << 6,  /* Co-Simulation: doStep returned fmi3Discard */
     TERMINATED = 1 << 7,
     ERROR_STATE = 1 << 8, /* a call returned fmi3Error */
 };
 #define ANY_STATE                                                                                                 \
-    (INSTANTIATED | CONFIGURATION | INITIALIZATION | EVENT | CONTINUOUS_TIME | STEP | STEP_DISCARDED | TERMINATED | \
+    (INSTANTIATED | CONFIGURATION | INITIALIZATION | EVENT | CONTINUOUS_TIME | STEP | TERMINATED | \
      ERROR_STATE)
 
 static const char *state_name(int state) {
@@ -62,7 +61,6 @@ static const char *state_name(int state) {
     case EVENT: return "Event Mode";
     case CONTINUOUS_TIME: return "Continuous-Time Mode";
     case STEP: return "Step Mode";
-    case STEP_DISCARDED: return "Step Mode after fmi3Discard";
     case TERMINATED: return "Terminated";
     default: return "Error (after fmi3Error: only get, FMU states, reset and free)";
     }
@@ -73,14 +71,14 @@ static const char *state_name(int state) {
 #define MASK_EnterInitializationMode INSTANTIATED
 #define MASK_ExitInitializationMode INITIALIZATION
 #define MASK_EnterEventMode CONTINUOUS_TIME /* Co-Simulation: Event Mode is not offered */
-#define MASK_Terminate (EVENT | CONTINUOUS_TIME | STEP | STEP_DISCARDED)
+#define MASK_Terminate (EVENT | CONTINUOUS_TIME | STEP)
 #define MASK_Reset ANY_STATE
-#define MASK_GET (CONFIGURATION | INITIALIZATION | EVENT | CONTINUOUS_TIME | STEP | STEP_DISCARDED | TERMINATED | \
-                  ERROR_STATE)
-#define MASK_SET_FLOAT64 (INSTANTIATED | CONFIGURATION | INITIALIZATION | EVENT | CONTINUOUS_TIME | STEP)
-#define MASK_SET (INSTANTIATED | CONFIGURATION | INITIALIZATION | EVENT | STEP)
+/* start values are read in Instantiated (2.3.2); Configuration Mode is for structural parameters only (2.3.6) */
+#define MASK_GET (INSTANTIATED | INITIALIZATION | EVENT | CONTINUOUS_TIME | STEP | TERMINATED | ERROR_STATE)
+#define MASK_SET_FLOAT64 (INSTANTIATED | INITIALIZATION | EVENT | CONTINUOUS_TIME | STEP)
+#define MASK_SET (INSTANTIATED | INITIALIZATION | EVENT | STEP)
 #define MASK_FMU_STATE ANY_STATE
-#define MASK_DERIVATIVES (INITIALIZATION | EVENT | CONTINUOUS_TIME | STEP | STEP_DISCARDED | TERMINATED | ERROR_STATE)
+#define MASK_DERIVATIVES (INITIALIZATION | EVENT | CONTINUOUS_TIME | STEP | TERMINATED | ERROR_STATE)
 #define MASK_EnterConfigurationMode INSTANTIATED
 #define MASK_ExitConfigurationMode CONFIGURATION
 #define MASK_UpdateDiscreteStates EVENT
@@ -89,15 +87,16 @@ static const char *state_name(int state) {
 #define MASK_SetTime (EVENT | CONTINUOUS_TIME)
 #define MASK_SetContinuousStates CONTINUOUS_TIME
 #define MASK_STATE_VECTORS (INITIALIZATION | EVENT | CONTINUOUS_TIME | TERMINATED | ERROR_STATE)
-#define MASK_NUMBERS ANY_STATE
+#define MASK_NUMBERS ANY_STATE /* Model Exchange only (2.3.2) */
+#define MASK_EvaluateDiscreteStates EVENT
 #define MASK_EnterStepMode EVENT /* not reached: without Event Mode Co-Simulation goes to Step Mode */
-#define MASK_GetOutputDerivatives (STEP | STEP_DISCARDED | TERMINATED | ERROR_STATE)
+#define MASK_GetOutputDerivatives (STEP | TERMINATED | ERROR_STATE)
 #define MASK_DoStep STEP
 #define MASK_ANY ANY_STATE
 
 
 #define ME_STATES (INSTANTIATED | CONFIGURATION | INITIALIZATION | EVENT | CONTINUOUS_TIME | TERMINATED | ERROR_STATE)
-#define CS_STATES (INSTANTIATED | CONFIGURATION | INITIALIZATION | STEP | STEP_DISCARDED | TERMINATED | ERROR_STATE)
+#define CS_STATES (INSTANTIATED | CONFIGURATION | INITIALIZATION | STEP | TERMINATED | ERROR_STATE)
 
 static int state_allowed(const char *interface, int state) {
     return (state & (strcmp(interface, MODEL_EXCHANGE) == 0 ? ME_STATES : CS_STATES)) != 0;
@@ -275,11 +274,11 @@ FMI3_Export fmi3Status fmi3Reset(fmi3Instance instance) {
     return (fmi3Status)guard_reset(&g->common);
 }
 
-/* No structural parameters: Configuration Mode has nothing to configure, but its calls are legal. */
+/* No structural parameters: Configuration Mode is not to be entered (2.3.2), its exit never reached. */
 FMI3_Export fmi3Status fmi3EnterConfigurationMode(fmi3Instance instance) {
     BEGIN(EnterConfigurationMode);
-    g->common.at.state = CONFIGURATION;
-    return fmi3OK;
+    return (fmi3Status)fail(&g->common, "fmi3EnterConfigurationMode: this FMU has no structural parameters, so "
+                                        "there is nothing to configure (FMI 3.0, section 2.3.2)");
 }
 
 FMI3_Export fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
@@ -476,14 +475,14 @@ STATE_VECTOR(GetNominalsOfContinuousStates, "get_nominals_of_continuous_states",
 STATE_VECTOR(GetEventIndicators, "get_event_indicators", eventIndicators, nEventIndicators, N_EVENT_INDICATORS)
 
 FMI3_Export fmi3Status fmi3GetNumberOfContinuousStates(fmi3Instance instance, size_t *nContinuousStates) {
-    BEGIN_FOR(GetNumberOfContinuousStates, MASK_NUMBERS, BOTH);
+    BEGIN_FOR(GetNumberOfContinuousStates, MASK_NUMBERS, ME);
     REQUIRE_OUT(GetNumberOfContinuousStates, nContinuousStates);
     *nContinuousStates = N_CONTINUOUS_STATES;
     return fmi3OK;
 }
 
 FMI3_Export fmi3Status fmi3GetNumberOfEventIndicators(fmi3Instance instance, size_t *nEventIndicators) {
-    BEGIN_FOR(GetNumberOfEventIndicators, MASK_NUMBERS, BOTH);
+    BEGIN_FOR(GetNumberOfEventIndicators, MASK_NUMBERS, ME);
     REQUIRE_OUT(GetNumberOfEventIndicators, nEventIndicators);
     *nEventIndicators = N_EVENT_INDICATORS;
     return fmi3OK;
@@ -505,8 +504,7 @@ FMI3_Export fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentComm
     int status = CALL(NO_PAYLOAD, "do_step", "(ddi)", currentCommunicationPoint, communicationStepSize,
                       (int)noSetFMUStatePriorToCurrentPoint);
     *eventHandlingNeeded = fmi3False, *earlyReturn = fmi3False;
-    if (status == fmi3Discard) { /* the solver gave up: the FMU stays where the step began */
-        at->state = STEP_DISCARDED;
+    if (status == fmi3Discard) { /* the solver gave up: the FMU stays where the step began, in Step Mode (2.2.3) */
         at->last_successful_time = at->time;
         at->wants_to_terminate = 1;
         *terminateSimulation = fmi3True, *lastSuccessfulTime = at->time;
@@ -516,6 +514,12 @@ FMI3_Export fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentComm
     if (status <= fmi3Warning) at->time = at->last_successful_time = currentCommunicationPoint + communicationStepSize;
     *terminateSimulation = fmi3False, *lastSuccessfulTime = at->last_successful_time;
     return (fmi3Status)status;
+}
+
+/* Without providesEvaluateDiscreteStates the call "is ignored" (2.3.5): there are no discrete states. */
+FMI3_Export fmi3Status fmi3EvaluateDiscreteStates(fmi3Instance instance) {
+    BEGIN_FOR(EvaluateDiscreteStates, MASK_EvaluateDiscreteStates, BOTH);
+    return fmi3OK;
 }
 
 FMI3_Export fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueReference valueReferences[],
@@ -567,7 +571,6 @@ UNSUPPORTED(SetIntervalDecimal, (fmi3Instance instance, VR, const fmi3Float64 v[
 UNSUPPORTED(SetIntervalFraction, (fmi3Instance instance, VR, const fmi3UInt64 c[], const fmi3UInt64 r[]), NO_CLOCKS)
 UNSUPPORTED(SetShiftDecimal, (fmi3Instance instance, VR, const fmi3Float64 v[]), NO_CLOCKS)
 UNSUPPORTED(SetShiftFraction, (fmi3Instance instance, VR, const fmi3UInt64 c[], const fmi3UInt64 r[]), NO_CLOCKS)
-UNSUPPORTED(EvaluateDiscreteStates, (fmi3Instance instance), "it has no discrete states")
 UNSUPPORTED(ActivateModelPartition, (fmi3Instance instance, fmi3ValueReference clock, fmi3Float64 time),
             "Scheduled Execution is not offered")
 UNSUPPORTED(GetNumberOfVariableDependencies, (fmi3Instance instance, fmi3ValueReference v, size_t *n),
