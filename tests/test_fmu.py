@@ -294,3 +294,20 @@ def test_a_newer_build_module_makes_the_fmu_stale(fmu_path, tmp_path, monkeypatc
     os.utime(newer, (fmu_path.stat().st_mtime + 60,) * 2)
     monkeypatch.setattr(build, "build_sources", lambda: [newer])
     assert not build.fmu_is_current(fmu_path)
+
+
+def test_every_fmu_claims_only_the_platform_it_ran_on_and_no_sources_that_do_not_build_it(fmu_path):
+    """Each FMU's binaries are the Linux loader alone (pythonfmu's binaries for other platforms, never run, are
+    left out), the container's only fmpy's Linux binary (every member has the Linux loader only), and no FMU
+    ships sources/ (pythonfmu3's sources build its own C++ library, not the FMU's binary)."""
+    folder = fmu_path.parent
+    for fmu, platform in ((fmu_path, "linux64"), (folder / "Suspension.fmu", "linux64"),
+                          (folder / "fmi3" / "DoublePendulum.fmu", "x86_64-linux"),
+                          (folder / "PendulumOnSuspension.fmu", "linux64")):
+        with zipfile.ZipFile(fmu) as z:
+            names = z.namelist()
+        platforms = {n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") >= 2}
+        assert platforms == {platform}, (fmu.name, platforms)
+        assert not [n for n in names if n.startswith("sources/")], fmu.name
+        members = {n.split("/")[3] for n in names if n.startswith("resources/") and "/binaries/" in n}
+        assert members <= {"linux64"}, (fmu.name, members)

@@ -239,7 +239,9 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
     token = instantiation_token(files["modelDescription.xml"])
     # The FMI library's binaries (pythonfmu's C++ layer, for every platform it ships) are left out: the
     # FMU's one binary is the loader, built here from source, which calls the Python side itself.
-    files = {name: data for name, data in files.items() if not name.startswith("binaries/")}
+    # pythonfmu3's sources/ build its own C++ library, not this binary: an FMU carries no sources that do not
+    # build it
+    files = {name: data for name, data in files.items() if not name.startswith(("binaries/", "sources/"))}
     binary = f"binaries/{loader.PLATFORMS[fmi_version]}/{model_identifier}.so"
     files[binary] = loader.compiled_loader(fmi_version, {"MODEL_IDENTIFIER": model_identifier, "FMU_GUID": token,
                                                          **(defines or {})})

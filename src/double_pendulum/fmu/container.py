@@ -161,11 +161,9 @@ def write_container(
         write_model_description(config.modelDescription, root / "modelDescription.xml")
         write_configuration(config, root / "resources" / "container.json")
         _fix_connection_types(root / "resources" / "container.json")
-        for platform_tuple, fmi2_platform, library in (
-            ("x86_64-linux", "linux64", "container_fmu.so"),
-            ("x86_64-windows", "win64", "container_fmu.dll"),
-            ("x86_64-darwin", "darwin64", "container_fmu.dylib"),
-        ):
+        # fmpy's container binary only for the platforms every member has a binary for (their loaders: Linux):
+        # a container claims to run only where all of it can
+        for platform_tuple, fmi2_platform, library in (("x86_64-linux", "linux64", "container_fmu.so"),):
             (root / "binaries" / fmi2_platform).mkdir(parents=True, exist_ok=True)
             shutil.copyfile(binaries / platform_tuple / library, root / "binaries" / fmi2_platform / library)
         if documented:
