@@ -152,3 +152,29 @@ def test_the_example_in_the_help_runs_as_written(fmu_path, tmp_path, capsys):
     argv = [*example[1:-2], "--stop", "0.5", "--fmu", str(fmu_path), "--out", str(tmp_path / "my_case")]
     assert main(argv) == 0
     assert Path(tmp_path / "my_case" / "simulation.png").stat().st_size > 10_000
+
+
+def test_the_summary_s_fmpy_call_works_from_any_folder_and_null_means_only_explains_nulls(tmp_path, fmu_path,
+                                                                                       monkeypatch):
+    """The summary's fmpy call names the FMU by its absolute path (run from another folder it gives the same
+    numbers as the case's CSV); ``null_means`` explains only the values that are null."""
+    import ast
+    import os
+
+    from double_pendulum.case import Case, run_case
+
+    monkeypatch.chdir(fmu_path.parent)
+    (tmp_path / "case").mkdir()
+    outcome = run_case(Case(fmu=Path(fmu_path.name), start_values={"phi1_0": 1.0}, stop_time=0.2),
+                       tmp_path / "case", animate=False)
+    summary = json.loads((tmp_path / "case" / "summary.json").read_text())
+    call = ast.parse(summary["fmpy_call"], mode="eval").body
+    path = ast.literal_eval(call.args[0])
+    assert os.path.isabs(path)
+    monkeypatch.chdir(tmp_path)  # another folder
+    again = simulate_fmu(path, **{k.arg: ast.literal_eval(k.value) for k in call.keywords})
+    written = read_results_csv(tmp_path / "case" / "simulation.csv")
+    assert float(again["phi1"][-1]) == float(written["phi1"][-1])
+    for key in summary["null_means"]:
+        assert summary.get(key) is None, (key, summary.get(key))
+    assert outcome.message is None and "fmu_message" in summary["null_means"]

@@ -55,8 +55,8 @@ class Case:
     fmi_type: str = "CoSimulation"
 
     def fmpy_call(self) -> str:
-        """The Python call that gives the same numbers."""
-        return (f"fmpy.simulate_fmu({str(self.fmu)!r}, fmi_type={self.fmi_type!r}, "
+        """The Python call that gives the same numbers, from any folder (the FMU's absolute path)."""
+        return (f"fmpy.simulate_fmu({str(Path(self.fmu).resolve())!r}, fmi_type={self.fmi_type!r}, "
                 f"start_values={self.start_values!r}, stop_time={self.stop_time!r}, "
                 f"output_interval={self.output_interval!r})")
 
@@ -94,13 +94,15 @@ def _summary(case: Case, runner: FmuRunner, result: np.ndarray | None, message: 
         "fmu_message": message,
         "rows": 0 if result is None else len(result),
         "wall_time_s": wall_s,
-        "null_means": {"fmu_message": "the run reached its stop time",
-                       "relative_tolerance": "not used: the FMU integrates with its own solver (its rtol)"},
+        "null_means": {},  # why a value is null, for the values that are (runs.page.null_reason)
     }
+    if message is None:
+        summary["null_means"]["fmu_message"] = "the run reached its stop time"
     if case.fmi_type == "ModelExchange":  # fmpy's CVode: the default experiment's tolerance, else its own 1e-5
         summary["relative_tolerance"] = float(experiment.tolerance) if experiment and experiment.tolerance else 1e-5
     else:
         summary["relative_tolerance"] = None
+        summary["null_means"]["relative_tolerance"] = "not used: the FMU integrates with its own solver (its rtol)"
     if result is not None and len(result):
         e = np.asarray(result["E_total"])
         summary.update(end_time_s=float(result["time"][-1]), E_total_start_J=float(e[0]),
