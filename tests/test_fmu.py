@@ -10,6 +10,7 @@ import sys
 import sysconfig
 import textwrap
 import zipfile
+from pathlib import Path
 from xml.etree import ElementTree as ET
 
 import numpy as np
@@ -311,3 +312,23 @@ def test_every_fmu_claims_only_the_platform_it_ran_on_and_no_sources_that_do_not
         assert not [n for n in names if n.startswith("sources/")], fmu.name
         members = {n.split("/")[3] for n in names if n.startswith("resources/") and "/binaries/" in n}
         assert members <= {"linux64"}, (fmu.name, members)
+
+
+def test_every_fmu_carries_the_licences_of_what_it_bundles(fmu_path):
+    """documentation/licenses/: the project's MIT licence and those of pythonfmu (FMI 2) or pythonfmu3 (FMI 3),
+    and for the container fmpy's (its container binary), each the text the distribution ships."""
+    from double_pendulum.fmu.presentation import distribution_licence
+
+    project = (Path(__file__).resolve().parents[1] / "LICENSE").read_bytes()
+    folder = fmu_path.parent
+    for fmu, bundled in ((fmu_path, ("double-pendulum-fmu", "pythonfmu")),
+                         (folder / "Suspension.fmu", ("double-pendulum-fmu", "pythonfmu")),
+                         (folder / "fmi3" / "DoublePendulum.fmu", ("double-pendulum-fmu", "pythonfmu3")),
+                         (folder / "PendulumOnSuspension.fmu", ("double-pendulum-fmu", "fmpy"))):
+        with zipfile.ZipFile(fmu) as z:
+            licences = {n.rpartition("/")[2]: z.read(n) for n in z.namelist()
+                        if n.startswith("documentation/licenses/")}
+        assert set(licences) == {f"{name}.txt" for name in bundled}, (fmu.name, sorted(licences))
+        assert licences["double-pendulum-fmu.txt"].strip() == project.strip()
+        for name in bundled:
+            assert licences[f"{name}.txt"] == distribution_licence(name) and len(licences[f"{name}.txt"]) > 200

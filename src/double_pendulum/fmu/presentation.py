@@ -7,7 +7,9 @@
 * the icon: ``model.png`` (FMI 2.0) and ``terminalsAndIcons/icon.png`` (FMI 3.0, and FMI 2.0.4's
   back-port), :mod:`double_pendulum.fmu.icons`;
 * ``terminalsAndIcons/terminalsAndIcons.xml`` with the terminals of the FMU's variables and their
-  pictures (:mod:`double_pendulum.fmu.terminals`).
+  pictures (:mod:`double_pendulum.fmu.terminals`);
+* ``documentation/licenses/<distribution>.txt``: the licence of everything the FMU bundles
+  (:func:`licence_files`).
 
 The build adds them in :func:`double_pendulum.fmu.build.rewrite_fmu` (DoublePendulum, Suspension, the
 FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.container.write_container` (the container).
@@ -15,6 +17,7 @@ FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.container.write_container` 
 
 from __future__ import annotations
 
+import importlib.metadata
 from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
@@ -65,6 +68,31 @@ def _plot_case(model: str, fmi_version: int, root: ET.Element,
     return dict(start_values), stop, step, caption
 
 
+# What each FMU bundles, by the distribution it comes from: the project's runtime and adapters, and the FMI
+# library's Python part (FMI 2: pythonfmu, FMI 3: pythonfmu3); the container fmpy's container binary (its two
+# FMUs inside carry their own licences).
+BUNDLED = {2: ("double-pendulum-fmu", "pythonfmu"), 3: ("double-pendulum-fmu", "pythonfmu3")}
+CONTAINER_BUNDLED = ("double-pendulum-fmu", "fmpy")
+LICENCE_FOLDER = "documentation/licenses"
+
+
+def distribution_licence(name: str) -> bytes:
+    """The licence text(s) the installed distribution ``name`` ships in its metadata (PEP 639's licenses/, or
+    the older place beside METADATA), joined; raises LookupError if it ships none."""
+    dist = importlib.metadata.distribution(name)
+    texts = [f.read_text(encoding="utf-8") for f in (dist.files or [])
+             if ".dist-info" in str(f) and f.name.upper().startswith(("LICEN", "COPYING"))]
+    if not texts:
+        raise LookupError(f"the installed {name} ships no licence file in its metadata")
+    return "\n".join(texts).encode()
+
+
+def licence_files(model: str, fmi_version: int) -> dict[str, bytes]:
+    """``documentation/licenses/<distribution>.txt`` for everything the FMU ``model`` bundles."""
+    names = CONTAINER_BUNDLED if model == CONTAINER else BUNDLED[fmi_version]
+    return {f"{LICENCE_FOLDER}/{name}.txt": distribution_licence(name) for name in names}
+
+
 def presentation_files(model: str, fmi_version: int, files: Mapping[str, bytes],
                        start_values: Mapping[str, Any] | None = None) -> dict[str, bytes]:
     """The documentation, icon and terminal files of an FMU whose other files are ``files``.
@@ -90,5 +118,6 @@ def presentation_files(model: str, fmi_version: int, files: Mapping[str, bytes],
     out[terminals.FILE] = terminals.terminals_xml(found)
     for path in sorted(terminals.icon_files(found)):
         out[path] = icons.terminal_icon(path.rpartition("/")[2].removesuffix(".png"))
+    out.update(licence_files(model, fmi_version))
     return out
 
