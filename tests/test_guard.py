@@ -578,14 +578,19 @@ def test_ten_thousand_instantiate_free_cycles_cost_no_memory_after_warm_up(hosts
 @pytest.mark.slow
 @not_sanitized
 def test_dlopen_instantiate_free_dlclose_cycles_are_flat_after_warm_up(hosts, extracted, tmp_path):
-    """2,000 cycles of dlopen, fmi2Instantiate, fmi2FreeInstance, dlclose of the binary (no other handle on
-    it): less than 0.5 KiB a cycle over the last 1,000. The first few hundred grow by about 2 KiB a cycle,
-    with the library kept loaded as much (measured: 2.1 KiB, CPython's allocator warming up); over cycles
-    2,000-3,000, 0.35 KiB a cycle with dlclose and 0.16 with the library kept."""
+    """6,000 cycles of dlopen, fmi2Instantiate, fmi2FreeInstance, dlclose of the binary (no other handle on
+    it): the growth per cycle, the median over the 300-cycle windows from cycle 1,800 on, is less than 0.5 KiB
+    (the FMU before: 18 KiB a cycle). The first 2,000 or so grow by up to 2 KiB a cycle, with the library kept
+    loaded about as much (CPython's allocator warming up), and the allocator takes a step of a few hundred KiB
+    now and then, which the median leaves out; between them, quiet, 0.14 to 0.15 KiB a cycle, steady (10,000
+    cycles, two runs), a residue of loading the binary again that the cycles with the library kept do not show."""
     folder, description = extracted["fmi2"]
-    done = run(host_command(hosts[2], folder, description, 2, "reload", "2000"), tmp_path)
+    done = run(host_command(hosts[2], folder, description, 2, "reload", "6000"), tmp_path)
     assert done.returncode == 0 and "reload-failed" not in done.stdout, done.stdout[-2000:] + done.stderr
     rss = rss_figures(done.stdout)
-    slope = (rss[2000] - rss[1000]) / 1000
-    print(f"dlopen/dlclose cycles: {slope:.2f} KiB per cycle over cycles 1000-2000 ({rss[1000]} -> {rss[2000]} KiB)")
-    assert slope < 0.5, rss
+    cycles = sorted(k for k in rss if k >= 1800)
+    slopes = sorted((rss[b] - rss[a]) / (b - a) for a, b in zip(cycles, cycles[1:]))
+    median = slopes[len(slopes) // 2]
+    print(f"dlopen/dlclose cycles: median {median:.2f} KiB per cycle over {len(slopes)} windows from cycle "
+          f"{cycles[0]} on ({rss[cycles[0]]} -> {rss[cycles[-1]]} KiB)")
+    assert median < 0.5, rss
