@@ -80,7 +80,7 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
         if var.causality == "parameter":
             variable = _TYPES[var.fmi_type](
                 name, causality=Causality.parameter, variability=Variability.fixed, description=var.description,
-                getter=lambda: self._sim.get(name), setter=lambda value: self._guarded(self._sim.set, name, value),
+                getter=lambda: self._sim.get(name), setter=lambda value: self._sim.set(name, value),
                 **unit)
         elif var.causality == "input":
             variable = Float64(
@@ -126,17 +126,17 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
         self._model_exchange().set_time(time)
 
     def _set_input(self, name: str, value: float) -> None:
-        self._guarded(self._sim.set_input, name, value)
+        self._sim.set_input(name, value)
         if self._states is not None:
             self._states.note_input(name, float(value))
 
     def _output(self, name: str) -> float:
         if self._model_exchange_used:
-            return self._guarded(self._states.output, name)
+            return self._states.output(name)
         return super()._output(name)
 
     def exit_initialization_mode(self):
-        self._guarded(self._sim.initialise)
+        self._sim.initialise()
         self._states = PendulumStates(self._sim)
 
     def _view(self) -> PendulumStates:

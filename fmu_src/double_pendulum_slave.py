@@ -91,7 +91,7 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
                 variability=Fmi2Variability.fixed,
                 description=var.description,
                 getter=lambda: self._sim.get(name),
-                setter=lambda value: self._guarded(self._sim.set, name, value),
+                setter=lambda value: self._sim.set(name, value),
             )
         elif var.causality == "input":
             variable = Real(
@@ -100,7 +100,7 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
                 variability=Fmi2Variability.continuous,
                 description=var.description,
                 getter=lambda: self._sim.get(name),
-                setter=lambda value: self._guarded(self._sim.set_input, name, value),
+                setter=lambda value: self._sim.set_input(name, value),
             )
         else:
             variable = Real(
@@ -113,10 +113,10 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
         self.register_variable(variable)
 
     def setup_experiment(self, start_time, stop_time=None, tolerance=None):
-        self._guarded(self._sim.set_start_time, start_time)
+        self._sim.set_start_time(start_time)
 
     def exit_initialization_mode(self):
-        self._guarded(self._sim.initialise)
+        self._sim.initialise()
 
     # FMU state (fmi2Get/SetFMUstate, fmi2(De)SerializeFMUstate): the component's complete
     # state, including the integrator's hidden state, as JSON-serialisable data.

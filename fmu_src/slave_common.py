@@ -148,10 +148,6 @@ class ComponentMapping:
             self._preview_key, self._preview_sim = key, preview
         return self._preview_sim
 
-    def _guarded(self, call, *args):
-        """Run ``call``: kept as the one place the slave's calls into the component go through."""
-        return call(*args)
-
     def check_fmu_state(self, state) -> None:
         """Raise (naming what is wrong) unless ``state`` is one :meth:`_get_fmu_state` of this FMU gives."""
         type(self._sim).check_state(state)
