@@ -42,7 +42,8 @@ def main() -> None:
     fig, (ax_angle, ax_work) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True, layout="constrained")
     for omega in (SLOW_MODE_RAD_S, 0.6 * SLOW_MODE_RAD_S):
         result = simulate_fmu(fmu, start_values={"phi1_0": 0.0, "phi2_0": 0.0, "air_drag": True},
-                              stop_time=args.stop, output_interval=0.01, input=torque_signal(omega, args.stop))
+                              stop_time=args.stop, output_interval=0.01, input=torque_signal(omega, args.stop),
+                              output=["phi1", "W_input"])  # W_input is a local: recorded when asked for
         label = f"torque at {omega:.2f} rad/s"
         ax_angle.plot(result["time"], result["phi1"], lw=0.9, label=label)
         ax_work.plot(result["time"], 1000 * result["W_input"], label=label)

@@ -39,7 +39,7 @@ DefaultExperiment = importlib.import_module(f"{_library}.default_experiment").De
 Causality, Variability = _enums.Fmi3Causality, _enums.Fmi3Variability
 Initial, Status = _enums.Fmi3Initial, _enums.Fmi3Status
 Float64 = _variables.Float64
-_TYPES = {"Real": Float64, "Boolean": _variables.Boolean, "String": _variables.String}
+_TYPES = {"Real": Float64, "Integer": _variables.Int32, "Boolean": _variables.Boolean, "String": _variables.String}
 
 _cosimulation = runtime_module("component.cosimulation")
 _names = runtime_module("component.variables")
@@ -86,10 +86,10 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
             variable = Float64(
                 name, causality=Causality.input, variability=Variability.continuous, description=var.description,
                 getter=lambda: self._sim.get(name), setter=lambda value: self._set_input(name, value), **unit)
-        else:
+        else:  # an output (a port) or a local diagnostic, read by name
             variable = Float64(
-                name, causality=Causality.output, variability=Variability.continuous, initial=Initial.calculated,
-                description=var.description, getter=lambda: self._output(name), **unit)
+                name, causality=Causality[var.causality], variability=Variability.continuous,
+                initial=Initial.calculated, description=var.description, getter=lambda: self._output(name), **unit)
         self.register_variable(variable)
 
     def _register_states(self) -> None:

@@ -30,7 +30,7 @@ _enums = importlib.import_module(f"{_pythonfmu}.enums")
 Fmi2Slave = _slave.Fmi2Slave
 DefaultExperiment = importlib.import_module(f"{_pythonfmu}.default_experiment").DefaultExperiment
 Fmi2Causality, Fmi2Variability, Fmi2Status = _enums.Fmi2Causality, _enums.Fmi2Variability, _enums.Fmi2Status
-_FMI_TYPES = {name: getattr(_variables, name) for name in ("Real", "Boolean", "String")}
+_FMI_TYPES = {name: getattr(_variables, name) for name in ("Real", "Integer", "Boolean", "String")}
 Real = _FMI_TYPES["Real"]
 
 
@@ -102,10 +102,10 @@ class ComponentSlave(ComponentMapping, Fmi2Slave):
                 getter=lambda: self._sim.get(name),
                 setter=lambda value: self._sim.set_input(name, value),
             )
-        else:
+        else:  # an output (a port) or a local diagnostic, read by name
             variable = Real(
                 name,
-                causality=Fmi2Causality.output,
+                causality=Fmi2Causality[var.causality],
                 variability=Fmi2Variability.continuous,
                 description=var.description,
                 getter=lambda: self._output(name),

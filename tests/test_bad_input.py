@@ -17,6 +17,8 @@ INVALID_VALUES = {
     "positive": [-1.0, 0.0, math.nan, math.inf, -math.inf],
     "nonnegative": [-1.0, -1e-300, math.nan, math.inf],
     "finite": [math.nan, math.inf, -math.inf],
+    "angle": [math.nan, math.inf, -math.inf, 1e300, -1.0001e4],  # a start angle: at most 1e4 rad in size
+    "count": [0, -5],  # an Integer (max_steps)
 }
 
 

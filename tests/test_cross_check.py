@@ -82,6 +82,9 @@ CLOSE = 1e-7
 """How close a co-simulation import at the FMU's defaults (rtol 1e-9 where not baked in) comes to the
 reference (rtol 1e-12), relative to each column's scale: measured 2.1e-12 at most for the pendulum,
 3.5e-8 (fmpy) and 1.4e-8 (the checker) for the Suspension."""
+ME_CLOSE = 1e-4
+"""The same for a Model Exchange import: fmpy's CVode at the options' RelTol, the one that made the reference
+(1e-12); CVode's own error path differs from the FMU's integrator by 1.5e-5 on the chaotic case."""
 
 
 def deviation(result, reference) -> float:
@@ -100,8 +103,8 @@ def test_fmpy_as_the_importer_passes_the_cross_check_comparison(tree, case):
     assert result["time"][-1] == pytest.approx(case.stop_time)
     got = deviation(result, read_csv(str(folder / f"{case.model}_ref.csv")))
     print(f"fmpy as importer, {case.folder.as_posix()}: {got:.2g} of the scale off the reference")
-    if case.fmi_type == "cs":  # under ME the importer's CVode at RelTol 1e-6 decides (up to 1e-2 after chaos)
-        assert got <= CLOSE
+    # under ME CVode runs at the RelTol that made the reference (1e-12), its own error path all the same
+    assert got <= (CLOSE if case.fmi_type == "cs" else ME_CLOSE)
 
 
 def test_the_baked_scenes_need_no_start_value(tree):

@@ -115,7 +115,7 @@ def test_the_variables_are_the_fmi2_fmus(fmu_path, fmu3_path):
     for name, v2 in fmi2.items():
         v3 = fmi3[name]
         assert (v3.causality, v3.description, v3.unit) == (v2.causality, v2.description, v2.unit), name
-        assert v3.type == {"Real": "Float64"}.get(v2.type, v2.type)
+        assert v3.type == {"Real": "Float64", "Integer": "Int32"}.get(v2.type, v2.type)
         if v2.start is not None:
             assert type(v2.start)(v3.start) == v2.start, name
 

@@ -13,7 +13,7 @@ from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.fmu.runner import FmuRunError
 from double_pendulum.fmu.simulate import simulate
 from double_pendulum.model.inputs import INPUT_NAMES
-from double_pendulum.model.outputs import MODEL_OUTPUT_NAMES, OUTPUT_NAMES
+from double_pendulum.model.outputs import MODEL_OUTPUT_NAMES, OUTPUT_NAMES, PORT_NAMES
 from double_pendulum.model.parameters import ParameterError, PendulumParameters
 
 TIGHT = {"rtol": 1e-12, "atol": 1e-14}
@@ -201,8 +201,10 @@ def test_model_structure_states_the_outputs_dependencies_on_the_inputs(fmu_path)
         for u in root.find("ModelStructure/Outputs")
     }
     assert sorted(map(int, deps["F_pivot_y"].split())) == sorted(index[n] for n in INPUT_NAMES)
-    assert deps["phi1"] == "" and deps["W_input"] == ""
-    assert deps["x1"] == str(index["pivot_x"])
+    assert deps["phi1"] == "" and deps["omega2"] == ""
+    assert sorted(map(int, deps["E_total"].split())) == sorted(index[n] for n in INPUT_NAMES if n.startswith("pivot_")
+                                                               and not n.startswith("pivot_a"))
+    assert set(deps) == set(PORT_NAMES)  # the diagnostics are locals: no ports, no Outputs entry
 
 
 def test_fmu_state_with_inputs_restores_through_the_fmu(runner):

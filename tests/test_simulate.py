@@ -15,6 +15,7 @@ from double_pendulum.case import FILES
 from double_pendulum.cli import main
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.fmu.start_values import StartValueError, closest_name, parse_start_values
+from double_pendulum.model.outputs import OUTPUT_NAMES
 from double_pendulum.runs.results_io import read_results_csv
 
 
@@ -41,12 +42,13 @@ def test_a_case_writes_csv_figure_animation_and_summary_with_fmpy_s_numbers(fmu_
     with open(out / "simulation.csv") as fh:
         assert '"time [s]","phi1 [rad]"' in fh.readline()  # units in the column names
     plain = simulate_fmu(str(fmu_path), start_values={"phi1_0": 2.0, "air_drag": True}, stop_time=3.0,
-                         output_interval=0.02)  # what a user of fmpy writes
+                         output_interval=0.02, output=list(OUTPUT_NAMES))  # the summary's fmpy call
     assert written.dtype.names == plain.dtype.names
     for name, column in _columns(plain).items():
         assert np.array_equal(written[name], column), name  # bit for bit
     assert summary["E_total_start_J"] > summary["E_total_end_J"]  # air drag takes energy
     assert summary["fmpy_call"].startswith("fmpy.simulate_fmu(") and "'air_drag': True" in summary["fmpy_call"]
+    assert f"output={list(OUTPUT_NAMES)!r})" in summary["fmpy_call"]  # fmpy records only the outputs by default
 
 
 def test_model_exchange_through_the_fmi3_fmu_gives_fmpy_s_numbers(fmu_path, tmp_path):
@@ -72,7 +74,8 @@ def test_model_exchange_through_the_fmi3_fmu_gives_fmpy_s_numbers(fmu_path, tmp_
     ("m1=heavy", "m1 is a real number [kg]"),
     ("m1=nan", "m1 must be a finite number [kg]"),
     ("pivot_x=0.1", "pivot_x is an input"),
-    ("x2=0.1", "x2 is an output variable"),
+    ("x2=0.1", "x2 is a local variable"),
+    ("phi1=0.1", "phi1 is an output variable"),
     ("phi1_0", "write NAME=VALUE"),
 ])
 def test_a_bad_set_is_refused_in_one_line_that_says_why(fmu_path, tmp_path, capsys, setting, words):

@@ -16,7 +16,7 @@ from double_pendulum.fmu.build import build_fmu
 from double_pendulum.fmu.coupling import FmuSlave, run_jacobi
 from double_pendulum.fmu.runner import FmuRunError, FmuRunner
 from double_pendulum.model.parameters import ParameterError, PendulumParameters, SuspensionLoad
-from double_pendulum.model.suspension import OUTPUT_NAMES
+from double_pendulum.model.suspension import OUTPUT_NAMES, PORT_NAMES
 
 START = {"phi1_0": 1.0, "phi2_0": 1.0}
 
@@ -56,7 +56,9 @@ def test_suspension_fmu_validates_and_states_its_interface(suspension_fmu):
         for u in root.find("ModelStructure/Outputs")
     }
     assert deps["ay"] == str(variables.index(by_name["F_y"]) + 1)
-    assert deps["y"] == "" and deps["E_suspension"] == ""
+    assert deps["y"] == "" and deps["vx"] == ""
+    assert set(deps) == set(PORT_NAMES)  # energies, works and power are locals
+    assert by_name["E_suspension"].get("causality") == "local"
 
 
 def test_static_load_leaves_the_mass_at_rest(suspension_runner):

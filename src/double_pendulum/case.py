@@ -31,6 +31,7 @@ import numpy as np
 
 from .fmu.runner import FmuRunError, FmuRunner
 from .fmu.start_values import value_text
+from .model.outputs import OUTPUT_NAMES
 from .plots import animate_swings, swing
 from .plots.case import plot_case
 from .runs.interrupts import acknowledge, interrupted
@@ -46,19 +47,22 @@ FMI_TYPES = {"CoSimulation": "co-simulation", "ModelExchange": "model exchange"}
 @dataclass(frozen=True)
 class Case:
     """A run of the FMU file ``fmu`` as :func:`fmpy.simulate_fmu` makes it: ``fmi_type``, the ``start_values``,
-    ``stop_time`` [s] and ``output_interval`` [s] (also the communication step of a co-simulation)."""
+    ``stop_time`` [s], ``output_interval`` [s] (also the communication step of a co-simulation) and the
+    quantities recorded, ``outputs`` (the FMU's outputs and its local diagnostics: every quantity)."""
 
     fmu: Path
     start_values: dict[str, Any] = field(default_factory=dict)
     stop_time: float = 10.0
     output_interval: float = 0.01
     fmi_type: str = "CoSimulation"
+    outputs: tuple[str, ...] = OUTPUT_NAMES
 
     def fmpy_call(self) -> str:
-        """The Python call that gives the same numbers, from any folder (the FMU's absolute path)."""
+        """The Python call that gives the same numbers, from any folder (the FMU's absolute path); it names
+        what it records, as fmpy records only the FMU's outputs by default."""
         return (f"fmpy.simulate_fmu({str(Path(self.fmu).resolve())!r}, fmi_type={self.fmi_type!r}, "
                 f"start_values={self.start_values!r}, stop_time={self.stop_time!r}, "
-                f"output_interval={self.output_interval!r})")
+                f"output_interval={self.output_interval!r}, output={list(self.outputs)!r})")
 
     def words(self) -> str:
         """The case in a line: its start values and length."""
@@ -145,7 +149,8 @@ def run_case(case: Case, out: Path, *, animate: bool = True) -> Outcome:
             start, message = time.perf_counter(), None
             try:
                 result = runner.simulate(case.start_values, stop_time=case.stop_time,
-                                         output_interval=case.output_interval, fmi_type=case.fmi_type)
+                                         output_interval=case.output_interval, fmi_type=case.fmi_type,
+                                         outputs=case.outputs)
             except FmuRunError as error:
                 if interrupted():
                     raise KeyboardInterrupt from None

@@ -107,8 +107,10 @@ def checked_parameter(rules: Mapping[str, tuple[str, str]], name: str, value: An
             "is set before the FMU leaves Initialization Mode)"
         )
     unit, rule = rules[name]
-    if rule != "str" and rule != "bool" and isinstance(value, int) and not isinstance(value, bool):
+    if rule not in ("str", "bool", "count") and isinstance(value, int) and not isinstance(value, bool):
         value = float(value)
+    if rule == "count" and isinstance(value, float) and value.is_integer() and abs(value) < 2.0**53:
+        value = int(value)  # 1e6 from Python is the count 1000000; 1.5 is refused by check_value
     check_value(name, value, unit, rule)
     if name in STRING_PARAMETER_GROUPS:
         STRING_PARAMETER_GROUPS[name](**{name: value})  # checks the name

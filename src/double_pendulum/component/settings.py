@@ -25,8 +25,8 @@ class SolverSettings(Validated):
     fixed_step: float = spec(
         1e-3, "s", "step size of the fixed-step solvers (gauss4, gauss2, rk4, euler)", rule="positive"
     )
-    max_steps: float = spec(
-        1e6, "1", "most integrator steps within one doStep before it fails (bounds the CPU time)", rule="positive"
+    max_steps: int = spec(
+        1_000_000, "1", "most integrator steps within one doStep before it fails (bounds the CPU time)", rule="count"
     )
 
     def __post_init__(self) -> None:

@@ -14,7 +14,7 @@ from typing import Any, NamedTuple
 
 from ..model import suspension
 from ..model.inputs import INPUTS
-from ..model.outputs import INPUT_DEPENDENCIES, OUTPUTS, Quantity
+from ..model.outputs import INPUT_DEPENDENCIES, OUTPUTS, PORT_NAMES, Quantity
 from .cosimulation import PARAMETER_GROUPS
 from .suspension import INPUT_START, PARAMETER_FIELDS
 
@@ -36,8 +36,8 @@ class FmuVariable(NamedTuple):
     """One FMI scalar variable."""
 
     name: str
-    fmi_type: str  # "Real", "Boolean" or "String"
-    causality: str  # "parameter", "input" or "output"
+    fmi_type: str  # "Real", "Integer", "Boolean" or "String"
+    causality: str  # "parameter", "input", "output" (a port) or "local" (a diagnostic, read by name)
     unit: str  # FMI unit string, "" for none
     description: str
     start: Any  # start value for parameters and inputs, None for outputs
@@ -45,7 +45,7 @@ class FmuVariable(NamedTuple):
 
 
 def _fmi_type(rule: str) -> str:
-    return {"str": "String", "bool": "Boolean"}.get(rule, "Real")
+    return {"str": "String", "bool": "Boolean", "count": "Integer"}.get(rule, "Real")
 
 
 def described(description: str, unit: str) -> str:
@@ -58,8 +58,13 @@ def _variables(
     inputs: Iterable[Quantity],
     input_start: Mapping[str, float],
     outputs: Iterable[Quantity],
+    ports: Iterable[str],
 ) -> list[FmuVariable]:
-    """Parameters (dataclass fields, in order), inputs, then outputs as FMU variables."""
+    """Parameters (dataclass fields, in order), inputs, then the output quantities as FMU variables.
+
+    The output quantities named in ``ports`` are the FMU's outputs, the others its local variables.
+    """
+    ports = frozenset(ports)
     variables = [
         FmuVariable(
             f.name,
@@ -78,19 +83,21 @@ def _variables(
         for q in inputs
     ]
     variables += [
-        FmuVariable(q.name, "Real", "output", q.unit, described(q.description, q.unit), None) for q in outputs
+        FmuVariable(q.name, "Real", "output" if q.name in ports else "local", q.unit,
+                    described(q.description, q.unit), None)
+        for q in outputs
     ]
     return variables
 
 
 def fmu_variables() -> list[FmuVariable]:
-    """Return all DoublePendulum variables: parameters (in dataclass order), inputs, then outputs."""
-    return _variables((f for group in PARAMETER_GROUPS for f in fields(group)), INPUTS, {}, OUTPUTS)
+    """Return all DoublePendulum variables: parameters (in dataclass order), inputs, then outputs and locals."""
+    return _variables((f for group in PARAMETER_GROUPS for f in fields(group)), INPUTS, {}, OUTPUTS, PORT_NAMES)
 
 
 def suspension_fmu_variables() -> list[FmuVariable]:
     """Return all Suspension variables (:mod:`double_pendulum.model.suspension`)."""
-    return _variables(PARAMETER_FIELDS, suspension.INPUTS, INPUT_START, suspension.OUTPUTS)
+    return _variables(PARAMETER_FIELDS, suspension.INPUTS, INPUT_START, suspension.OUTPUTS, suspension.PORT_NAMES)
 
 
 class FmuInterface(NamedTuple):

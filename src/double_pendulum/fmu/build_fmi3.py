@@ -72,9 +72,14 @@ def complete_model_description_fmi3(xml_text: bytes) -> bytes:
     for v in variables:
         if v.get("derivative") is not None:
             ET.SubElement(structure, "ContinuousStateDerivative", valueReference=v.get("valueReference"))
+    # FMI 3.0, 2.4.8: the outputs, the continuous states and their derivatives that are calculated or
+    # approx; a local diagnostic that is neither is no initial unknown
+    derivatives = {v.get("valueReference") for v in variables if v.get("derivative") is not None}
     for v in variables:
-        if v.get("initial") in ("approx", "calculated") and v.get("causality") in ("output", "local"):
-            ET.SubElement(structure, "InitialUnknown", valueReference=v.get("valueReference"))
+        vr = v.get("valueReference")
+        exposed = v.get("causality") == "output" or vr in states or vr in derivatives
+        if v.get("initial") in ("approx", "calculated") and exposed:
+            ET.SubElement(structure, "InitialUnknown", valueReference=vr)
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 

@@ -60,7 +60,7 @@ def run_checker(checker: str | Path, folder: str | Path, case: ReferenceCase, ou
     folder, out = Path(folder), Path(out)
     out.mkdir(parents=True, exist_ok=True)
     log, result = out / f"{case.model}_cc.log", out / f"{case.model}_cc.csv"
-    command = [str(checker), "-l", "3", "-e", str(log), "-o", str(result), "-c", ",", "-n", "0",
+    command = [str(checker), "-l", "3", "-e", str(log), "-o", str(result), "-c", ",", "-f", "-n", "0",
                "-s", f"{case.stop_time:g}", "-h", f"{case.step_size:g}"]
     if input_names(case):
         command += ["-i", str(folder / f"{case.model}_in.csv")]

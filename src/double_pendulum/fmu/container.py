@@ -79,6 +79,8 @@ def _literal(value: Any) -> str:
     """A start value as the literal the modelDescription and container.json hold."""
     if isinstance(value, bool):
         return "true" if value else "false"
+    if isinstance(value, int):  # an Integer
+        return str(value)
     return value if isinstance(value, str) else repr(float(value))
 
 
@@ -88,9 +90,11 @@ def _expose(md: Any, mappings: dict, component: Any, name: str, start: Any = Non
 
     source = _variables(component)[name]
     is_parameter = start is not None
+    # a member's output is the container's output, its local diagnostic a local of the container
+    causality = "parameter" if is_parameter else "local" if source.causality == "local" else "output"
     variable = ModelVariable(
         name=f"{component.name}.{name}", type=source.type, description=source.description,
-        causality="parameter" if is_parameter else "output",
+        causality=causality,
         variability="fixed" if is_parameter else "continuous",
         initial="exact" if is_parameter else None, start=None if start is None else _literal(start),
     )
@@ -98,7 +102,7 @@ def _expose(md: Any, mappings: dict, component: Any, name: str, start: Any = Non
     variable.canHandleMultipleSetPerTimeInstant = False
     md.modelVariables.append(variable)
     mappings[variable] = [(component, source)]
-    if not is_parameter:
+    if causality == "output":
         md.outputs.append(Unknown(variable=variable, dependencies=[]))
         md.initialUnknowns.append(Unknown(variable=variable, dependencies=[]))
 

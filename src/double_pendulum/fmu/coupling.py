@@ -370,7 +370,8 @@ class FmuSlave:
 
     def _set(self, name: str, value: Any) -> None:
         var = self.refs[name]
-        setter = {"Real": self.fmu.setReal, "Boolean": self.fmu.setBoolean, "String": self.fmu.setString}[var.type]
+        setter = {"Real": self.fmu.setReal, "Integer": self.fmu.setInteger, "Boolean": self.fmu.setBoolean,
+                  "String": self.fmu.setString}[var.type]
         setter([var.valueReference], [value])
 
     def set_input(self, name: str, value: float) -> None:

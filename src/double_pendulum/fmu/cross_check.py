@@ -41,9 +41,11 @@ def model_dir(root: str | Path, case: ReferenceCase) -> Path:
 
 
 def checker_command(case: ReferenceCase, checker: str = "fmuCheck.linux64") -> str:
-    """How the FMI Compliance Checker runs the case (from the model's folder; the rules' section 9.1.2)."""
+    """How the FMI Compliance Checker runs the case (from the model's folder; the rules' section 9.1.2). ``-f``
+    prints every variable: the reference holds local diagnostics too (W_air, E_kin), which the checker's
+    default, the outputs only, would leave out."""
     inputs = f" -i {case.model}_in.csv" if input_names(case) else ""
-    return (f"{checker} -e {case.model}_cc.log{inputs} -o {case.model}_cc.csv -c , -n 0 -s {case.stop_time:g} "
+    return (f"{checker} -e {case.model}_cc.log{inputs} -o {case.model}_cc.csv -c , -f -n 0 -s {case.stop_time:g} "
             f"-h {case.step_size:g} {case.model}.fmu")
 
 

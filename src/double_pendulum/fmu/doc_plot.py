@@ -16,7 +16,7 @@ from __future__ import annotations
 import functools
 import io
 import json
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ..component.suspension import INPUT_START
@@ -49,19 +49,26 @@ def axis_label(names: list[str]) -> str:
     return " / ".join(f"{QUANTITY.get(unit, 'value')} [{unit}]" for unit in units)
 
 
-def run(model: str, start_values: Mapping[str, Any], stop_time: float, interval: float) -> dict[str, list[float]]:
-    """The model's default run from ``start_values`` to ``stop_time`` [s], every ``interval`` [s]:
-    ``time`` and the outputs of :data:`PLOTTED`, as lists."""
+def run(
+    model: str, start_values: Mapping[str, Any], stop_time: float, interval: float,
+    names: Sequence[str] | None = None, load: Mapping[str, float] | None = None, macro_step: float | None = None,
+) -> dict[str, list[float]]:
+    """The model's run from ``start_values`` to ``stop_time`` [s], every ``interval`` [s]: ``time`` and
+    ``names`` (the outputs of :data:`PLOTTED` by default), as lists.
+
+    ``load``: the Suspension's inputs (its default inputs leave it at rest; the plot applies
+    :data:`SUSPENSION_STEP`); ``macro_step`` [s]: the coupled system's (``interval`` by default; ``interval``
+    must be a multiple of it).
+    """
+    names = list(names) if names is not None else [n for group in PLOTTED[model] for n in group]
     if model == "PendulumOnSuspension":
-        return _coupled(start_values, stop_time, interval)
+        return _coupled(start_values, stop_time, interval, names, macro_step or interval)
     component = presets.COMPONENTS[model]()
     for name, value in start_values.items():
         component.set(name, value)
-    if model == "Suspension":
-        for name, value in SUSPENSION_STEP.items():
-            component.set_input(name, value)
+    for name, value in (load or {}).items():
+        component.set_input(name, value)
     component.initialise()
-    names = [n for group in PLOTTED[model] for n in group]
     rows = {"time": [component.time], **{n: [component.outputs[n]] for n in names}}
     for current, step in communication_points(0.0, stop_time, interval):
         component.do_step(current, step)
@@ -71,22 +78,40 @@ def run(model: str, start_values: Mapping[str, Any], stop_time: float, interval:
     return rows
 
 
-def _coupled(values: Mapping[str, Any], stop_time: float, macro_step: float) -> dict[str, list[float]]:
-    """The container's components as it couples them: ``values`` are the container's (``DoublePendulum.x``)."""
-    from .coupling import run_coupled
+def _coupled(values: Mapping[str, Any], stop_time: float, interval: float, names: Sequence[str],
+             macro_step: float) -> dict[str, list[float]]:
+    """The container's components as it couples them: ``values`` and ``names`` are the container's
+    (``DoublePendulum.phi1_0``, ``Suspension.x``); rows every ``interval`` [s], a multiple of ``macro_step``.
 
+    The container steps both components over a macro step, then passes the connections, the force first
+    (``jacobi_sequential``, :func:`double_pendulum.fmu.coupling.sequential_exchange`), and a host reads its
+    outputs after that: the outputs that follow their inputs at once (the pivot force, the suspension's
+    acceleration) are recorded after the exchange too.
+    """
+    from .coupling import sequential_exchange
+
+    every = round(interval / macro_step)
+    if every < 1 or abs(every * macro_step - interval) > 1e-9 * interval:
+        raise ValueError(f"interval = {interval:g} s is no multiple of the macro step {macro_step:g} s")
     components = {name: presets.COMPONENTS[name]() for name in ("DoublePendulum", "Suspension")}
     for name, value in values.items():
         owner, _, parameter = name.partition(".")
         components[owner].set(parameter, value)
     for component in components.values():
         component.initialise()
-    rows = run_coupled(components["DoublePendulum"], components["Suspension"], stop_time=stop_time,
-                       macro_step=macro_step, scheme="jacobi_sequential", pendulum_outputs=("phi1", "phi2"),
-                       suspension_outputs=("x", "y"))
-    return {"time": rows["time"].tolist(), "DoublePendulum.phi1": rows["phi1"].tolist(),
-            "DoublePendulum.phi2": rows["phi2"].tolist(), "Suspension.x": rows["x"].tolist(),
-            "Suspension.y": rows["y"].tolist()}
+    pendulum, suspension = components["DoublePendulum"], components["Suspension"]
+    sources = [(components[owner], base) for owner, _, base in (n.partition(".") for n in names)]
+    sequential_exchange(pendulum, suspension)
+    rows = {"time": [0.0], **{n: [c.get(b)] for n, (c, b) in zip(names, sources)}}
+    for k, (current, step) in enumerate(communication_points(0.0, stop_time, macro_step), start=1):
+        pendulum.do_step(current, step)
+        suspension.do_step(current, step)
+        sequential_exchange(pendulum, suspension)
+        if k % every == 0:
+            rows["time"].append(k // every * interval)  # fmpy's grid: start + n * interval
+            for name, (component, base) in zip(names, sources):
+                rows[name].append(component.get(base))
+    return rows
 
 
 def result_plot(model: str, start_values: Mapping[str, Any], stop_time: float, interval: float) -> bytes:
@@ -98,7 +123,8 @@ def result_plot(model: str, start_values: Mapping[str, Any], stop_time: float, i
 def _plot(model: str, start_values: str, stop_time: float, interval: float) -> bytes:
     from matplotlib.figure import Figure
 
-    rows = run(model, json.loads(start_values), stop_time, interval)
+    rows = run(model, json.loads(start_values), stop_time, interval,
+               load=SUSPENSION_STEP if model == "Suspension" else None)
     time = rows["time"]
     fig = Figure(figsize=(7.0, 4.2), layout="constrained")
     axes = fig.subplots(2, 1, sharex=True)

@@ -28,7 +28,7 @@ from xml.etree import ElementTree as ET
 
 from .. import __version__
 from ..component.variables import INTERFACES
-from ..model.parameters import AirDragParameters, BearingParameters, SuspensionParameters
+from ..model.parameters import MAX_START_ANGLE, AirDragParameters, BearingParameters, SuspensionParameters
 from . import elf_needs, presets
 from .docstring_html import docstring_html, inline_html, summary
 
@@ -41,7 +41,8 @@ MODEL_SOURCES: dict[str, tuple[str, ...]] = {
 }
 """The modules (under ``double_pendulum``) whose docstrings are the page's "The model" section."""
 SWITCH_GROUPS = {"DoublePendulum": (AirDragParameters, BearingParameters, SuspensionParameters)}
-RULES = {"positive": "> 0", "nonnegative": "≥ 0", "finite": "finite", "bool": "true, false", "str": "text"}
+RULES = {"positive": "> 0", "nonnegative": "≥ 0", "finite": "finite", "bool": "true, false", "str": "text",
+         "count": "whole number ≥ 1", "angle": f"within ±{MAX_START_ANGLE:g} rad"}
 RESULT_PLOT = "documentation/result.png"
 STYLE = """
 body { font-family: Helvetica, Arial, sans-serif; margin: 2em; color: #1b1f23; line-height: 1.45; }

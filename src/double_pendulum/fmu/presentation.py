@@ -9,7 +9,9 @@
 * ``terminalsAndIcons/terminalsAndIcons.xml`` with the terminals of the FMU's variables and their
   pictures (:mod:`double_pendulum.fmu.terminals`);
 * ``documentation/licenses/<distribution>.txt``: the licence of everything the FMU bundles
-  (:func:`licence_files`).
+  (:func:`licence_files`);
+* ``extra/org.fmi-standard.fmi-ls-ref/``: the reference result of the default experiment, in Reference-FMUs'
+  layout (:mod:`double_pendulum.fmu.reference_result`).
 
 The build adds them in :func:`double_pendulum.fmu.build.rewrite_fmu` (DoublePendulum, Suspension, the
 FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.container.write_container` (the container).
@@ -22,7 +24,7 @@ from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from . import doc_plot, documentation, icons, terminals
+from . import doc_plot, documentation, icons, reference_result, terminals
 
 CONTAINER = "PendulumOnSuspension"
 CONTAINER_PLOT_TIME = 2.0  # [s] of the container's result plot (its default experiment runs 10 s)
@@ -33,6 +35,8 @@ def _typed(kind: str, text: str | None) -> Any:
         return text == "true"
     if kind == "String":
         return text
+    if kind in ("Integer", "Int32"):
+        return int(text)
     return float(text)
 
 
@@ -119,5 +123,7 @@ def presentation_files(model: str, fmi_version: int, files: Mapping[str, bytes],
     for path in sorted(terminals.icon_files(found)):
         out[path] = icons.terminal_icon(path.rpartition("/")[2].removesuffix(".png"))
     out.update(licence_files(model, fmi_version))
+    starts = _parameter_starts(root) if model == CONTAINER else start_values
+    out.update(reference_result.reference_files(model, md, starts))
     return out
 

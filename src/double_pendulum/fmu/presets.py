@@ -52,6 +52,8 @@ def literal(value: Any) -> str:
         return "true" if value else "false"
     if isinstance(value, str):
         return value
+    if isinstance(value, int):  # an Integer
+        return str(value)
     return repr(float(value))
 
 

@@ -106,9 +106,11 @@ class ReferenceCase:
 
     @property
     def rel_tol(self) -> float:
-        """The ``RelTol`` of ``_ref.opt``: the tolerance an importer's solver should use (ME), or the
-        FMU's own (CS)."""
-        return 1e-6 if self.fmi_type == "me" else float({**self.baked, **self.reference_start}.get("rtol", 1e-9))
+        """The ``RelTol`` of ``_ref.opt``: the tolerance that made the reference, CVode's under Model Exchange
+        (:data:`ME_REFERENCE_TOLERANCE`), the FMU's own integrator's under Co-Simulation."""
+        if self.fmi_type == "me":
+            return ME_REFERENCE_TOLERANCE
+        return float({**self.baked, **self.reference_start}.get("rtol", 1e-9))
 
 
 # Signals, not diagnostics: energy_residual (integration error) and a conserved E_total depend on the importer's

@@ -49,6 +49,8 @@ def _literal(value: Any) -> tuple[str, str]:
         return "Boolean", "true" if value else "false"
     if isinstance(value, str):
         return "String", value
+    if isinstance(value, int):
+        return "Integer", str(value)
     return "Real", repr(float(value))
 
 

@@ -28,6 +28,9 @@ class StartValueError(ValueError):
     """A ``--set`` the FMU cannot take; its message is the one line that says why."""
 
 
+_ARTICLE = {"independent": "the", "local": "a"}  # "x2 is a local variable", "phi1 is an output variable"
+
+
 def parameters(model_description: Any) -> list[Any]:
     """The variables of ``model_description`` (fmpy's) that ``--set`` may set: parameters, fixed or tunable."""
     return [v for v in model_description.modelVariables
@@ -92,7 +95,7 @@ def _refuse_unsettable(variable: Any, text: str) -> None:
         raise StartValueError(f"--set {name}={text}: {name} is an input, driven by a signal over time, not a "
                               "parameter (an fmpy input signal drives it: examples/drive_inputs.py)")
     if causality in ("output", "local", "independent"):
-        raise StartValueError(f"--set {name}={text}: {name} is {'the' if causality == 'independent' else 'an'} "
+        raise StartValueError(f"--set {name}={text}: {name} is {_ARTICLE.get(causality, 'an')} "
                               f"{causality} variable, which the FMU computes; --set takes parameters")
     raise StartValueError(f"--set {name}={text}: {name} is a {variable.variability} {causality}, "
                           "which a master cannot set")

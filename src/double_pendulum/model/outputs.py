@@ -77,6 +77,12 @@ OUTPUTS = OUTPUTS + SOLVER_OUTPUTS
 OUTPUT_NAMES: tuple[str, ...] = tuple(q.name for q in OUTPUTS)
 WORK_NAMES: tuple[str, ...] = ("W_air", "W_bearing", "W_bearing_drag", "W_suspension")
 
+# The FMU's outputs (its ports): what a master couples to, the pivot force, and what a user plots
+# first, the angles, the rates and the total energy. Every other quantity is one of the FMU's local
+# variables: read and recorded by name all the same (fmpy's ``output=[...]``), but neither a port
+# nor in a tool's default plot (docs/fmu.md, "Outputs and diagnostics").
+PORT_NAMES: tuple[str, ...] = ("phi1", "phi2", "omega1", "omega2", "E_total", "F_pivot_x", "F_pivot_y")
+
 
 def _pivot(model: Model, y: list[float], u: InputValues | None = None) -> tuple[float, float, float, float]:
     """``(xs, ys, vxs, vys)`` of the pivot: state ``y``, or the inputs ``u`` where it is prescribed."""

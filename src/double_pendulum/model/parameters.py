@@ -37,9 +37,19 @@ def spec(
     """Declare a dataclass field with its unit, description and validity rule.
 
     ``rule`` is one of ``"finite"``, ``"positive"`` (finite and > 0), ``"nonnegative"``
-    (finite and >= 0), ``"bool"`` or ``"str"``.
+    (finite and >= 0), ``"count"`` (a whole number >= 1: an FMI Integer), ``"angle"`` (a start angle:
+    at most :data:`MAX_START_ANGLE` in size), ``"bool"`` or ``"str"``.
     """
     return field(default=default, metadata={"unit": unit, "description": description, "rule": rule})
+
+
+COUNT_MAX = 2**31 - 1  # a count is an FMI Integer (fmi2Integer, fmi3Int32): 32 bits
+MAX_START_ANGLE = 1e4
+"""Largest start angle [rad] (about 1600 turns). The solver's error control is relative to the state's size
+(atol + rtol |phi|), so an angle of 1e300 rad makes every error look small and the run is garbage (its
+energy rose from 3 J to 2438 J without friction before the step size underflowed); an angle is
+2 pi-periodic, so any start is given within this bound, best within (-pi, pi]. At 1e4 rad a double's spacing is
+1.8e-12 rad and rtol = 1e-9 allows 1e-5 rad per step: still a meaningful angle."""
 
 
 def check_value(name: str, value: Any, unit: str, rule: str) -> None:
@@ -53,6 +63,10 @@ def check_value(name: str, value: Any, unit: str, rule: str) -> None:
         if not isinstance(value, str):
             raise ParameterError(f"invalid {shown}: must be a string")
         return
+    if rule == "count":
+        if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= COUNT_MAX:
+            raise ParameterError(f"invalid {shown}: must be a whole number from 1 to {COUNT_MAX}")
+        return
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ParameterError(f"invalid {shown}: must be a real number")
     if not math.isfinite(value):
@@ -61,6 +75,9 @@ def check_value(name: str, value: Any, unit: str, rule: str) -> None:
         raise ParameterError(f"invalid {shown}: must be > 0")
     if rule == "nonnegative" and not value >= 0.0:
         raise ParameterError(f"invalid {shown}: must be >= 0")
+    if rule == "angle" and not abs(value) <= MAX_START_ANGLE:
+        raise ParameterError(f"invalid {shown}: a start angle must be within +-{MAX_START_ANGLE:g} rad (the solver's "
+                             "error control is relative to it); an angle is 2 pi-periodic: give it within (-pi, pi]")
 
 
 class Validated:
@@ -218,8 +235,8 @@ class SuspensionParameters(Validated):
 class InitialState(Validated):
     """Start values of the rod angles and their rates (the suspension starts at rest)."""
 
-    phi1_0: float = spec(1.0, "rad", "initial angle of the upper rod from the downward vertical")
-    phi2_0: float = spec(1.0, "rad", "initial angle of the lower rod from the downward vertical")
+    phi1_0: float = spec(1.0, "rad", "initial angle of the upper rod from the downward vertical", rule="angle")
+    phi2_0: float = spec(1.0, "rad", "initial angle of the lower rod from the downward vertical", rule="angle")
     omega1_0: float = spec(0.0, "rad/s", "initial angular velocity of the upper rod")
     omega2_0: float = spec(0.0, "rad/s", "initial angular velocity of the lower rod")
 

@@ -61,6 +61,9 @@ OUTPUTS: tuple[Quantity, ...] = (
     Quantity("energy_residual", "J", "E_suspension(t) + W_suspension - W_in - E_suspension(0)"),
 )
 OUTPUT_NAMES: tuple[str, ...] = tuple(q.name for q in OUTPUTS)
+# The FMU's outputs (ports): the motion the pendulum's pivot inputs take; the energies, works and the
+# power are local variables, recorded by name (as DoublePendulum's, double_pendulum.model.outputs).
+PORT_NAMES: tuple[str, ...] = ("x", "y", "vx", "vy", "ax", "ay")
 # Direct dependence on the inputs (FMI ModelStructure/Outputs): the acceleration and the power
 # follow the force at once; positions, velocities, energies and works are states.
 INPUT_DEPENDENCIES: dict[str, tuple[str, ...]] = {
