@@ -214,3 +214,17 @@ def test_docstrings_become_paragraphs_lists_equations_and_code():
     assert '<div class="equation"><i>c</i> = <i>d</i><br>+ <i>e</i></div>' in out
     assert "<p>Literal:</p>\n<pre>raw &lt;text&gt;</pre>" in out
     assert inline_html("a < b") == "a &lt; b"
+
+
+@pytest.mark.parametrize("name", FMUS)
+def test_every_page_links_the_fmus_reference_result_and_licences(contents, name):
+    """The page points to what the FMU carries besides its code, and each link resolves inside the FMU."""
+    files = contents[name]
+    page = files["documentation/index.html"].decode()
+    carried = page.split("Reference result and licences")[1]
+    links = re.findall(r'href="([^"]+)"', carried)
+    resolved = [link.removeprefix("../") if link.startswith("../") else f"documentation/{link}" for link in links]
+    assert all(path in files for path in resolved), resolved
+    assert any(p.startswith("extra/org.fmi-standard.fmi-ls-ref/") and p.endswith("_out.csv") for p in resolved)
+    assert {p for p in resolved if p.startswith("documentation/licenses/")} == {
+        p for p in files if p.startswith("documentation/licenses/")}

@@ -6,10 +6,11 @@ Stated tolerances, per output column, relative to the column's largest magnitude
 fmpy and the C hosts under Co-Simulation run the same FMU code on the same communication grid,
 REPRODUCE = 1e-9 (they agree to rounding; the margin covers another machine's libm through 3 s of
 chaos); the C host's Model Exchange integrates with its own RK4 at a quarter of a millisecond against
-CVode at rtol 1e-12 (RK4_ME): 1e-6 for the free swing, 1e-4 for the chaotic case, 1e-3 with friction,
+CVode at rtol 1e-12 (RK4_ME): 1e-6 for the free swing, 1e-4 for the chaotic case, 3e-3 with friction,
 where the regularised friction torque switches within about omega_reg / (angular acceleration), 1e-4 s,
 as the pendulum leaves rest: a fixed-step RK4 steps over it (1e-6 rad/s after 10 ms, grown to 4.6e-4
-relative over 5 s, the same at 0.125 ms steps), CVode resolves it. Each test prints what it measured.
+relative over 5 s in the angles and rates, the same at 0.125 ms steps; 1.3e-3 in the pivot force, which
+carries the accelerations the switch acts on), CVode resolves it. Each test prints what it measured.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from double_pendulum.fmu.reference_runs import (
 pytestmark = pytest.mark.filterwarnings("ignore:Please import:DeprecationWarning")  # fmpy's scipy.ndimage.filters
 REFERENCES = Path(str(data_path("reference/fmu")))
 REPRODUCE = 1e-9
-RK4_ME = {"DoublePendulumChaotic": 1e-4, "DoublePendulumFriction": 1e-3}
+RK4_ME = {"DoublePendulumChaotic": 1e-4, "DoublePendulumFriction": 3e-3}
 RK4_ME_DEFAULT = 1e-6
 ME_SUBSTEPS = 40  # RK4 steps of the C host per output interval (0.25 ms at 10 ms)
 HOST_SOURCES = {"2.0": "fmi2_host.c", "3.0": "fmi3_host.c"}

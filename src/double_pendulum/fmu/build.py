@@ -334,7 +334,7 @@ def build_systems(
     folder = Path(pendulum_fmu).parent
     fmus = (Path(pendulum_fmu), folder / "Suspension.fmu")
     return [
-        write_ssp(folder / "PendulumOnSuspension.ssp", *fmus, values, macro_step=macro_step),
+        write_ssp(folder / "PendulumOnSuspension.ssp", *fmus, values, macro_step=macro_step, reference=True),
         write_container(folder / "PendulumOnSuspension.fmu", *fmus, values, macro_step=macro_step, documented=True),
     ]
 

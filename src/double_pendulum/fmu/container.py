@@ -39,6 +39,8 @@ from .coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, S
 SYSTEM_NAME = "PendulumOnSuspension"
 PENDULUM, SUSPENSION = "DoublePendulum", "Suspension"
 FMI3_TYPES = {"Real": "Float64", "Integer": "Int32"}
+PORTS = ("DoublePendulum.phi1", "DoublePendulum.phi2", "Suspension.x", "Suspension.y")
+"""The container's outputs: both angles and the suspension mass's position (its documentation plot's)."""
 EXPOSED_PARAMETERS = {
     PENDULUM: ("phi1_0", "phi2_0", "omega1_0", "omega2_0"),
     SUSPENSION: ("M_s", "k_x", "k_y", "c_x", "c_y", "F_static_y"),
@@ -90,8 +92,9 @@ def _expose(md: Any, mappings: dict, component: Any, name: str, start: Any = Non
 
     source = _variables(component)[name]
     is_parameter = start is not None
-    # a member's output is the container's output, its local diagnostic a local of the container
-    causality = "parameter" if is_parameter else "local" if source.causality == "local" else "output"
+    # the container is a closed system: no master couples to it, so its outputs are what a user plots first
+    # (CONTAINER_PORTS); whatever else it exposes is a local, recorded by name
+    causality = "parameter" if is_parameter else "output" if f"{component.name}.{name}" in PORTS else "local"
     variable = ModelVariable(
         name=f"{component.name}.{name}", type=source.type, description=source.description,
         causality=causality,

@@ -109,10 +109,14 @@ def presentation_files(model: str, fmi_version: int, files: Mapping[str, bytes],
     root = ET.fromstring(md)
     page_kind = "DoublePendulumFmi3" if (model, fmi_version) == ("DoublePendulum", 3) else model
     plot_values, stop, step, caption = _plot_case(model, fmi_version, root, start_values)
+    starts = _parameter_starts(root) if model == CONTAINER else start_values
+    carried = {**licence_files(model, fmi_version), **reference_result.reference_files(model, md, starts)}
+    page = documentation.index_html(page_kind, md, {**files, **carried}, start_values, caption)
     out = {
         documentation.RESULT_PLOT: doc_plot.result_plot(model, plot_values, stop, step),
-        "documentation/index.html": documentation.index_html(page_kind, md, files, start_values, caption).encode(),
+        "documentation/index.html": page.encode(),
         "terminalsAndIcons/icon.png": icons.icon(model),
+        **carried,
     }
     if fmi_version == 2:
         out["model.png"] = icons.icon(model)
@@ -122,8 +126,5 @@ def presentation_files(model: str, fmi_version: int, files: Mapping[str, bytes],
     out[terminals.FILE] = terminals.terminals_xml(found)
     for path in sorted(terminals.icon_files(found)):
         out[path] = icons.terminal_icon(path.rpartition("/")[2].removesuffix(".png"))
-    out.update(licence_files(model, fmi_version))
-    starts = _parameter_starts(root) if model == CONTAINER else start_values
-    out.update(reference_result.reference_files(model, md, starts))
     return out
 

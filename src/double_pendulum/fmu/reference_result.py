@@ -44,15 +44,15 @@ def csv_text(rows: Mapping[str, list[float]]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def manifest(model: str, step: float) -> bytes:
+def manifest(model: str, step: float, description: str | None = None) -> bytes:
     """``fmi-ls-manifest.xml``: the one related file, the result of the default experiment."""
     ET.register_namespace("fmi-ls", "http://fmi-standard.org/fmi-ls-manifest")
     ls = "{http://fmi-standard.org/fmi-ls-manifest}"
     root = ET.Element("fmiReferences", {f"{ls}fmi-ls-name": "org.fmi-standard.fmi-ls-ref",
                                         f"{ls}fmi-ls-version": "1.0.0-alpha.1"})
     ET.SubElement(root, "Related", type="text/csv", source=f"{model}_out.csv", role="result",
-                  description=f"Outputs of the default experiment every {step:g} s (computed at build with the "
-                  "component the FMU runs)")
+                  description=description or f"Outputs of the default experiment every {step:g} s (computed at "
+                  "build with the component the FMU runs)")
     ET.indent(root, space="    ")
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
@@ -76,3 +76,41 @@ def reference_files(model: str, model_description: bytes, start_values: Mapping[
         every = interval(start, stop, step)
         rows = doc_plot.run(model, dict(start_values), stop, every, outputs)
     return {MANIFEST: manifest(model, every), f"{FOLDER}/{model}_out.csv": csv_text(rows).encode()}
+
+
+SSP_STATES = ("DoublePendulum.phi1", "DoublePendulum.phi2", "DoublePendulum.omega1", "DoublePendulum.omega2",
+              "Suspension.x", "Suspension.y", "Suspension.vx", "Suspension.vy")
+"""The SSP reference's columns: the states, which every master reads alike; the direct-feedthrough outputs (the
+pivot force, the suspension's acceleration) depend on when a master reads them between its exchanges."""
+LIBCOSIM_INITIAL_EXCHANGES = 2  # libcosim exchanges twice more while initialising (docs/coupling.md)
+
+
+def ssp_reference_files(values: Mapping[str, Any], stop_time: float, macro_step: float) -> dict[str, bytes]:
+    """The SSP's reference result, in the FMUs' layout: the coupled system from the monolith's start ``values`` as
+    libcosim's fixed-step algorithm steps it (``jacobi``: both FMUs step on the inputs of the last exchange, then
+    all outputs are passed; two extra exchanges while initialising), macro step ``macro_step`` [s], to
+    ``stop_time`` [s], :data:`SSP_STATES` every :func:`interval`. Computed at build in-process with the two
+    components; ``run_coupled`` reproduces libcosim to rounding (``tests/test_engines.py``)."""
+    from .coupling import run_coupled, split_values
+    from .presets import COMPONENTS
+
+    every = interval(0.0, stop_time, macro_step, macro_step)
+    pendulum_values, suspension_values = split_values(values)
+    pendulum, suspension = COMPONENTS["DoublePendulum"](), COMPONENTS["Suspension"]()
+    for component, start in ((pendulum, pendulum_values), (suspension, suspension_values)):
+        for name, value in start.items():
+            component.set(name, value)
+        component.initialise()
+    names = [n.partition(".")[2] for n in SSP_STATES]
+    rows = run_coupled(pendulum, suspension, stop_time=stop_time, macro_step=macro_step, scheme="jacobi",
+                       pendulum_outputs=names[:4], suspension_outputs=names[4:],
+                       initial_exchanges=LIBCOSIM_INITIAL_EXCHANGES)
+    kept = rows[:: round(every / macro_step)]
+    table = {"time": [k * every for k in range(len(kept))],
+             **{full: kept[short].tolist() for full, short in zip(SSP_STATES, names)}}
+    description = (f"States of the coupled system every {every:g} s as libcosim's fixed-step algorithm steps it "
+                   f"(Jacobi, macro step {macro_step:g} s; computed at build in-process). Its difference to the "
+                   "monolith, DoublePendulum with suspension on, is the coupling error, first order in the macro "
+                   "step (docs/coupling.md)")
+    return {MANIFEST: manifest(CONTAINER, every, description),
+            f"{FOLDER}/{CONTAINER}_out.csv": csv_text(table).encode()}

@@ -119,9 +119,14 @@ def _units(fmu: Path) -> dict[str, str]:
 
 def write_ssp(
     dest: str | Path, pendulum_fmu: str | Path, suspension_fmu: str | Path, values: Mapping[str, Any] | None = None,
-    *, macro_step: float = DEFAULT_MACRO_STEP, stop_time: float = 10.0,
+    *, macro_step: float = DEFAULT_MACRO_STEP, stop_time: float = 10.0, reference: bool = False,
 ) -> Path:
-    """Write the ``.ssp`` at ``dest`` holding both FMUs; ``values``: the monolith's start values (defaults if None)."""
+    """Write the ``.ssp`` at ``dest`` holding both FMUs; ``values``: the monolith's start values (defaults if None).
+
+    ``reference=True`` (the build's SSP) adds the reference result of its default experiment,
+    ``extra/org.fmi-standard.fmi-ls-ref/`` as in the FMUs (:func:`~double_pendulum.fmu.reference_result.
+    ssp_reference_files`: the states as libcosim steps them; about 1.5 s of CPU for the 10 s).
+    """
     dest = Path(dest)
     dest.parent.mkdir(parents=True, exist_ok=True)
     units = {**_units(Path(pendulum_fmu)), **_units(Path(suspension_fmu))}
@@ -131,5 +136,10 @@ def write_ssp(
         archive.writestr("SystemStructure.ssd", ssd)
         archive.write(pendulum_fmu, f"resources/{PENDULUM}.fmu")
         archive.write(suspension_fmu, f"resources/{SUSPENSION}.fmu")
+        if reference:
+            from .reference_result import ssp_reference_files
+
+            for name, data in ssp_reference_files(values or {}, stop_time, macro_step).items():
+                archive.writestr(name, data)
     tmp.replace(dest)
     return dest
