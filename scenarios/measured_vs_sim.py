@@ -43,13 +43,16 @@ per-frame error smoothed by a centred moving median over 0.25 s (about 7 frames;
 track's frame-to-frame jitter; ``horizons_smoothed_s``) and on the raw per-frame error
 (``horizons_raw_s``). Goal (issue 12): at least 3 s at 5 cm for the lower bob, smoothed. Two floors
 limit the horizon: the track itself (the distance between the bobs varies by about +-1 cm where a
-rigid rod allows none) and the fit's own uncertainty (an ensemble of FMU runs drawn from the fit's
-covariance). The regime at the measured energy comes from the largest Lyapunov exponent of the
-fitted start (frictionless, rods, :data:`LYAPUNOV_S` s; quick: :data:`QUICK_LYAPUNOV_S` s; thorough:
-:data:`THOROUGH_LYAPUNOV_S` s), compared with the energy the lower rod needs to flip.
+rigid rod allows none) and the start's own uncertainty (FMU runs drawn from the start fit's covariance). The
+losses' uncertainty moves it far more: ``loss_uncertainty`` gives each supported model's horizons at 1 -+ 1 % damping
+(cached) and, with ``thorough``, an ensemble over the losses' and the start's covariance
+(:mod:`double_pendulum.analysis.prediction.loss_uncertainty`). The regime at the measured energy: the largest
+Lyapunov exponent of the fitted start (frictionless, rods, :data:`LYAPUNOV_S` s; quick: :data:`QUICK_LYAPUNOV_S` s;
+thorough: :data:`THOROUGH_LYAPUNOV_S` s) against the energy the lower rod needs to flip.
 
 Cost: about 29 s of CPU by default once ``loss_identification`` has cached its fits (about 130 s on a first
-run that fits every model itself). ``thorough`` adds the fit-window check (the start and geometry fitted again to
+run that fits every model itself, plus about 6 s for the damping runs until they are cached). ``thorough`` adds
+the loss ensemble (60 runs, about 40 s, cached) and the fit-window check (the start and geometry fitted again to
 the first :data:`WINDOW_SENSITIVITY` frames, about 35 s of CPU) and averages the Lyapunov exponent over
 :data:`THOROUGH_LYAPUNOV_S` s (5 s more). ``quick``: a 3 s prediction, the geometry fitted to
 :data:`QUICK_GEOMETRY_FIT_FRAMES` frames, :data:`QUICK_ENSEMBLE_SIZE` ensemble runs, a 10 s Lyapunov exponent.
@@ -71,8 +74,6 @@ import numpy as np
 from double_pendulum import plots
 from double_pendulum.analysis.losses.identification import seed_reconstruction
 from double_pendulum.analysis.prediction.comparison import (
-    FREE_GEOMETRY,
-    PIVOT_SHIFT_GEOMETRY,
     SMOOTHING_S,
     THRESHOLDS_M,
     Prediction,
@@ -85,32 +86,33 @@ from double_pendulum.analysis.prediction.comparison import (
     headline_entries,
     headline_horizon,
     identified_losses,
-    least_squares_start,
     measured_coordinates,
     model_summary,
     nearest_frame,
     null_means,
-    predict,
     reconstructed_state,
     regime,
     rod_floor_summary,
     rod_length_floor,
     run_title,
     simulated_coordinates,
-    start_fit_summary,
     window_sensitivity,
 )
 from double_pendulum.analysis.prediction.loss_models import (
     loss_model_predictions,
     loss_model_sensitivity,
     smoothed_error_band,
+    supported_loss_fits,
     supported_loss_values,
 )
+from double_pendulum.analysis.prediction.loss_uncertainty import ENSEMBLE_SIZE as LOSS_ENSEMBLE_SIZE
+from double_pendulum.analysis.prediction.loss_uncertainty import loss_uncertainty
 from double_pendulum.analysis.prediction.paths import PATHS_UNITS, paths_table
 from double_pendulum.analysis.prediction.report import report_text
+from double_pendulum.analysis.prediction.runs import fitted_starts, starts_summary
+from double_pendulum.analysis.prediction.runs import predictions as run_predictions
 from double_pendulum.analysis.suspension.identification import START_FIT_FRAMES
 from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, Reconstruction
-from double_pendulum.analysis.track.start_state import STATE_NAMES
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.runs.results_io import read_results_csv, write_json, write_results_csv, write_text
@@ -137,9 +139,8 @@ GOAL_S = 3.0
 """Issue 12's goal: the lower bob's smoothed error stays below 5 cm for at least this long [s] after t0."""
 LYAPUNOV_S = 50.0
 """Averaging time [s] of the Lyapunov exponent at the measured energy (quick: :data:`QUICK_LYAPUNOV_S`,
-thorough: :data:`THOROUGH_LYAPUNOV_S`). At the seed's energy the running exponent falls like 1/T through
-5, 10, 20 and 50 s (0.79, 0.45, 0.23, 0.12 1/s), which the regular verdict needs; 100 s only adds 0.07 1/s
-at twice the cost."""
+thorough: :data:`THOROUGH_LYAPUNOV_S`). At the seed's energy the running exponent keeps falling through 5, 10,
+20 and 50 s (0.79, 0.45, 0.23, 0.12 1/s; lambda T grows only like ln T), which the regular verdict needs."""
 QUICK_LYAPUNOV_S = 10.0
 THOROUGH_LYAPUNOV_S = 100.0
 ENSEMBLE_SIZE = 6
@@ -196,23 +197,16 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     n_frames = round((QUICK_PREDICTION_S if quick else PREDICTION_S) / FRAME_INTERVAL) + 1
     ensemble_size = QUICK_ENSEMBLE_SIZE if quick else ENSEMBLE_SIZE
     seed_state = reconstructed_state(rec, i0)
-    fit = least_squares_start(runner, rec, i0, values, FIT_FRAMES)
-    geometry_frames = QUICK_GEOMETRY_FIT_FRAMES if quick else GEOMETRY_FIT_FRAMES
-    geo = least_squares_start(runner, rec, i0, values, geometry_frames, FREE_GEOMETRY)
-    fixed = least_squares_start(runner, rec, i0, values, geometry_frames)
-    shift = least_squares_start(runner, rec, i0, values, geometry_frames, PIVOT_SHIFT_GEOMETRY)
-    predictions = [  # the main run last (error_curves draws its per-frame error)
-        predict(runner, "seed_start_frictionless", frictionless, seed_state, rec, i0, n_frames),
-        predict(runner, "seed_start_identified", values, seed_state, rec, i0, n_frames),
-        predict(runner, "lsq_start_identified", values, fit.state, rec, i0, n_frames),
-        predict(runner, "lsq_fixed_geometry_identified", values, fixed.state, rec, i0, n_frames),
-        predict(runner, "lsq_pivot_shift_identified", values, shift.state, rec, i0, n_frames, shift.geometry),
-        predict(runner, "lsq_geometry_identified", values, geo.state, rec, i0, n_frames, geo.geometry),
-    ]
+    starts = fitted_starts(runner, rec, i0, values, QUICK_GEOMETRY_FIT_FRAMES if quick else GEOMETRY_FIT_FRAMES)
+    geo = starts.geometry
+    predictions = run_predictions(runner, rec, i0, n_frames, values, frictionless, seed_state, starts)
     headlines = {p.label: headline_horizon(p, (n_frames - 1) * FRAME_INTERVAL) for p in predictions[3:]}
+    loss_fits = supported_loss_fits(rec, quick=quick)
     by_model = loss_model_predictions(runner, rec, i0, n_frames, losses.pendulum, geo,
-                                      supported_loss_values(rec, quick=quick), done=(values, predictions[-1]))
+                                      supported_loss_values(loss_fits), done=(values, predictions[-1]))
     spread = chaos_spread(runner, values, geo, predictions[-1], n_frames, ensemble_size)
+    uncertainty = loss_uncertainty(runner, rec, i0, n_frames, losses.pendulum, geo, loss_fits, by_model,
+                                   list(loss_fits), LOSS_ENSEMBLE_SIZE if thorough else 0)
     prediction_s = (n_frames - 1) * FRAME_INTERVAL
     smoothed = {p.label: p.smoothed_horizons() for p in predictions}
     reached = smoothed["lsq_geometry_identified"]["lower_bob_5cm_s"]
@@ -227,18 +221,13 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         "prediction_s": prediction_s,
         "pivot_origin_m": {"x": rec.geometry.pivot.xc, "y": rec.geometry.pivot.yc},
         "model": model_summary(losses),
-        "starts": {
-            "seed_reconstruction": dict(zip(STATE_NAMES, seed_state.tolist())),
-            "least_squares": start_fit_summary(fit, seed_state),
-            "least_squares_geometry": start_fit_summary(geo, seed_state),
-            "least_squares_fixed_geometry": start_fit_summary(fixed, seed_state),
-            "least_squares_pivot_shift": start_fit_summary(shift, seed_state),
-        },
+        "starts": starts_summary(seed_state, starts),
         **headline_entries(headlines),
         "smoothing": {"method": "centred moving median of the per-frame position error", "window_s": SMOOTHING_S},
         "horizons_smoothed_s": smoothed,
         "horizons_raw_s": {p.label: p.horizons() for p in predictions},
         "loss_model_sensitivity": loss_model_sensitivity(by_model, n_frames),
+        "loss_uncertainty": uncertainty,
         "goal": goal_entry(reached, prediction_s, GOAL_S),
         "regime": regime(PendulumParameters(**{**losses.pendulum, **fitted_l2}), geo.state, lyapunov_s),
         "chaos_horizons_s": chaos_horizons(spread),
@@ -248,9 +237,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         "null_means": null_means(prediction_s),
     }
     if thorough:
-        summary["fit_window_sensitivity"] = window_sensitivity(
-            runner, rec, i0, values, n_frames, WINDOW_SENSITIVITY, FREE_GEOMETRY, warm=geo
-        )
+        summary["fit_window_sensitivity"] = window_sensitivity(runner, rec, i0, values, n_frames,
+                                                               WINDOW_SENSITIVITY, warm=geo)
     for p in predictions:
         write_results_csv(out_dir / f"{p.label}.csv", p.result, runner.units)
     write_results_csv(out_dir / "errors.csv", errors_table(rec, i0, n_frames, predictions), errors_units(predictions))

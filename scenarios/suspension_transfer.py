@@ -101,7 +101,9 @@ CONDITIONAL_ON = {
     "k": "assumed (the parameter default), not measured",
     "M_s": "assumed (the parameter default), not measured",
     "losses": "the default air drag, rod drag and rolling friction (settings.losses), not fitted",
-    "model": "a suspension model the data reject: it reproduces neither b nor the loss exponent p (refit)",
+    "model": "this suspension model at these k and M_s: refitted it reproduces neither b nor the loss exponent p "
+             "(refit), so at these k and M_s the data do not support it; another k, M_s or suspension law, or "
+             "another part of the record, could change that (not fitted here)",
     "valley": "equally good fits lie along valley.linearised: c is not an identified property of the stand",
 }
 """What the identified c is conditional on (``summary["identified"]["conditional_on"]``)."""

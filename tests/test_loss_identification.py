@@ -98,7 +98,7 @@ def test_top_model_on_the_real_data_quick(quick_results):
     seed = s["drag_torque_against_seed_rolling_friction"]
     assert seed["fitted_over_seed"][0] == pytest.approx(s["parameters"]["tau_b"]["value"] / seed["torque_N_m"][0])
     assert seed["fitted_over_seed"][0] == pytest.approx(2.0 * seed["fitted_over_seed"][1])  # c_R 0.5e-3 and 1e-3
-    assert s["suspension_dominates"] is None and s["answer"].startswith("Not tested")
+    assert s["suspension_verdict"] is None and s["answer"].startswith("Not tested")
     assert s["profile_likelihood"] == {}
     for key in ("b_measured_per_s", "b_sim_per_s", "p_measured", "p_measured_stderr", "p_sim"):
         assert math.isfinite(s[key])
@@ -308,6 +308,29 @@ def test_the_suspension_at_its_nested_limit_is_reported_as_a_bound_not_a_fit():
     bound = loss_claims.suspension_bound(list(rows.values()))
     assert bound["delta_aic_at_best"] == susp["delta_aic_at_best"] and bound["stopped_at"]["c_suspension"] == 112.0
     assert comparison.limit_model("air+drag") is None and comparison.limit_model("air+drag+suspension") == "air+drag"
+
+
+def test_the_suspension_verdict_states_the_k_and_m_s_it_holds_at_and_what_would_change_it():
+    """No bare yes/no: the verdict names the assumed k and M_s and the record, and what could change it."""
+    fits = [_fake_fit("air", 641.06), _fake_fit("air+drag", 608.9), _fake_fit("drag", 619.0),
+            _fake_fit("air+suspension", 833.6, [0.29, 112.0])]
+    rows = comparison.comparison_rows(fits, 1.28)
+    answer = identification.suspension_answer(rows)
+    v = answer["suspension_verdict"]
+    assert "suspension_dominates" not in answer
+    assert v["verdict"] == "not the main loss" and v["top_model"] == "air+drag"
+    assert v["holds_at"]["k_N_per_m"] == mechanisms.SUSPENSION_K and v["holds_at"]["M_s_kg"] == mechanisms.SUSPENSION_M
+    assert v["delta_aic_at_best_of_air_and_suspension"] == pytest.approx(
+        next(r for r in rows if r["model"] == "air+suspension")["delta_aic_at_best"])
+    assert any("stiffness k" in w for w in v["would_change_it"]) and any("c / k^2" in w for w in v["would_change_it"])
+    text = answer["answer"]
+    assert text.startswith("Not the main loss at the assumed k = 20000 N/m and M_s = 2 kg")
+    assert "What would change it" in text and "reject" not in text and not text.startswith("No:")
+    # a top model that loses most in the suspension: "main loss", still at these k and M_s only
+    top = dict(rows[0], model="air+suspension", shares={mechanisms.MECHANISMS["suspension"].label: 0.9})
+    v = identification.suspension_verdict([top, *rows[1:]])
+    assert v["verdict"] == "main loss" and v["suspension_share_in_top_model"] == 0.9
+    assert identification.suspension_verdict([r for r in rows if r["model"] != "air+suspension"]) is None
 
 
 def test_a_larger_correlation_factor_lets_models_with_fewer_numbers_join_the_tie():

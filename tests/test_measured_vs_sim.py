@@ -260,6 +260,13 @@ def test_quick_run_compares_both_starts_with_the_track(quick_results):
     assert "are fitted with ``--thorough``" in report
     assert summary["starts"]["least_squares_geometry"]["n_frames"] <= 15  # the quick run's shorter geometry fit
     assert summary["regime"]["averaging_time_s"] == pytest.approx(10.0)
+    # the damping-level runs: their fitted level is the loss model's own prediction; the ensemble is --thorough only
+    unc = summary["loss_uncertainty"]
+    for model, d in unc["damping_sensitivity"].items():
+        assert d["levels"]["fitted"]["horizon_s"] == summary["loss_model_sensitivity"]["models"][model]["horizon_s"]
+        h = [d["levels"][k]["horizon_s"] for k in ("less_damping", "more_damping")]
+        assert d["smoothed_s_per_percent"] == pytest.approx((h[1] - h[0]) / 2.0)
+    assert "ensemble" not in unc and "The losses' uncertainty" in report
 
 
 def test_the_loss_models_reuse_the_main_run_and_run_each_other_model_once(monkeypatch):

@@ -210,7 +210,7 @@ def spectrum_summary(spectrum: Spectrum, t_end: float) -> dict:
     """Final exponents [1/s], the pairing ``lambda1 + lambda4``, their sum and its bound.
 
     The exponents are finite-time values of one run up to ``t_end`` [s], not the limit T -> infinity:
-    the middle pair, 0 in the limit, is still of order 1/T, and a single run's lambda1 scatters by
+    the middle pair, 0 in the limit, is still of order ln(T)/T, and a single run's lambda1 scatters by
     10-20 % between neighbouring starts (:func:`compare_integrations` averages a cloud).
     """
     lam = spectrum.running[-1]
@@ -222,7 +222,7 @@ def spectrum_summary(spectrum: Spectrum, t_end: float) -> dict:
         "t_end_s": t_end,
         "method": f"QR (Gram-Schmidt) of 4 complex-step tangent vectors, rk4 h = {spectrum.h * 1e3:g} ms",
         "note": f"finite-time spectrum of one {t_end:g} s run (not the T -> infinity limit; the middle pair "
-        "tends to 0 like 1/T)",
+        "tends to 0 like ln(T)/T or faster)",
     }
 
 

@@ -82,38 +82,83 @@ class LossIdentification:
     works: dict[str, np.ndarray]
 
 
-def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
-    """Does the suspension dominate the loss? From the suspension's share in every model that has it
-    and the top model's composition (a plain sentence and the numbers); not asked (``None``) when no
-    fitted model has a suspension (the quick run)."""
+SUSPENSION_WOULD_CHANGE = (
+    "another stiffness k or suspension mass M_s (assumed, not measured: suspension_transfer maps the decay rate "
+    "over k and the damping c)",
+    "another suspension law: a stiff suspension loses about c <|dF/dt|^2> / k^2, so only the combination c / k^2 "
+    "is tested here, at one k",
+    "another part of the record (only the whole record is fitted here; a fit to a shorter window weighs the early, "
+    "larger swings more)",
+)
+"""What the suspension verdict of :func:`suspension_answer` is conditional on: what could change it."""
+
+
+def suspension_verdict(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any] | None:
+    """The suspension's verdict as a conditional statement, not a bare yes/no: ``verdict`` ("main loss" if the model
+    with the lowest AIC loses more than half its energy in the suspension, else "not the main loss"), ``holds_at``
+    (the fixed k [N/m] and M_s [kg], the record fitted, the criterion), the suspension's share in the top model and
+    where it is fitted, the bound of air drag + suspension (``loss_claims.suspension_bound``) and
+    ``would_change_it`` (:data:`SUSPENSION_WOULD_CHANGE`). None when no fitted model has a suspension (quick)."""
     label = MECHANISMS["suspension"].label
     if not any("suspension" in r["model"].split("+") for r in rows):
-        return {"suspension_dominates": None, "suspension_share_by_model": {},
+        return None
+    best = rows[0]
+    share = best["shares"].get(label, 0.0)
+    bound = loss_claims.suspension_bound(rows)
+    return {
+        "verdict": "main loss" if share > 0.5 else "not the main loss",
+        "holds_at": {"k_N_per_m": SUSPENSION_K, "M_s_kg": SUSPENSION_M, "record": "the whole measured record",
+                     "criterion": "the suspension's share of the loss in the model with the lowest AIC > 50 %"},
+        "top_model": best["model"],
+        "suspension_share_in_top_model": share,
+        "delta_aic_at_best_of_air_and_suspension": None if bound is None else bound["delta_aic_at_best"],
+        "would_change_it": list(SUSPENSION_WOULD_CHANGE),
+    }
+
+
+def suspension_answer(rows: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """Does the suspension dominate the loss? A conditional verdict (:func:`suspension_verdict`: at the assumed k and
+    M_s, on the whole record), the suspension's share in every model that has it and a plain sentence that says the
+    conditions; not asked (verdict ``None``) when no fitted model has a suspension (the quick run)."""
+    label = MECHANISMS["suspension"].label
+    verdict = suspension_verdict(rows)
+    if verdict is None:
+        return {"suspension_verdict": None, "suspension_share_by_model": {},
                 "answer": "Not tested: no model with a suspension was fitted in this run (quick mode fits "
                           "air+drag alone); the default run fits air+suspension."}  # fmt: skip
     with_susp = {r["model"]: r["shares"].get(label) for r in rows if label in r["shares"] and r["converged"]}
     best = rows[0]
-    dominates = bool(label in best["shares"] and best["shares"][label] > 0.5)
-    if dominates:
-        share = best["shares"][label]
-        text = (f"Yes: the model with the lowest AIC ({model_title(best['model'])}) loses {share:.0%} of its energy in "
-                "the suspension.")
+    at = f"at the assumed k = {SUSPENSION_K:g} N/m and M_s = {SUSPENSION_M:g} kg, on the whole record"
+    if verdict["verdict"] == "main loss":
+        text = (f"At these conditions, yes ({at}): the model with the lowest AIC ({model_title(best['model'])}) loses "
+                f"{verdict['suspension_share_in_top_model']:.0%} of its energy in the suspension.")
     else:
         parts = ", ".join(f"{m}: {s:.0%} (delta AIC {next(r['delta_aic'] for r in rows if r['model'] == m):.1f})"
                           for m, s in with_susp.items())  # fmt: skip
         if label in best["shares"]:
-            text = (f"No: the suspension carries {best['shares'][label]:.0%} of the loss in the model with the lowest "
-                    "AIC")
+            text = (f"Not the main loss {at}: the suspension carries {best['shares'][label]:.0%} of the loss in the "
+                    "model with the lowest AIC")
         else:
-            text = f"No: the model with the lowest AIC ({model_title(best['model'])}) has no suspension"
+            text = (f"Not the main loss {at}: the model with the lowest AIC ({model_title(best['model'])}) has no "
+                    "suspension")
         text += f"; suspension share where it is fitted: {parts}." if parts else "."
     bound = loss_claims.suspension_bound(rows)
     if bound is not None:
-        text += (f" As the main loss ({bound['model_in_words']}, at the assumed k = {SUSPENSION_K:g} N/m and M_s = "
-                 f"{SUSPENSION_M:g} kg) the suspension has no finite optimum: {bound['statement']}; so it fits worse "
-                 f"than the lowest AIC by at least delta AIC {bound['delta_aic_at_best']:.0f}, at these k and M_s "
-                 "only (suspension_transfer maps others).")
-    return {"suspension_dominates": dominates, "answer": text, "suspension_share_by_model": with_susp}
+        text += (f" As the main loss ({bound['model_in_words']}) the suspension has no finite optimum at these k and "
+                 f"M_s: {bound['statement']}; so it fits worse than the lowest AIC by at least delta AIC "
+                 f"{bound['delta_aic_at_best']:.0f}, at these k and M_s only.")
+    text += " What would change it: " + "; ".join(SUSPENSION_WOULD_CHANGE) + "."
+    return {"suspension_verdict": verdict, "answer": text, "suspension_share_by_model": with_susp}
+
+
+def _air_model_on_measured_decay(fits: Sequence[Any], rows: Sequence[Mapping[str, Any]]) -> Any:
+    """The converged model with air drag and the lowest AIC among those within delta AIC 2 (it follows the measured
+    energy), for :func:`~.comparison.air_share_at_defaults`; None if there is none."""
+    supported = loss_claims.supported_models(rows)["models"]
+    for r in rows:  # rows are in AIC order
+        if r["model"] in supported and r["converged"] and "air" in r["model"].split("+"):
+            return next(f for f in fits if f.model == r["model"])
+    return None
 
 
 def goal_checks(numbers: Mapping[str, float], halves: Mapping[str, Any]) -> dict[str, Any]:
@@ -208,12 +253,12 @@ def identify_losses(
         "drag_torque_against_seed_rolling_friction": next(
             (loss_claims.seed_rolling_friction(rec.params, r["parameters"]["tau_b"]["value"]) for r in rows
              if r["model"] == "air+drag"), None),
-        "air_drag_at_defaults": air_share_at_defaults(problem, loss),
+        "air_drag_at_defaults": air_share_at_defaults(problem, loss, _air_model_on_measured_decay(fits, rows)),
         "models": rows,
         "suspension_fixed": {"k_N_per_m": SUSPENSION_K, "M_s_kg": SUSPENSION_M},
         "omega_reg_rad_per_s": OMEGA_REG,
         "regularisation": regularisation,
-        "null_means": {"suspension_dominates": "not tested: no model with a suspension was fitted (quick mode)",
+        "null_means": {"suspension_verdict": "not tested: no model with a suspension was fitted (quick mode)",
                        "suspension_as_main_loss": "not fitted (quick mode), or air+suspension converged to a "
                                                   "finite damping",
                        "stderr": "models[...].parameters of a model that did not converge: values where its fit "

@@ -86,7 +86,7 @@ LYAPUNOV_STEP_S = 2e-3
 """RK4 step [s] of the Lyapunov estimate (:func:`regime`; the step the ``chaos`` scenario's checks support)."""
 REGULAR_DECAY = 0.5
 """The motion counts as regular if the running exponent at T has fallen below this fraction of its
-value at T/4 (1/T-like decay: the tangent grows linearly); a converging positive exponent stays near 1."""
+value at T/4 (a tangent that grows linearly gives lambda(T) ~ ln(T)/T); a converging positive exponent stays near 1."""
 ENSEMBLE_SEED = 20240611
 """Seed of the random start states of :func:`chaos_spread`."""
 RUN_OUTPUTS: tuple[str, ...] = (*POSITION_OUTPUTS, "phi1", "phi2", "omega1", "omega2", "E_pendulum")
@@ -393,7 +393,7 @@ def regime(params: PendulumParameters, state: Sequence[float], t_end: float) -> 
     The largest Lyapunov exponent by Benettin's method
     (:func:`~double_pendulum.analysis.chaos.lyapunov.lyapunov_benettin`, RK4 at :data:`LYAPUNOV_STEP_S`,
     renormalised every :data:`LYAPUNOV_RENORM_S`) over ``t_end`` [s]; the motion is called regular if the running
-    exponent at T = ``t_end`` has fallen below :data:`REGULAR_DECAY` of its value at T/4 (the 1/T decay of a tangent
+    exponent at T = ``t_end`` has fallen below :data:`REGULAR_DECAY` of its value at T/4 (the ln(T)/T decay of a tangent
     that grows linearly), chaotic otherwise. The energy is
     compared with the least energy that lets the lower rod flip, V(0, pi).
     """

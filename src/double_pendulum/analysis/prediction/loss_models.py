@@ -36,16 +36,22 @@ THRESHOLD_M = 0.05
 """The error [m] whose first crossing is compared across the loss models."""
 
 
-def supported_loss_values(rec: Reconstruction, *, quick: bool = False) -> dict[str, dict[str, Any]]:
-    """FMU start values of the losses of every model within delta AIC 2 of the lowest, by model name, fitted to
-    the whole record of ``rec`` as ``loss_identification`` fits them in that mode (quick: its one model)."""
+def supported_loss_fits(rec: Reconstruction, *, quick: bool = False) -> dict[str, tuple[fitting.ModelFit, float]]:
+    """The fit of every model within delta AIC 2 of the lowest and the record's correlation factor F (its
+    covariance is ``fit.cov(F)``), by model name, fitted to the whole record of ``rec`` as ``loss_identification``
+    fits them in that mode (quick: its one model)."""
     problem = fitting.problem_from_track(rec, identification.measured(rec), quick=quick)
     models = mechanisms.QUICK_MODELS if quick else mechanisms.FULL_MODELS
     fits, _ = fitting.fit_models(models, problem, max_workers=1, max_runs=fitting.run_budget(quick))
-    rows = comparison.comparison_rows(fits, comparison.common_factor(problem))
-    supported = claims.supported_models(rows)["models"]
-    return {f.model: {**mechanisms.model_values(f.model, f.theta), "omega_reg": mechanisms.OMEGA_REG}
-            for f in fits if f.model in supported}  # fmt: skip
+    factor = comparison.common_factor(problem)
+    supported = claims.supported_models(comparison.comparison_rows(fits, factor))["models"]
+    return {f.model: (f, factor) for f in fits if f.model in supported}
+
+
+def supported_loss_values(fits: Mapping[str, tuple[fitting.ModelFit, float]]) -> dict[str, dict[str, Any]]:
+    """FMU start values of the losses of each of ``fits`` (:func:`supported_loss_fits`) at its fitted parameters."""
+    return {model: {**mechanisms.model_values(model, f.theta), "omega_reg": mechanisms.OMEGA_REG}
+            for model, (f, _) in fits.items()}  # fmt: skip
 
 
 def loss_model_predictions(

@@ -182,10 +182,11 @@ def regime_text(s: Mapping[str, Any]) -> str:
         f"{checkpoints} (at T/4: {r['exponent_at_quarter_time_per_s']:.3f} 1/s)."
     )
     if r["verdict"] == "regular":
-        return (f"{head} It falls like 1/T and tends to 0: the motion is regular, nearby runs separate about "
-                "linearly, and no horizon here is a chaos limit; it is a model and measurement limit.")
-    return (f"{head} It does not fall like 1/T: the motion is chaotic, with an e-folding time of about "
-            f"{1 / r['largest_lyapunov_exponent_per_s']:.1f} s.")
+        return (f"{head} It keeps falling towards 0 (lambda T grows only about like ln T, as for a separation "
+                "that grows linearly): the motion is regular, nearby runs separate about linearly, and no horizon "
+                "here is a chaos limit; it is a model and measurement limit.")
+    return (f"{head} It does not fall towards 0 (lambda T grows like T): the motion is chaotic, with an e-folding "
+            f"time of about {1 / r['largest_lyapunov_exponent_per_s']:.1f} s.")
 
 
 def loss_models_text(s: Mapping[str, Any]) -> str:
@@ -202,6 +203,35 @@ def loss_models_text(s: Mapping[str, Any]) -> str:
             f"geometry with each ({rows}) keep the smoothed error within 5 cm for {smoothed_range_text(sens)} and the "
             f"per-frame error for {raw_range_text(sens)}. That range, not one run's figure, is what the record "
             "supports; the table above is the run with one of them.")
+
+
+def loss_uncertainty_text(s: Mapping[str, Any]) -> str:
+    """The horizon's sensitivity to the damping level per model and, with ``--thorough``, the ensemble over the
+    losses' and the start's covariance (median and 16-84 % range)."""
+    u = s.get("loss_uncertainty")
+    if not u or not u["damping_sensitivity"]:
+        return ""
+    rows = "; ".join(f"{model_title(m)}: {d['smoothed_s_per_percent']:+.1f} s smoothed"
+                     f"{' or more' if d['slope_is_lower_bound'] else ''}, {d['raw_s_per_percent']:+.1f} s per frame"
+                     for m, d in u["damping_sensitivity"].items())  # fmt: skip
+    text = ("**The losses' uncertainty.** The horizons above take each model's fitted losses as exact, and the horizon "
+            "is very sensitive to the damping level: 1 % more damping (every loss coefficient times 1.01; central "
+            f"difference of +-1 %) changes the 5 cm horizon by about ({rows}; \"or more\": a censored end, the "
+            "size is a lower bound), so an uncertainty of the fitted damping of a few tenths of a per cent "
+            "already moves it by a second.")
+    if "ensemble" not in u:
+        return text + " The ensemble over the losses' covariance runs with ``--thorough``."
+    ens = "; ".join(f"{model_title(m)}: {_stats_text(e['smoothed_5cm'])} smoothed, {_stats_text(e['raw_5cm'])} "
+                    "per frame" for m, e in u["ensemble"].items())  # fmt: skip
+    return text + f" Drawn from the losses' and the start's covariance ({u['ensemble_definition']}): {ens}."
+
+
+def _stats_text(stats: Mapping[str, Any]) -> str:
+    """'median 13.3 s (16-84 %: 9.5 s to beyond the record)' of :func:`~.loss_uncertainty.horizon_stats`."""
+    med = "beyond the record" if stats["median_censored"] else f"{stats['median_s']:.1f} s"
+    lo, hi = stats["range_16_84_s"]
+    top = "beyond the record" if stats["top_censored"] else f"{hi:.1f} s"
+    return f"median {med} (16-84 %: {lo:.1f} s to {top})"
 
 
 def smoothed_range_text(sens: Mapping[str, Any]) -> str:
@@ -270,7 +300,7 @@ def _opening(s: Mapping[str, Any], quick: str) -> str:
         "chi2_red": "the fit's sum of squared residuals over their errors per degree of freedom; about 1 if the "
                     "model misses the track by its noise; the standard errors are scaled by its square root",
         "Lyapunov exponent": "the rate [1/s] at which nearby runs separate exponentially; tending to 0 with the "
-                             "averaging time T (like 1/T) means regular motion",
+                             "averaging time T (like ln T / T: the separation grows linearly) means regular motion",
     })
 
 
@@ -339,15 +369,17 @@ censored):
 
 {loss_models_text(s)}
 
+{loss_uncertainty_text(s)}
+
 **Goal**: {goal["statement"]}. Held {reached}, **{"met" if goal["met"] else "not met"}** (in-sample).
 The seed saw agreement until about 2 s, i.e. about {2.0 - s["t0_s"]:.1f} s after t0, by eye.
 
 **Two floors.** (1) The track: the distance between the bobs varies where a rigid rod allows none,
 by {1e3 * floor["rms_m"]:.1f} mm rms and up to {1e3 * floor["max_m"]:.1f} mm in this window (correlation of the
-signed deviation with omega2^2: {floor["correlation_with_omega2_squared"]:+.2f}). (2) The fit's own uncertainty:
-{s["ensemble_size"]} runs drawn from the covariance of the start and geometry part from the central run by 2 cm
-after {fmt_horizon(chaos["lower_bob_2cm_s"], span)} s and by 5 cm after {fmt_horizon(chaos["lower_bob_5cm_s"], span)} s
-(median distance of the lower bob). {cause_text(s)}
+signed deviation with omega2^2: {floor["correlation_with_omega2_squared"]:+.2f}). (2) The start's own
+uncertainty (losses held at their fit): {s["ensemble_size"]} runs drawn from the covariance of the start and geometry
+part from the central run by 2 cm after {fmt_horizon(chaos["lower_bob_2cm_s"], span)} s and by 5 cm after
+{fmt_horizon(chaos["lower_bob_5cm_s"], span)} s (median distance of the lower bob). {cause_text(s)}
 
 {regime_text(s)}
 

@@ -221,7 +221,7 @@ inflated by sqrt({i["autocorrelation_factor"]:.1f}) for the correlated residuals
 {i["n_frames"]} frames (chi2_red {i["chi2_red"]:.2f}), {i["n_fmu_runs"]} FMU runs.
 
 **What this c is.** It is conditional: on the assumed k and M_s (not measured), on the default air drag and
-rolling friction beside it (not fitted), and on a model the data reject: refitted, it gives
+rolling friction beside it (not fitted), and on this suspension model at these k and M_s: refitted, it gives
 b = {refit["b_E_pendulum_per_s"]:.4f} 1/s against the measured {s["measured"]["b_per_s"]:.4f} 1/s
 ({refit["difference_in_total_sigma"]:+.1f} times the total error of the measured b, statistical and systematic;
 {refit["difference_in_measured_sigma"]:+.1f} times its statistical error alone), which b alone does not reject,
@@ -406,7 +406,8 @@ def _opening(s: Mapping[str, Any], quick: str) -> str:
         f"Fitting c at an assumed k = {i['fixed']['k']:g} N/m and mass M_s = {i['fixed']['M_s']:g} kg gives "
         f"c = {i['c_N_s_per_m']:.0f} N s/m, but that suspension makes the loss depend on the swing's size far more "
         f"steeply than measured (loss exponent {refit['p']:.1f} against {m['decay_shape']['p']:.1f}), so it is a "
-        "point on a curve of a model the data reject, not a property of the stand.",
+        "point on a curve of a model the data do not support at these k and M_s (others were not fitted), not a "
+        "property of the stand.",
         "How sure: k and M_s are assumed, not measured, and every fit is judged on the record it was fitted to.",
     ], {
         "b": "the decay rate [1/s] of the energy fitted as E = a exp(b t)",
