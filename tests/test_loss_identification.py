@@ -102,6 +102,13 @@ def test_top_model_on_the_real_data_quick(quick_results):
     assert s["profile_likelihood"] == {}
     for key in ("b_measured_per_s", "b_sim_per_s", "p_measured", "p_measured_stderr", "p_sim"):
         assert math.isfinite(s[key])
+    # the AR(1) criteria of the one model, and the half-record test as a smoke run (air+drag both ways)
+    crit = s["noise_model"]["criteria"]["air+drag"]
+    assert 0.0 < crit["rho"] < 1.0 and crit["k"] == 3 + 2 and s["noise_model"]["ties"]["bic_ar1"] == ["air+drag"]
+    assert s["models"][0]["ar1"]["aic"] == pytest.approx(crit["neg2_log_likelihood"] + 2 * crit["k"])
+    oos = s["out_of_sample"]
+    assert set(oos["directions"]) == {"first_predicts_second", "second_predicts_first"}
+    assert all(math.isfinite(d["scores"]["air+drag"]["ar1_chi2_per_frame"]) for d in oos["directions"].values())
 
 
 def test_a_fit_above_its_nested_model_counts_as_not_converged():

@@ -14,7 +14,7 @@ from .chaos import (
     plot_predictability,
 )
 from .decay import plot_circle_fit, plot_energy_decay
-from .losses import plot_energy_fit, plot_loss_shares, plot_profiles
+from .losses import plot_energy_fit, plot_loss_shares, plot_out_of_sample, plot_profiles
 from .prediction import (
     animate_prediction,
     plot_lower_bob_paths,
@@ -69,5 +69,6 @@ __all__ = [
     "swing",
     "plot_energy_fit",
     "plot_loss_shares",
+    "plot_out_of_sample",
     "plot_profiles",
 ]

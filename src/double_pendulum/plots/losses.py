@@ -89,3 +89,36 @@ def plot_profiles(profile: Mapping[str, Mapping[str, Any]], labels: Mapping[str,
         ax.legend(loc="upper center", fontsize=8)
         ax.grid(alpha=0.3)
     return save(fig, path)
+
+
+def plot_out_of_sample(oos: Mapping[str, Any], titles: Mapping[str, str], path: str | Path) -> Path:
+    """The out-of-sample test (``summary["out_of_sample"]``): per model (named by ``titles``, the best predictor
+    over both directions on top) and direction, left the held-out half's chi2 per frame with the AR(1) noise model
+    (bars) and without it (open circles); right the held-out mean residual simulated - measured [mJ] with its
+    AR(1) standard error."""
+    models = oos["both_directions"]["order"]
+    dirs = list(oos["directions"].items())
+    fig, (ax, ax_m) = plt.subplots(1, 2, figsize=(12, 0.6 * len(models) + 2.2), sharey=True)
+    y = np.arange(len(models))[::-1]
+    h = 0.38
+    for j, (name, d) in enumerate(dirs):
+        s = [d["scores"][m] for m in models]
+        yy = y + (0.5 - j) * h
+        words = name.replace("_predicts_", " half fitted, predicting the ") + " half"
+        ax.barh(yy, [x["ar1_chi2_per_frame"] for x in s], height=h, color=f"C{j}", label=f"{words}: AR(1)")
+        ax.plot([x["chi2_per_frame"] for x in s], yy, "o", mfc="none", color="k", ms=5,
+                label="plain chi2 per frame (no noise model)" if j == 0 else None)
+        ax_m.errorbar([1e3 * x["mean_residual_J"] for x in s], yy, xerr=[1e3 * x["mean_residual_stderr_J"] for x in s],
+                      fmt="o", color=f"C{j}", capsize=3, label=words)  # fmt: skip
+    ax.axvline(1.0, color="0.4", lw=0.8, ls="--")
+    ax_m.axvline(0.0, color="0.4", lw=0.8, ls="--")
+    ax.set_yticks(y, [titles.get(m, m) for m in models])
+    ax.set(xlabel="held-out chi2 per frame [1] (1: as good as the frames' errors)",
+           title="How well each loss model, fitted to one half,\npredicts the other half's energy")  # fmt: skip
+    ax_m.set(xlabel="held-out mean residual, simulated - measured energy [mJ]",
+             title="Bias of the prediction on the held-out half\n(error bars: one standard error, AR(1) noise)")
+    for a in (ax, ax_m):
+        a.grid(alpha=0.3, axis="x")
+    handles, labels = ax.get_legend_handles_labels()
+    legend_below(fig, handles, labels, ncols=2, fontsize=8)
+    return save(fig, path)

@@ -30,7 +30,8 @@ from .comparison import (
     regularisation_effect,
     share_errors,
 )
-from .fitting import fit_models, problem_from_track, run_budget
+from .fitting import SHORT_RUN_BUDGET, fit_models, problem_from_track, run_budget
+from .holdout import holdout_fits, out_of_sample
 from .mechanisms import (
     FULL_MODELS,
     MECHANISMS,
@@ -44,6 +45,7 @@ from .mechanisms import (
     model_values,
     shares,
 )
+from .noise import noise_model_summary
 
 REGULARISED_MODEL = "air+drag"
 """The model whose sensitivity to the friction regularisation the summary reports (``regularisation``): its drag
@@ -187,7 +189,9 @@ def identify_losses(
     every round and the profile. All modes fit the whole record (the first 8 s alone leave the losses
     unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim`` obtains its
     ``air+drag`` by :func:`identified_fit` from the same problem (:func:`problem_from_track` in the same
-    mode: the same start, budget and settings), so it reads this mode's fit."""
+    mode: the same start, budget and settings), so it reads this mode's fit. The AR(1) criteria
+    (:func:`.noise.noise_model_summary`) need no runs; the out-of-sample test (:mod:`.holdout`: every converged
+    model fitted to each half, 12 runs a fit, quick: the quick budget) runs in the thorough and the quick mode only."""
     from ..sweep import parallel_map, worker_pool  # noqa: PLC0415 - process pools only when identifying
 
     rec = seed_reconstruction()
@@ -201,6 +205,15 @@ def identify_losses(
         factor = common_factor(problem)
         rows = comparison_rows(fits, factor)
         best = next(f for f in fits if f.model == rows[0]["model"])
+        noise = noise_model_summary(rows, {f.model: f.residuals for f in fits}, problem.sigma, factor)
+        for r in rows:
+            r["ar1"] = {k: noise["criteria"][r["model"]][k] for k in ("rho", "aic", "bic", "delta_aic", "delta_bic")
+                        } if r["model"] in noise["criteria"] else None  # fmt: skip
+        holdout = None
+        if quick or thorough:  # the default run: +86 % wall time (109 s to 203 s), so thorough (and quick) only
+            ranked = [f for f in fits if next(r for r in rows if r["model"] == f.model)["converged"]]
+            budget = run_budget(quick) or SHORT_RUN_BUDGET
+            holdout = out_of_sample(problem, holdout_fits(problem, ranked, budget, pool, max_workers))
         if thorough:
             items = profile_items(best, factor)
             chi2s, _ = parallel_map(profile_item, items, shared=problem, max_workers=max_workers, label="profile",
@@ -241,6 +254,8 @@ def identify_losses(
         "correlation_factor_from": "the record's residuals about the free-exponent decay law dE/dt = -k E^p "
                                    "(decay.fit.record_correlation_factor), the same F for every model",
         "supported_from_factor": loss_claims.supported_from_factor(rows, factor),
+        "noise_model": noise,
+        "out_of_sample": holdout,
         "residual_halves": halves,
         "goal": goal_checks(numbers, halves),
         "measured_loss_J": loss,
@@ -269,6 +284,9 @@ def identify_losses(
                        "parameter_correlation": "a model that did not converge: no curvature of an optimum",
                        "supported_from_factor": "a model that joins the supported set at no F up to 10",
                        "regularisation": "not measured in the quick run",
+                       "ar1": "models[...].ar1 of a model that did not converge: no likelihood of an optimum",
+                       "out_of_sample": "not run: the half-record test runs with --thorough (and --quick, one model "
+                                        "as a smoke run); it would add about 85 % to the default run's time",
                        "profile_likelihood": "empty: profiled with --thorough only (its intervals matched the "
                                              "curvature errors in the runs so far)"},
         "start_state": {k: problem.base[k] for k in ("phi1_0", "phi2_0", "omega1_0", "omega2_0")},

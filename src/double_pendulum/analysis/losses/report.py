@@ -9,10 +9,12 @@ record, and the answer to the seed's question.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from typing import Any
 
 from ...runs.results_io import report_opening
+from .holdout import holdout_section
 from .mechanisms import model_title
 
 
@@ -174,6 +176,45 @@ def seed_friction_text(s: Mapping[str, Any]) -> str:
             " maker, not their type or seals, so this stays an assumption." + c_r)
 
 
+def noise_section(s: Mapping[str, Any]) -> str:
+    """AIC and BIC with F and with the AR(1) likelihood, side by side for every ranked model, and the ties."""
+    nm = s.get("noise_model")
+    if not nm:
+        return ""
+    lines = ["| model | dAIC (F) | dBIC (F) | rho | dAIC (AR(1)) | dBIC (AR(1)) | innovations' autocorrelation, "
+             "lags 1-3 |", "|---|---|---|---|---|---|---|"]
+    for r in s["models"]:
+        c = nm["criteria"].get(r["model"])
+        if c is None:
+            continue
+        acf = ", ".join(f"{v:+.2f}" for v in c["innovation_autocorrelation"])
+        lines.append(f"| {model_title(r['model'])} | {r['delta_aic']:.1f} | {r['delta_bic']:.1f} | {c['rho']:.2f} "
+                     f"| {c['delta_aic']:.1f} | {c['delta_bic']:.1f} | {acf} |")
+    n = next(iter(nm["criteria"].values()))["n_eff"]
+    return f"""## The noise model: AR(1) residuals, AIC and BIC from its likelihood
+
+The fits' residuals are modelled as an AR(1) process, r_i = rho r_(i-1) + e_i, with rho and the variance fitted to
+each model's residuals; its exact Gaussian likelihood, evaluated at each least-squares optimum, gives AIC =
+-2 ln L + 2 k and BIC = -2 ln L + k ln n_eff (n_eff = n (1 - rho)/(1 + rho) = {n:.0f} frames; k counts the loss
+parameters, kappa, rho and the variance). Beside them the criteria with the common factor F. All four are in-sample.
+
+{chr(10).join(lines)}
+
+{nm['text']} {_whiteness_text(nm, s['n_frames'])}"""
+
+
+def _whiteness_text(nm: Mapping[str, Any], n: int) -> str:
+    """Whether AR(1) whitens the residuals: the innovations' largest autocorrelation against 2/sqrt(n)."""
+    worst = max(abs(v) for c in nm["criteria"].values() for v in c["innovation_autocorrelation"])
+    bound = 2.0 / math.sqrt(n)
+    if worst <= bound:
+        return (f"The innovations e_i are white within 2/sqrt(n) = {bound:.2f} at lags 1 to 3: AR(1) describes the "
+                "residuals' correlation.")
+    return (f"The innovations e_i are not white (autocorrelation up to {worst:.2f} at lags 1 to 3 against "
+            f"2/sqrt(n) = {bound:.2f} for independent frames): AR(1) captures the main correlation, not all of it, "
+            "so its likelihood differences are approximate too.")
+
+
 def _opening(s: Mapping[str, Any]) -> str:
     """Title, plain summary and the words used."""
     title = "Loss identification: which mechanisms drain the seed's pendulum?"
@@ -197,6 +238,13 @@ def _opening(s: Mapping[str, Any]) -> str:
         f"({names}), so the record shows how fast the energy falls but not which losses cause it"
         + (f": air drag's share of the loss can be anything from {air[0]:.0%} to {air[1]:.0%}." if air else "."),
     ]
+    nm = s.get("noise_model")
+    if nm and sorted(nm["ties"]["bic_ar1"]) != sorted(sup["models"]):
+        bic, air_bic = nm["ties"]["bic_ar1"], nm["air_share_range"]["bic_ar1"]
+        sentences.append(f"A stricter criterion that charges more for each fitted number (BIC, with a model of the "
+                         f"correlated noise) keeps {len(bic)} of them ({'; '.join(model_title(m) for m in bic)})"
+                         + (", none with air drag" if air_bic is None else "")
+                         + ": how many candidates tie depends on the criterion, and so does air drag's share.")
     bound = s.get("suspension_as_main_loss")
     if bound:
         sentences.append(f"A damped springy pivot as the main loss, the seed's explanation, fits clearly worse at the "
@@ -281,6 +329,10 @@ neither b nor p). Errors of fitted numbers are multiplied by sqrt(F). {_factor_t
 {s['supported_models']['text']}
 
 {_pair_text(s)}
+
+{noise_section(s)}
+
+{holdout_section(s)}
 
 How plausible the fitted friction is, against the seed's own estimate: {seed_friction_text(s)}
 
