@@ -98,7 +98,7 @@ def plot_out_of_sample(oos: Mapping[str, Any], titles: Mapping[str, str], path: 
     AR(1) standard error."""
     models = oos["both_directions"]["order"]
     dirs = list(oos["directions"].items())
-    fig, (ax, ax_m) = plt.subplots(1, 2, figsize=(12, 0.6 * len(models) + 2.2), sharey=True)
+    fig, (ax, ax_m) = plt.subplots(1, 2, figsize=(12, 0.6 * len(models) + 2.2), sharey=True, layout="constrained")
     y = np.arange(len(models))[::-1]
     h = 0.38
     for j, (name, d) in enumerate(dirs):
