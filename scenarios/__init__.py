@@ -116,8 +116,10 @@ HEADLINES: dict[str, tuple[Headline, ...]] = {
         Headline("start angles from which a rod turns over (flip map)", "flip_map/fraction_flipped*100", unit="%"),
     ),
     "energy_decay": (
-        Headline("decay rate b of the measured energy, E = a exp(b t)", "b_per_s", "error_budget/total_b_per_s",
-                 "1/s"),
+        Headline("decay rate b of the measured energy, E = a exp(b t) (statistical error)", "b_per_s",
+                 "error_budget/b_statement/statistical_per_s", "1/s"),
+        Headline("largest shift of b by the choice of weights, window or energy (a range, apart)",
+                 "error_budget/b_statement/systematic_max_shift_per_s", unit="1/s"),
         Headline("energy a at the release", "a_J", "error_budget/total_a_J", "J"),
         Headline("the seed's decay rate", "seed/b_per_s", unit="1/s"),
     ),

@@ -9,8 +9,12 @@ section 4.2, with the package's own energy function. Outputs in ``results/energy
 - ``circle_fit.png``: the pivot circle fit and the rod-length residuals;
 - ``summary.json``: pivot, rod lengths, the exponential fit ``a_J``, ``b_per_s`` with errors, the
   model comparison (AIC/BIC), the same fit with other weights, the seed's numbers, and the error
-  budget of a and b (``error_budget``: statistical and systematic rows, totals ``total_a_J``,
-  ``total_b_per_s``; :mod:`double_pendulum.analysis.decay.error_budget`);
+  budget of a and b (``error_budget``: statistical and systematic rows, quadrature totals ``total_a_J``,
+  ``total_b_per_s``; :mod:`double_pendulum.analysis.decay.error_budget`), b as it is
+  (``error_budget/b_statement``: the statistical error from an AR(1) noise model and a block bootstrap,
+  ``error_budget/noise_model``; the range over named variants apart; the halves in sigma) and the
+  non-stationarity study (``error_budget/stationarity``: calibration drift, the energy's biases, b in windows
+  against the energy; :mod:`double_pendulum.analysis.decay.stationarity`);
 - ``report.md``: the figures and why they differ from the seed's a = 0.813 J, b = -0.024 1/s.
 
 The runner argument of :func:`run` is not used, nor is ``quick`` (the analysis takes about a second).

@@ -2,21 +2,28 @@ r"""Error budget of the exponential fit E = a exp(b t) of the measured energy (`
 
 The main fit (:mod:`double_pendulum.analysis.decay.summary`): Savitzky-Golay energies of point
 masses, the calibrated errors of :func:`~double_pendulum.analysis.decay.fit.calibrate_error_model`,
-the frames after the hand release. Its statistical error is the fit's, multiplied by
-:math:`\sqrt F` (F the residual-correlation factor, n_eff = n/F). Each systematic row re-does the
-fit with one choice changed and takes the shift of a [J] and b [1/s] from the main fit:
+the frames after the hand release. Its statistical error is the fit's under AR(1) residuals
+(:func:`~double_pendulum.analysis.decay.noise.noise_model`: the sandwich error; a moving-block bootstrap
+and the correlation factor F beside it). Each systematic row re-does the fit with one choice changed and
+takes the shift of a [J] and b [1/s] from the main fit:
 
 - velocity estimator: central differences (the seed's) instead of Savitzky-Golay;
 - weights: the largest shift among the seed's eq. 25 weights, equal weights and the position-noise
   (inverse-variance) weights;
 - first against second half: half the difference of the fits to the two halves of the frames (a
-  taken at t = 0 for both): a decay that is not exactly exponential;
+  taken at t = 0 for both). Each half's fit has its own statistical error (AR(1), about three times the
+  whole record's), so this row holds mostly that noise again; :func:`halves` states the difference in
+  units of its error;
 - rod mass: rigid links :data:`~double_pendulum.model.parameters.SEED_RIGID_LINKS` instead of point
   masses (a bias of the point-mass energy, not a scatter), and half the difference between rods of
   70 +- 30 g a member;
 - pivot: the pivot moved by its circle-fit standard errors in x and y (quadrature of the two shifts).
 
-Total: the quadrature sum of the statistical error and every systematic shift.
+Total: the quadrature sum of the statistical error and every row (``total_a_J``, ``total_b_per_s``). It counts
+the noise twice (the statistical row and the halves' row) and adds shifts of choices as if they were
+independent errors: it is no confidence interval, and ``suspension_transfer`` alone still judges by it. b is
+stated by :func:`b_statement`: the statistical error, and apart from it the range of b over named variants of
+the weighting, the window and the energy (not added in quadrature).
 """
 
 from __future__ import annotations
@@ -36,6 +43,9 @@ from .fit import (
     fit_model,
     record_correlation_factor,
 )
+from .noise import ar1_gls_fit, noise_model
+from .stationarity import stationarity
+from .summary import r1_drift
 
 ROD_MASS_UNCERTAINTY_KG = 0.03
 """Uncertainty of each member's rod mass [kg] (see SEED_RIGID_LINKS)."""
@@ -108,18 +118,114 @@ def _recipe(track: Track, rec: Reconstruction, **kwargs: Any) -> tuple[float, fl
     return _calibrated(other, rec.free_motion & other.energy_valid)
 
 
+HALVES_RESAMPLES = 500
+"""Bootstrap resamples for each half (its error to about 3 % of itself)."""
+TRIM_S = 1.5
+"""Time [s] cut from the start or the end of the record for the window variants of b (one slow swing)."""
+
+
+def _variant_b(rec: Reconstruction, sigma: np.ndarray, gls_b: float, rows: list[dict], b0: float) -> dict[str, dict]:
+    """b [1/s] of the main fit with one choice changed, by group (weighting, window, energy) and name."""
+    m = rec.free_motion
+    t, e = rec.t[m], rec.energy[m]
+
+    def b_of(mask: np.ndarray, s: np.ndarray | None, energy: np.ndarray = e) -> float:
+        return fit_model("exponential", t[mask], energy[mask], None if s is None else s[mask]).value("b")
+
+    every = np.ones(len(t), dtype=bool)
+    shifts = {r["source"]: r["b_shift_per_s"] for r in rows}
+    return {
+        "weighting": {"seed eq. 25": b_of(every, rec.sigma_energy_seed[m]), "equal": b_of(every, None),
+                      "position noise": b_of(every, rec.sigma_energy[m]), "AR(1) GLS": gls_b},
+        "window": {f"first {TRIM_S} s left out": b_of(t >= t[0] + TRIM_S, sigma),
+                   f"last {TRIM_S} s left out": b_of(t <= t[-1] - TRIM_S, sigma)},
+        "energy": {"central differences": b_of(every, sigma, rec.energy_cd[m]),
+                   "rigid links (70 g members)": b0 + shifts["rod mass (point masses vs rigid links)"],
+                   "pivot moved by its errors": b0 + shifts["pivot position"]},
+    }  # fmt: skip
+
+
+def halves(t: np.ndarray, e: np.ndarray, sigma: np.ndarray) -> dict[str, Any]:
+    """The exponential fit to each half of the frames with its AR(1) and block-bootstrap errors [1/s], and their
+    difference in units of its error sqrt(sigma_1^2 + sigma_2^2) for either noise description."""
+    half = len(t) // 2
+    fits = [noise_model(t[s], e[s], sigma[s], n_boot=HALVES_RESAMPLES) for s in (slice(None, half), slice(half, None))]
+    diff = fits[1]["b_per_s"] - fits[0]["b_per_s"]
+    out: dict[str, Any] = {"b_per_s": [f["b_per_s"] for f in fits], "rho": [f["rho"] for f in fits],
+                           "difference_per_s": diff}  # fmt: skip
+    for key in ("ar1", "bootstrap"):
+        errs = [f[key]["b_per_s_stderr"] for f in fits]
+        out[f"b_per_s_stderr_{key}"] = errs
+        out[f"difference_in_sigma_{key}"] = diff / math.hypot(*errs)
+    return out
+
+
+def b_statement(noise: dict[str, Any], variants: dict[str, dict], halves_fit: dict[str, Any], factor: float,
+                fit_error: float) -> dict[str, Any]:  # fmt: skip
+    """b stated as what it is: the main fit's b [1/s] with its statistical error (AR(1) sandwich; the block
+    bootstrap and the correlation factor beside it) and, apart, the range of b over the named variants."""
+    b = noise["b_per_s"]
+    flat = {f"{g}: {k}": v for g, vs in variants.items() for k, v in vs.items()}
+    widest = max(flat, key=lambda k: abs(flat[k] - b))
+    stat = noise["ar1"]["b_per_s_stderr"]
+    lo, hi = min(flat.values()), max(flat.values())
+    h = halves_fit
+    boot = noise["bootstrap"]
+    return {
+        "b_per_s": b,
+        "statistical_per_s": stat,
+        "statistical": {"ar1_per_s": stat, "bootstrap_per_s": noise["bootstrap"]["b_per_s_stderr"],
+                        "correlation_factor_per_s": fit_error * math.sqrt(factor), "rho": noise["rho"],
+                        "block_s": noise["bootstrap"]["block_s"]},  # fmt: skip
+        "systematic_range_per_s": [min(lo, b), max(hi, b)],
+        "systematic_max_shift_per_s": abs(flat[widest] - b),
+        "systematic_widest_variant": widest,
+        "systematic_max_shift_without_seed_weights_per_s": max(abs(v - b) for k, v in flat.items()
+                                                               if k != "weighting: seed eq. 25"),
+        "variants_per_s": variants,
+        "halves": h,
+        "text": (f"b = {b:.4f} +- {stat:.4f} 1/s (statistical: AR(1) residuals, rho = {noise['rho']:.2f}; "
+                 f"a {boot['block_s']:.1f} s block bootstrap gives {boot['b_per_s_stderr']:.5f}); "
+                 f"the weighting, the window and the energy's recipe move it by up to {abs(flat[widest] - b):.4f} "
+                 f"({widest}), over {lo:.4f} to {hi:.4f} 1/s"),  # fmt: skip
+        "definitions": {"statistical_per_s": "standard error of b from the record's scatter alone (AR(1) sandwich)",
+                        "systematic_range_per_s": "smallest and largest b over the named variants and the main fit: "
+                                                  "a range of choices, not an error to add in quadrature"},
+    }  # fmt: skip
+
+
 def error_budget(rec: Reconstruction, sigma: np.ndarray) -> dict[str, Any]:
-    """The whole budget: main a, b, statistical errors, systematic rows, totals, the seed's for comparison.
+    """The whole budget: main a, b, statistical errors, systematic rows, totals, the seed's for comparison;
+    the statement of b (:func:`b_statement`) and the non-stationarity study
+    (:func:`~double_pendulum.analysis.decay.stationarity.stationarity`).
 
     ``sigma`` [J]: the main fit's calibrated errors on ``rec.free_motion``.
     """
     m = rec.free_motion
-    a, b, sa, sb = exp_fit(rec.t[m], rec.energy[m], sigma)
+    t, e = rec.t[m], rec.energy[m]
+    fit = fit_model("exponential", t, e, sigma)
+    a, b = fit.value("a"), fit.value("b")
+    noise = noise_model(t, e, sigma)
+    sa, sb = noise["ar1"]["a_J_stderr"], noise["ar1"]["b_per_s_stderr"]
     rows = [{"source": "statistical (with residual correlation)", "a_J": sa, "b_per_s": sb,
-             "a_shift_J": None, "b_shift_per_s": None, "how": "fit error x sqrt(F)"}]  # fmt: skip
+             "a_shift_J": None, "b_shift_per_s": None,
+             "how": f"AR(1) residuals, rho = {noise['rho']:.2f} (block bootstrap: "
+                    f"{noise['bootstrap']['b_per_s_stderr'] * 1e4:.2f}e-4 1/s)"}]  # fmt: skip
     rows += systematic_rows(rec.track, rec, (a, b), sigma)
     total_a = math.sqrt(sum(r["a_J"] ** 2 for r in rows))
     total_b = math.sqrt(sum(r["b_per_s"] ** 2 for r in rows))
+    halves_fit = halves(t, e, sigma)
+    variants = _variant_b(rec, sigma, ar1_gls_fit(t, e, sigma).b, rows, b)
+    factor = record_correlation_factor(t, e, sigma)
+
+    def recipe(track: Track | None = None, **kwargs: Any) -> tuple[float, float]:
+        """The main fit on another reconstruction, with the main fit's errors where the frames are the same."""
+        other = reconstruct(rec.track if track is None else track, **{"geometry": rec.geometry, **kwargs})
+        frames = m & other.energy_valid
+        if not np.array_equal(frames, m):
+            return _calibrated(other, frames)
+        return exp_fit(t, other.energy[m], sigma)[:2]
+
     return {
         "a_J": a,
         "b_per_s": b,
@@ -130,6 +236,9 @@ def error_budget(rec: Reconstruction, sigma: np.ndarray) -> dict[str, Any]:
         "total_b_per_s": total_b,
         "total_a_relative": total_a / a,
         "total_b_relative": total_b / abs(b),
+        "noise_model": noise,
+        "b_statement": b_statement(noise, variants, halves_fit, factor, fit.error("b")),
+        "stationarity": stationarity(rec, sigma, r1_drift(rec), recipe, (a, b), rows),
         "seed": {"a_J": SEED_FIT["a_J"], "a_relative": SEED_FIT["a_rel_err"], "b_per_s": SEED_FIT["b_per_s"],
                  "b_relative": SEED_FIT["b_rel_err"]},  # fmt: skip
     }
