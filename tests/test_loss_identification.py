@@ -366,3 +366,16 @@ def test_a_wider_friction_regularisation_moves_the_motion_more(synthetic_problem
     angles = [rows[w]["max_angle_difference_rad"] for w in widths]
     assert angles == sorted(angles) and angles[0] < 1e-5 < angles[-1]
     assert all(rows[w]["joint_work_relative_change"] < 0 for w in widths)  # a soft sign function loses less
+
+
+def test_gauss_newton_with_every_parameter_held_evaluates_once():
+    """A one-parameter model's profile point holds its only parameter: nothing to fit, one run (the thorough
+    run's profiles stopped with numpy's "need at least one array to concatenate" there)."""
+    calls = []
+
+    def residuals(x):
+        calls.append(x)
+        return np.array([1.0, -2.0, 0.5])
+
+    x, jac, stop = fitting.gauss_newton(residuals, np.array([]))
+    assert (len(x), jac.shape, stop, len(calls)) == (0, (3, 0), "converged", 1)

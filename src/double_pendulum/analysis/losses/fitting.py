@@ -230,6 +230,8 @@ def gauss_newton(
     """
     x = np.asarray(x0, dtype=float).copy()
     r0 = residuals(x)
+    if not len(x):  # every parameter held (a one-parameter model's profile point): nothing to fit
+        return x, np.zeros((len(r0), 0)), "converged"
     runs = 1
     while True:
         jac = np.column_stack([(residuals(x + DIFF_STEP * e) - r0) / DIFF_STEP for e in np.eye(len(x))])
