@@ -97,7 +97,7 @@ def ar1_correlation_times(x: np.ndarray, rho: float) -> np.ndarray:
     return f + g - x
 
 
-def _prewhiten(z: np.ndarray, rho: float) -> np.ndarray:
+def prewhiten(z: np.ndarray, rho: float) -> np.ndarray:
     """Prais-Winsten prewhitening along the last axis: sqrt(1 - rho^2) z_1, z_i - rho z_(i-1)."""
     out = np.empty_like(z)
     out[..., 0] = math.sqrt(1.0 - rho**2) * z[..., 0]
@@ -130,14 +130,14 @@ def ar1_gls_fit(
     iterations = 0
     for iterations in range(1, max_iterations + 1):  # noqa: B007 (the count is returned)
         r = rho
-        res = least_squares(lambda p, r=r: _prewhiten((e - exponential(t, *p)) / w, r), theta,
-                            jac=lambda p, r=r: -_prewhiten((exponential_jacobian(t, *p) / w[:, None]).T, r).T)
+        res = least_squares(lambda p, r=r: prewhiten((e - exponential(t, *p)) / w, r), theta,
+                            jac=lambda p, r=r: -prewhiten((exponential_jacobian(t, *p) / w[:, None]).T, r).T)
         theta = res.x
         rho = ar1_coefficient((e - exponential(t, *theta)) / w)
         if abs(rho - r) < rtol:
             break
-    white = _prewhiten((e - exponential(t, *theta)) / w, rho)
-    jw = _prewhiten((exponential_jacobian(t, *theta) / w[:, None]).T, rho).T
+    white = prewhiten((e - exponential(t, *theta)) / w, rho)
+    jw = prewhiten((exponential_jacobian(t, *theta) / w[:, None]).T, rho).T
     cov = float(white @ white) / (len(t) - 2) * np.linalg.inv(jw.T @ jw)
     return Ar1Fit(float(theta[0]), float(theta[1]), math.sqrt(cov[0, 0]), math.sqrt(cov[1, 1]), rho, iterations)
 

@@ -47,6 +47,8 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from ..decay.noise import prewhiten
+
 NOISE_PARAMETERS = 2
 """Parameters of the noise model fitted with each loss model: rho and s^2."""
 RHO_BOUND = 0.99
@@ -55,9 +57,8 @@ RHO_BOUND = 0.99
 
 def whitened_chi2(r: np.ndarray, rho: float) -> float:
     """Q(rho) of the module docstring [1]: the AR(1)-whitened sum of squares of the normalised residuals ``r``."""
-    r = np.asarray(r, dtype=float)
-    e = r[1:] - rho * r[:-1]
-    return float(r[0] ** 2 + (e @ e) / (1.0 - rho * rho))
+    white = prewhiten(np.asarray(r, dtype=float), rho)  # Prais-Winsten: |white|^2 = (1 - rho^2) Q
+    return float(white @ white) / (1.0 - rho * rho)
 
 
 def neg2_log_likelihood(r: np.ndarray, rho: float, s2: float | None = None, sigma: np.ndarray | None = None) -> float:
