@@ -98,7 +98,7 @@ def plot_out_of_sample(oos: Mapping[str, Any], titles: Mapping[str, str], path: 
     AR(1) standard error."""
     models = oos["both_directions"]["order"]
     dirs = list(oos["directions"].items())
-    fig, (ax, ax_m) = plt.subplots(1, 2, figsize=(12, 0.6 * len(models) + 2.2), sharey=True, layout="constrained")
+    fig, (ax, ax_m) = plt.subplots(1, 2, figsize=(15, 0.6 * len(models) + 2.4), sharey=True, layout="constrained")
     y = np.arange(len(models))[::-1]
     h = 0.38
     for j, (name, d) in enumerate(dirs):
@@ -113,10 +113,10 @@ def plot_out_of_sample(oos: Mapping[str, Any], titles: Mapping[str, str], path: 
     ax.axvline(1.0, color="0.4", lw=0.8, ls="--")
     ax_m.axvline(0.0, color="0.4", lw=0.8, ls="--")
     ax.set_yticks(y, [titles.get(m, m) for m in models])
-    ax.set(xlabel="held-out chi2 per frame [1] (1: as good as the frames' errors)",
-           title="How well each loss model, fitted to one half,\npredicts the other half's energy")  # fmt: skip
-    ax_m.set(xlabel="held-out mean residual, simulated - measured energy [mJ]",
-             title="Bias of the prediction on the held-out half\n(error bars: one standard error, AR(1) noise)")
+    ax.set(xlabel="held-out chi2 per frame [1]\n(1: as good as the frames' errors)",
+           title="Each loss model fitted to one half:\nhow well it predicts the other half's energy")  # fmt: skip
+    ax_m.set(xlabel="held-out mean residual [mJ]\n(simulated - measured energy)",
+             title="Bias on the held-out half\n(error bars: one standard error, AR(1) noise)")
     for a in (ax, ax_m):
         a.grid(alpha=0.3, axis="x")
     handles, labels = ax.get_legend_handles_labels()

@@ -192,5 +192,5 @@ def shares(result: np.ndarray, model: str) -> dict[str, float]:
 def model_title(model: str) -> str:
     """A model in words: its mechanisms' labels joined by " + " (``air+drag``: "air drag + bearing drag torque"),
     a single one "... alone"."""
-    labels = [m.label for m in mechanisms_of(model)]
+    labels = [m.label + (" per joint" if m.name == "drag2" else "") for m in mechanisms_of(model)]  # not drag's
     return labels[0] + " alone" if len(labels) == 1 else " + ".join(labels)
