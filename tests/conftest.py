@@ -46,6 +46,19 @@ def close_kept_runners() -> Iterator[None]:
 
 
 @pytest.fixture(scope="session")
+def budget() -> dict:
+    """The measured record's error budget of b (``analysis.decay.error_budget``), computed once per process."""
+    from double_pendulum.analysis.decay.error_budget import error_budget
+    from double_pendulum.analysis.decay.fit import calibrate_error_model
+    from double_pendulum.analysis.track.measurement import load_track, reconstruct
+
+    rec = reconstruct(load_track())
+    m = rec.free_motion
+    errors = calibrate_error_model(rec.t[m], rec.energy[m], rec.sigma_energy[m], rec.momentum[m])
+    return error_budget(rec, errors.sigma)
+
+
+@pytest.fixture(scope="session")
 def runner(fmu_path: Path):
     """An fmpy runner for the session's FMU."""
     with FmuRunner(fmu_path) as r:

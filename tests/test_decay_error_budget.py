@@ -6,17 +6,7 @@ import math
 
 import pytest
 
-from double_pendulum.analysis.decay.error_budget import budget_table, error_budget
-from double_pendulum.analysis.decay.fit import calibrate_error_model
-from double_pendulum.analysis.track.measurement import load_track, reconstruct
-
-
-@pytest.fixture(scope="module")
-def budget():
-    rec = reconstruct(load_track())
-    m = rec.free_motion
-    errors = calibrate_error_model(rec.t[m], rec.energy[m], rec.sigma_energy[m], rec.momentum[m])
-    return error_budget(rec, errors.sigma)
+from double_pendulum.analysis.decay.error_budget import budget_table
 
 
 def test_total_is_the_quadrature_sum_and_covers_every_row(budget):

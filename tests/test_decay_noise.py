@@ -9,8 +9,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from double_pendulum.analysis.decay.error_budget import error_budget
-from double_pendulum.analysis.decay.fit import calibrate_error_model
 from double_pendulum.analysis.decay.noise import (
     ar1_coefficient,
     ar1_gls_fit,
@@ -19,7 +17,7 @@ from double_pendulum.analysis.decay.noise import (
     block_length_frames,
     gauss_newton_exponential,
 )
-from double_pendulum.analysis.track.measurement import FPS, load_track, reconstruct
+from double_pendulum.analysis.track.measurement import FPS
 
 A, B = 0.82, -0.0252  # J, 1/s: the record's fit
 RHO, SCALE = 0.55, 0.02  # the record's lag-one autocorrelation and rms energy scatter [J]
@@ -78,14 +76,6 @@ def test_gls_fit_recovers_the_decay_and_rho():
     fit = ar1_gls_fit(T, e, np.full(len(T), SCALE))
     assert fit.rho == pytest.approx(RHO, abs=0.1)
     assert abs(fit.b - B) < 3.0 * fit.sigma_b and abs(fit.a - A) < 3.0 * fit.sigma_a
-
-
-@pytest.fixture(scope="module")
-def budget():
-    rec = reconstruct(load_track())
-    m = rec.free_motion
-    errors = calibrate_error_model(rec.t[m], rec.energy[m], rec.sigma_energy[m], rec.momentum[m])
-    return error_budget(rec, errors.sigma)
 
 
 def test_statement_of_b_separates_statistical_and_systematic_parts(budget):

@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import Any
 
 from .coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, split_values
+from .presets import literal
 
 SYSTEM_NAME = "PendulumOnSuspension"
 PENDULUM, SUSPENSION = "DoublePendulum", "Suspension"
@@ -77,15 +78,6 @@ def _description(macro_step: float, stop_time: float) -> Any:
     )
 
 
-def _literal(value: Any) -> str:
-    """A start value as the literal the modelDescription and container.json hold."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int):  # an Integer
-        return str(value)
-    return value if isinstance(value, str) else repr(float(value))
-
-
 def _expose(md: Any, mappings: dict, component: Any, name: str, start: Any = None) -> None:
     """Add ``<component>.<name>`` to the container, mapped onto the component's variable."""
     from fmpy.model_description import ModelVariable, Unknown
@@ -99,7 +91,7 @@ def _expose(md: Any, mappings: dict, component: Any, name: str, start: Any = Non
         name=f"{component.name}.{name}", type=source.type, description=source.description,
         causality=causality,
         variability="fixed" if is_parameter else "continuous",
-        initial="exact" if is_parameter else None, start=None if start is None else _literal(start),
+        initial="exact" if is_parameter else None, start=None if start is None else literal(start),
     )
     variable.unit = source.unit
     variable.canHandleMultipleSetPerTimeInstant = False

@@ -109,8 +109,8 @@ def presentation_files(model: str, fmi_version: int, files: Mapping[str, bytes],
     root = ET.fromstring(md)
     page_kind = "DoublePendulumFmi3" if (model, fmi_version) == ("DoublePendulum", 3) else model
     plot_values, stop, step, caption = _plot_case(model, fmi_version, root, start_values)
-    starts = _parameter_starts(root) if model == CONTAINER else start_values
-    carried = {**licence_files(model, fmi_version), **reference_result.reference_files(model, md, starts)}
+    # plot_values: the FMU's own start values (the container's: its parameters'), also the reference run's
+    carried = {**licence_files(model, fmi_version), **reference_result.reference_files(model, md, plot_values)}
     page = documentation.index_html(page_kind, md, {**files, **carried}, start_values, caption)
     out = {
         documentation.RESULT_PLOT: doc_plot.result_plot(model, plot_values, stop, step),

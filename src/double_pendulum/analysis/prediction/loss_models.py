@@ -21,7 +21,7 @@ the part of a horizon the energy record cannot pin down.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -48,10 +48,17 @@ def supported_loss_fits(rec: Reconstruction, *, quick: bool = False) -> dict[str
     return {f.model: (f, factor) for f in fits if f.model in supported}
 
 
+def loss_values(model: str, theta: Sequence[float]) -> dict[str, Any]:
+    """FMU start values of the losses of ``model`` at parameters ``theta`` (negative values clipped to 0: a drawn
+    loss, :mod:`.loss_uncertainty`) with the friction regularisation of the fits."""
+    theta = np.clip(np.asarray(theta, dtype=float), 0.0, None)
+    return {**mechanisms.model_values(model, theta), "omega_reg": mechanisms.OMEGA_REG}
+
+
 def supported_loss_values(fits: Mapping[str, tuple[fitting.ModelFit, float]]) -> dict[str, dict[str, Any]]:
-    """FMU start values of the losses of each of ``fits`` (:func:`supported_loss_fits`) at its fitted parameters."""
-    return {model: {**mechanisms.model_values(model, f.theta), "omega_reg": mechanisms.OMEGA_REG}
-            for model, (f, _) in fits.items()}  # fmt: skip
+    """FMU start values of the losses of each of ``fits`` (:func:`supported_loss_fits`) at its fitted parameters
+    (within their bounds, all > 0)."""
+    return {model: loss_values(model, f.theta) for model, (f, _) in fits.items()}
 
 
 def loss_model_predictions(

@@ -39,11 +39,11 @@ import numpy as np
 
 from ...fmu.runner import FmuRunner
 from ...runs.result_cache import cached
-from ..losses import mechanisms
 from ..losses.fitting import ModelFit
 from ..track.measurement import FRAME_INTERVAL, Reconstruction
 from ..track.start_state import StartStateFit, split_geometry
 from .comparison import headline_horizon, predict
+from .loss_models import loss_values
 
 DAMPING_STEP = 0.01
 """Relative change delta of every loss coefficient in :func:`damping_sensitivity` (1 %)."""
@@ -54,13 +54,6 @@ ENSEMBLE_SEED = 20250611
 members move each member outward along the same direction)."""
 PERCENTILES = (16.0, 50.0, 84.0)
 """Percentiles reported of an ensemble's horizons: the 16-84 % range (about +-1 sigma) and the median."""
-
-
-def loss_values(model: str, theta: Sequence[float]) -> dict[str, Any]:
-    """FMU start values of the losses of ``model`` at parameters ``theta`` (negative values clipped to 0) with the
-    friction regularisation of the fits."""
-    theta = np.clip(np.asarray(theta, dtype=float), 0.0, None)
-    return {**mechanisms.model_values(model, theta), "omega_reg": mechanisms.OMEGA_REG}
 
 
 def correlated_draws(mean: np.ndarray, cov: np.ndarray, z: np.ndarray, width: float = 1.0) -> np.ndarray:
