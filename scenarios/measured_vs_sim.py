@@ -3,16 +3,12 @@ r"""Scenario ``measured_vs_sim``: how long does the FMU predict the measured tra
 The seed started its simulation from the state estimated at t0 = 0.8 s and found its bob
 coordinates agreeing with the camera track until about 2 s, i.e. about 1.2 s after t0 (its figs.
 11-14). This scenario does the same through the FMU and goes further. The model is the seed's
-pendulum with its acrylic rods (:data:`~double_pendulum.model.parameters.SEED_RIGID_LINKS`) and the
-losses of air drag with a free factor on rho_air plus a bearing drag torque at both joints, one of the models
-``loss_identification`` finds the measured energy supports equally (within delta AIC 2; the record does not rank
-them), fitted exactly as that scenario's run in the same mode fits it
-(:func:`double_pendulum.analysis.prediction.comparison.identified_losses`: default, warm-started from the
-one-mechanism fits; quick, from the reference values; the whole record in both: the first 8 s alone leave the two
-losses unidentified). The fits are cached, so after ``loss_identification`` they are read, not repeated (and the
-other way round). The main start then runs with every other supported model as well
-(:mod:`double_pendulum.analysis.prediction.loss_models`, ``loss_model_sensitivity``): the spread of its horizons
-is what the energy record cannot pin down. The runs:
+pendulum with its acrylic rods (:data:`~double_pendulum.model.parameters.SEED_RIGID_LINKS`) and air drag plus a
+bearing drag torque, one of the models ``loss_identification`` finds the measured energy supports equally,
+fitted as that scenario fits it (:func:`double_pendulum.analysis.prediction.comparison.identified_losses`; the
+fits are cached, so either scenario reads the other's). The main start then runs with every other supported model
+as well (:mod:`double_pendulum.analysis.prediction.loss_models`): the spread of its horizons is what the energy
+record cannot pin down. The runs:
 
 - **seed start**: angles and rates of the frame nearest t0 from the measurement reconstruction
   (angles from the positions, rates from the Savitzky-Golay derivative), run frictionless with point
@@ -28,14 +24,11 @@ is what the energy record cannot pin down. The runs:
   (:data:`~double_pendulum.analysis.prediction.comparison.PIVOT_SHIFT_GEOMETRY`), the alternative the rotation
   trades off against.
 
-The losses are fitted to the same record the predictions are compared with: every horizon here is in-sample.
-At the measured energy the motion is regular (below the lower rod's flip energy), so a horizon measures how
+The losses are fitted to the same record the predictions are compared with: every horizon here is in-sample
+(``thorough`` adds an out-of-sample test). At the measured energy the motion is regular, so a horizon measures how
 well the model's frequencies and damping match the pendulum's, not predictability. A horizon that reaches the
-end of the record is censored (``horizon_5cm_censored``): it is only known to exceed the record.
-
-Positions are compared relative to the pivot fitted by the measurement (circle fit of the upper
-bob); the FMU's origin is the pivot at rest; where geometry is fitted, its positions are turned by the
-fitted rotation about the pivot and shifted by the fitted pivot offset.
+end of the record is censored (``horizon_5cm_censored``). Positions are compared relative to the measurement's
+circle-fit pivot, the FMU's turned and shifted by the fitted geometry where it is fitted.
 
 Prediction horizon: the first time after t0 at which the position error |r_sim - r_track| [m]
 exceeds 2 cm and 5 cm, for the lower bob and for both bobs (the larger of the two errors), on the
@@ -52,15 +45,15 @@ thorough: :data:`THOROUGH_LYAPUNOV_S` s) against the energy the lower rod needs 
 
 Cost: about 29 s of CPU by default once ``loss_identification`` has cached its fits (about 130 s on a first
 run that fits every model itself, plus about 6 s for the damping runs until they are cached). ``thorough`` adds
-the loss ensemble (60 runs, about 40 s, cached) and the fit-window check (the start and geometry fitted again to
-the first :data:`WINDOW_SENSITIVITY` frames, about 35 s of CPU) and averages the Lyapunov exponent over
-:data:`THOROUGH_LYAPUNOV_S` s (5 s more). ``quick``: a 3 s prediction, the geometry fitted to
-:data:`QUICK_GEOMETRY_FIT_FRAMES` frames, :data:`QUICK_ENSEMBLE_SIZE` ensemble runs, a 10 s Lyapunov exponent.
+the loss ensemble (60 runs, about 40 s, cached), the fit-window check (:data:`WINDOW_SENSITIVITY`, about 35 s),
+the out-of-sample test of the motion (each supported model fitted to one half of the energy record predicts the
+other half's motion, :mod:`double_pendulum.analysis.prediction.out_of_sample`: ten runs, with the half fits read
+from ``loss_identification --thorough``'s cache) and a :data:`THOROUGH_LYAPUNOV_S` s Lyapunov exponent.
+``quick``: a 3 s prediction, the geometry fitted to :data:`QUICK_GEOMETRY_FIT_FRAMES` frames.
 
-Outputs in ``results/measured_vs_sim/``: a CSV per run (FMU outputs from t0), ``errors.csv`` (per frame),
-``coordinates.png`` (the seed's figs. 11-14), ``prediction_error.png``, ``paths.csv`` (measured and main run's bob
-positions per frame) and drawn from it ``lower_bob_paths.png`` (the x-y overlay) and ``measured_vs_sim.gif`` (real
-time), ``summary.json`` and ``report.md``.
+Outputs in ``results/measured_vs_sim/``: a CSV per run, ``errors.csv`` (per frame), ``coordinates.png`` (the
+seed's figs. 11-14), ``prediction_error.png``, ``paths.csv`` and drawn from it ``lower_bob_paths.png`` and
+``measured_vs_sim.gif``, with ``thorough`` ``out_of_sample_motion.png``, ``summary.json`` and ``report.md``.
 """
 
 from __future__ import annotations
@@ -73,6 +66,7 @@ import numpy as np
 
 from double_pendulum import plots
 from double_pendulum.analysis.losses.identification import seed_reconstruction
+from double_pendulum.analysis.losses.mechanisms import model_title
 from double_pendulum.analysis.prediction.comparison import (
     SMOOTHING_S,
     THRESHOLDS_M,
@@ -107,6 +101,7 @@ from double_pendulum.analysis.prediction.loss_models import (
 )
 from double_pendulum.analysis.prediction.loss_uncertainty import ENSEMBLE_SIZE as LOSS_ENSEMBLE_SIZE
 from double_pendulum.analysis.prediction.loss_uncertainty import loss_uncertainty
+from double_pendulum.analysis.prediction.out_of_sample import motion_test
 from double_pendulum.analysis.prediction.paths import PATHS_UNITS, paths_table
 from double_pendulum.analysis.prediction.report import report_text
 from double_pendulum.analysis.prediction.runs import fitted_starts, starts_summary
@@ -239,6 +234,11 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     if thorough:
         summary["fit_window_sensitivity"] = window_sensitivity(runner, rec, i0, values, n_frames,
                                                                WINDOW_SENSITIVITY, warm=geo)
+        summary["out_of_sample_motion"], curves = motion_test(runner, rec, i0, n_frames, losses.pendulum, geo, by_model,
+                                                              summary["track_rod_length_floor"]["rms_m"])
+        plots.plot_out_of_sample_motion(curves, summary["out_of_sample_motion"]["split_after_t0_s"], THRESHOLDS_M[-1],
+                                        SMOOTHING_S, out_dir / "out_of_sample_motion.png", titles=model_title,
+                                        whole=smoothed_error_band(by_model))  # fmt: skip
     for p in predictions:
         write_results_csv(out_dir / f"{p.label}.csv", p.result, runner.units)
     write_results_csv(out_dir / "errors.csv", errors_table(rec, i0, n_frames, predictions), errors_units(predictions))

@@ -28,7 +28,7 @@ def test_every_scenario_has_an_expected_cost_and_the_longest_start_first():
     assert sorted(order) == sorted(SCENARIOS)
 
 
-def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_small_ones_a_few_the_largest_first():
+def test_a_default_run_gives_each_scenario_a_child_the_small_ones_a_few_the_largest_first():
     groups = scenario_pool.scenario_groups(SCENARIOS, COSTS, quick=False, jobs=2)
     order = scenario_pool.longest_first(SCENARIOS, COSTS)
     small = [name for name in order if EXPECTED_CPU_S[name] < scenario_pool.SMALL_SCENARIO_CPU_S]
@@ -41,6 +41,17 @@ def test_a_default_or_thorough_run_gives_each_scenario_a_child_the_small_ones_a_
     assert len(shared) < len(small)  # they do share
     totals = [sum(EXPECTED_CPU_S[name] for name in group) for group in groups]
     assert totals == sorted(totals, reverse=True)
+
+
+def test_a_thorough_run_keeps_a_scenario_that_reads_cached_fits_after_the_one_that_writes_them():
+    thorough = scenario_pool.scenario_groups(SCENARIOS, COSTS, quick=False, jobs=2, thorough=True)
+    host = next(group for group in thorough if "loss_identification" in group)
+    assert host == ["loss_identification", "measured_vs_sim"]  # the half fits of the motion test, from the cache
+    assert thorough[0] == host  # the longest chain starts first
+    assert sorted(n for g in thorough for n in g) == sorted(SCENARIOS)
+    costs = Costs({"writer": 100.0, "reader": 5.0, "a": 50.0}, {}, {"reader": "writer", "absent": "gone"})
+    assert scenario_pool.scenario_groups(["reader", "a"], costs, quick=False, jobs=2, thorough=True) == [
+        ["a"], ["reader"]]  # the writer not in this run: the reader runs as in a default run
 
 
 def test_default_run_groups_sort_by_their_sum_and_keep_the_packing_order():
@@ -132,8 +143,10 @@ def test_children_count_progress_in_plain_lines_unless_it_is_off(monkeypatch, pa
 def test_children_run_their_sweeps_on_one_worker_unless_the_user_chose_a_number(monkeypatch):
     monkeypatch.delenv(WORKERS_ENV, raising=False)
     assert scenario_pool.child_environment()[WORKERS_ENV] == "1"
-    monkeypatch.setenv(WORKERS_ENV, "2")
-    assert scenario_pool.child_environment()[WORKERS_ENV] == "2"
+    assert scenario_pool.child_environment(2)[WORKERS_ENV] == "2"  # fewer children than cores
+    monkeypatch.setenv(WORKERS_ENV, "3")
+    assert scenario_pool.child_environment()[WORKERS_ENV] == "3"
+    assert scenario_pool.child_environment(2)[WORKERS_ENV] == "3"
 
 
 def test_lines_of_a_group_child_are_marked_with_the_scenario_running_in_it():

@@ -356,8 +356,9 @@ def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path
         print(f"running {len(names)} scenarios in {jobs} processes, each running its share one after another",
               flush=True)
     else:
-        print(f"running {len(names)} scenarios, {jobs} at a time in their own processes, the longest first",
-              flush=True)
+        after = [f"{r} after {w}" for r, w in READS_FITS_OF.items() if args.thorough and {r, w} <= set(names)]
+        print(f"running {len(names)} scenarios, {jobs} at a time in their own processes, the longest first"
+              + (f" ({', '.join(after)} in one process: it reads its cached fits)" if after else ""), flush=True)
     costs = Costs(EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF)
     return run_in_children(names, out, Path(args.fmu), costs, quick=args.quick, thorough=args.thorough, jobs=jobs)
 

@@ -18,6 +18,7 @@ from .losses import plot_energy_fit, plot_loss_shares, plot_out_of_sample, plot_
 from .prediction import (
     animate_prediction,
     plot_lower_bob_paths,
+    plot_out_of_sample_motion,
     plot_prediction_errors,
     plot_track_comparison,
     run_colours,
@@ -70,5 +71,6 @@ __all__ = [
     "plot_energy_fit",
     "plot_loss_shares",
     "plot_out_of_sample",
+    "plot_out_of_sample_motion",
     "plot_profiles",
 ]

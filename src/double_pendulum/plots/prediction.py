@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 from .animation import animate_swings, swing
-from .style import legend_below, save
+from .style import legend_below, plain_log_numbers, save
 
 ERROR_FLOOR_M = 1e-5
 """Errors [m] below this are drawn at it (the log axis has no zero)."""
@@ -143,3 +143,46 @@ def animate_prediction(paths: np.ndarray, path: str | Path, *, colour: str = "C0
               swing(paths, "FMU", colour, suffix="_simulated", pivot=pivot)]
     title = f"measured (camera) and simulated (FMU) pendulum from t0 = {float(paths['time'][0]):.2f} s"
     return animate_swings(paths["t_since_t0"], swings, path, title=title, time_label="t - t0")
+
+
+def plot_out_of_sample_motion(
+    curves: Mapping[str, Mapping[str, tuple[np.ndarray, np.ndarray]]],
+    split_s: float,
+    threshold: float,
+    smoothing_s: float,
+    path: str | Path,
+    *,
+    titles: Callable[[str], str] = str,
+    whole: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+) -> Path:
+    """The lower bob's position error [cm], smoothed over ``smoothing_s`` [s], over time since t0 [s] with each loss
+    model's losses fitted to one half of the energy record (``curves``: half fitted to -> model -> (t, error [m]);
+    one panel per half, a colour and line style per model named by ``titles(model)``, so that models ending at the same
+    losses show as overlapping lines), the held-out half shaded, the split ``split_s`` [s after t0], the
+    ``threshold`` [m] and, as a grey band, the lowest and highest error of the whole-record fits (``whole``: t,
+    low, high [m])."""
+    styles = (("-", 2.4), ("--", 1.7), (":", 1.9), ("-.", 1.4), ((0, (5, 1, 1, 1)), 1.2))
+    floor_cm = 100 * ERROR_FLOOR_M
+    halves = list(curves)
+    fig, axes = plt.subplots(1, len(halves), figsize=(15, 5.4), sharey=True, squeeze=False, layout="constrained")
+    for ax, half in zip(axes[0], halves):
+        t_end = max(float(t[-1]) for t, _ in curves[half].values())
+        lo, hi = (split_s, t_end) if half == "first" else (0.0, split_s)
+        ax.axvspan(lo, hi, color="tab:orange", alpha=0.08, lw=0, label="held-out half (the loss fit never saw it)")
+        if whole is not None:
+            ax.fill_between(whole[0], np.maximum(100 * whole[1], floor_cm), np.maximum(100 * whole[2], floor_cm),
+                            color="0.6", alpha=0.35, lw=0, label="range of the same models fitted to the whole record")
+        for i, (model, (t, err)) in enumerate(curves[half].items()):
+            ls, lw = styles[i % len(styles)]
+            ax.semilogy(t, np.maximum(100 * err, floor_cm), ls=ls, lw=lw, color=f"C{i}",
+                        label=f"fitted to one half: {titles(model)}")
+        ax.axvline(split_s, color="0.3", lw=0.9, ls=":", label=f"split of the record ({split_s:.1f} s after t0)")
+        ax.axhline(100 * threshold, color="k", lw=0.9, ls="--", label=f"threshold {100 * threshold:g} cm")
+        other = "second" if half == "first" else "first"
+        ax.set(xlabel="time since the start t - t0 [s]",
+               title=f"losses fitted to the {half} half of the energy record,\npredicting the {other} half's motion")
+        ax.grid(alpha=0.3, which="both")
+        plain_log_numbers(ax)
+    axes[0, 0].set_ylabel(f"position error of the lower bob [cm]\n(moving median over {smoothing_s:g} s)")
+    legend_below(fig, *axes[0, 0].get_legend_handles_labels(), ncols=3, fontsize=8)
+    return save(fig, path)

@@ -138,16 +138,23 @@ def pack_small(names: Sequence[str], costs: Costs, cap: float = SMALL_GROUP_CPU_
     return groups
 
 
-def scenario_groups(names: Sequence[str], costs: Costs, *, quick: bool, jobs: int) -> list[list[str]]:
+def scenario_groups(names: Sequence[str], costs: Costs, *, quick: bool, jobs: int,
+                    thorough: bool = False) -> list[list[str]]:  # fmt: skip
     """The scenarios each child runs, in the order the children start: in a quick run ``jobs``
     balanced groups (:func:`balanced_groups`), otherwise one scenario per child, except that those
     under :data:`SMALL_SCENARIO_CPU_S` share children of at most :data:`SMALL_GROUP_CPU_S`
-    (:func:`pack_small`); the children with the most expected CPU time first."""
+    (:func:`pack_small`); the children with the most expected CPU time first. ``thorough``: a scenario
+    reading another's cached fits (:attr:`Costs.reads_fits_of`) runs after that one in its child, as in a quick
+    run (``measured_vs_sim --thorough`` predicts the motion with ``loss_identification --thorough``'s half
+    fits, which it would otherwise fit again, one after another)."""
     if quick:
         return balanced_groups(names, jobs, costs)
     order = longest_first(names, costs)
-    small = [name for name in order if costs.cpu_s(name, quick=False) < SMALL_SCENARIO_CPU_S]
-    groups = [[name] for name in order if name not in small] + pack_small(small, costs)
+    readers = {r: w for r, w in costs.reads_fits_of.items() if thorough and r in order and w in order}
+    small = [name for name in order if costs.cpu_s(name, quick=False) < SMALL_SCENARIO_CPU_S and name not in readers]
+    groups = [[name] for name in order if name not in small and name not in readers] + pack_small(small, costs)
+    for reader, writer in readers.items():
+        next(group for group in groups if writer in group).append(reader)
     return sorted(groups, key=lambda group: -sum(costs.cpu_s(name, quick=False) for name in group))
 
 
@@ -164,15 +171,16 @@ def child_command(names: Sequence[str], indices: Sequence[str], out: Path, fmu: 
     return command
 
 
-def child_environment() -> dict[str, str]:
+def child_environment(workers: int = 1) -> dict[str, str]:
     """The parent's environment, with progress as plain lines (unless switched off), unbuffered output and
-    one worker process per child (unless ``$DOUBLE_PENDULUM_WORKERS`` is set): the children already run
-    one per core, and a pool of spawned workers costs each sweep some seconds of imports."""
+    ``workers`` worker processes per child (unless ``$DOUBLE_PENDULUM_WORKERS`` is set): one when the children
+    already run one per core (a pool of spawned workers costs each sweep some seconds of imports), more when
+    there are fewer children than cores."""
     env = dict(os.environ)
     if env.get(PROGRESS_ENV, "").strip().lower() != "off":
         env[PROGRESS_ENV] = "lines"
     env["PYTHONUNBUFFERED"] = "1"
-    env.setdefault(WORKERS_ENV, "1")
+    env.setdefault(WORKERS_ENV, str(workers))
     return env
 
 
@@ -241,11 +249,13 @@ def _relay(child: Child, stream: IO[str], target: Callable[[], IO[str]], lock: t
 
 
 def start_child(names: Sequence[str], command: list[str], lock: threading.Lock,
-                reported: Callable[[str], None], number: Callable[[], str] | None = None) -> Child:  # fmt: skip
-    """Start a child running the scenarios ``names`` and the threads that relay its stdout and stderr
-    (``number``: the "k/N" of the next scenario to start in the run, for its header line)."""
+                reported: Callable[[str], None], number: Callable[[], str] | None = None,
+                workers: int = 1) -> Child:  # fmt: skip
+    """Start a child running the scenarios ``names`` with ``workers`` worker processes (:func:`child_environment`)
+    and the threads that relay its stdout and stderr (``number``: the "k/N" of the next scenario to start in the
+    run, for its header line)."""
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, bufsize=1,
-                               env=child_environment())  # fmt: skip
+                               env=child_environment(workers))  # fmt: skip
     child = Child(tuple(names), process, current=names[0], number=number)
     for stream, target in ((process.stdout, lambda: sys.stdout), (process.stderr, lambda: sys.stderr)):
         thread = threading.Thread(target=_relay, args=(child, stream, target, lock, reported), daemon=True)
@@ -310,8 +320,9 @@ def run_in_children(
     KeyboardInterrupt once they have cleaned up."""
     weight = {name: max(1, round(costs.cpu_s(name, quick))) for name in names}
     lock = threading.Lock()
-    waiting, running, failed = scenario_groups(names, costs, quick=quick, jobs=jobs), [], []
+    waiting, running, failed = scenario_groups(names, costs, quick=quick, jobs=jobs, thorough=thorough), [], []
     order = [name for group in waiting for name in group]  # the children's own "k/N": until their header is seen
+    workers = max(1, jobs // max(1, len(waiting)))  # fewer children than cores: the spare cores to their sweeps
     starts = itertools.count(1)
     done: set[str] = set()  # scenarios whose whole share the bar holds
 
@@ -329,7 +340,7 @@ def run_in_children(
                     group = waiting.pop(0)
                     indices = [f"{order.index(n) + 1}/{len(names)}" for n in group]
                     command = child_command(group, indices, out, fmu, quick, thorough)
-                    running.append(start_child(group, command, lock, reported, number))
+                    running.append(start_child(group, command, lock, reported, number, workers))
                 _pause(POLL_S)
                 for child in [c for c in running if c.process.poll() is not None]:
                     running.remove(child)

@@ -30,8 +30,8 @@ from .comparison import (
     regularisation_effect,
     share_errors,
 )
-from .fitting import SHORT_RUN_BUDGET, fit_models, problem_from_track, run_budget
-from .holdout import holdout_fits, out_of_sample
+from .fitting import SHORT_RUN_BUDGET, FitProblem, ModelFit, fit_models, problem_from_track, run_budget
+from .holdout import HoldoutFit, holdout_fits, out_of_sample
 from .mechanisms import (
     FULL_MODELS,
     MECHANISMS,
@@ -50,6 +50,25 @@ from .noise import noise_model_summary
 REGULARISED_MODEL = "air+drag"
 """The model whose sensitivity to the friction regularisation the summary reports (``regularisation``): its drag
 torque is the regularised law measured_vs_sim uses (viscous damping has no sign function to regularise)."""
+
+
+def half_fits(problem: FitProblem, fits: Sequence[ModelFit], rows: Sequence[Mapping[str, Any]], quick: bool,
+              pool: Any = None, max_workers: int | None = None) -> list[HoldoutFit]:
+    """The out-of-sample test's fits (:func:`.holdout.holdout_fits`): every converged model of ``fits`` (``rows``:
+    their :func:`.comparison.comparison_rows`) fitted to each half, with the mode's run budget (quick: the quick
+    one, else :data:`.fitting.SHORT_RUN_BUDGET`)."""
+    converged = {r["model"] for r in rows if r["converged"]}
+    ranked = [f for f in fits if f.model in converged]
+    return holdout_fits(problem, ranked, run_budget(quick) or SHORT_RUN_BUDGET, pool, max_workers)
+
+
+def thorough_half_fits(rec: Reconstruction) -> tuple[FitProblem, list[HoldoutFit]]:
+    """The fit problem of ``rec`` and its half fits exactly as :func:`identify_losses` obtains them with
+    ``thorough`` (the same models, starts and budgets, in this process), so after that run they are read from the
+    cache (``measured_vs_sim --thorough`` predicts the motion with them)."""
+    problem = problem_from_track(rec, measured(rec))
+    fits, _ = fit_models(THOROUGH_MODELS, problem, max_workers=1, short=False, max_runs=run_budget(False))
+    return problem, half_fits(problem, fits, comparison_rows(fits, common_factor(problem)), False, max_workers=1)
 
 
 def measured_loss(md: MeasuredDecay) -> float:
@@ -211,9 +230,7 @@ def identify_losses(
                         } if r["model"] in noise["criteria"] else None  # fmt: skip
         holdout = None
         if quick or thorough:  # the default run: +86 % wall time (109 s to 203 s), so thorough (and quick) only
-            ranked = [f for f in fits if next(r for r in rows if r["model"] == f.model)["converged"]]
-            budget = run_budget(quick) or SHORT_RUN_BUDGET
-            holdout = out_of_sample(problem, holdout_fits(problem, ranked, budget, pool, max_workers))
+            holdout = out_of_sample(problem, half_fits(problem, fits, rows, quick, pool, max_workers))
         if thorough:
             items = profile_items(best, factor)
             chi2s, _ = parallel_map(profile_item, items, shared=problem, max_workers=max_workers, label="profile",

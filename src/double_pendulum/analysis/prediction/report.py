@@ -226,6 +226,40 @@ def loss_uncertainty_text(s: Mapping[str, Any]) -> str:
     return text + f" Drawn from the losses' and the start's covariance ({u['ensemble_definition']}): {ens}."
 
 
+def _short_horizon(score: Mapping[str, Any]) -> str:
+    """'12.34 s', or '> 19.99 s' for a censored horizon (never crossed in the record)."""
+    return f"{'> ' if score['horizon_5cm_censored'] else ''}{score['horizon_5cm_s']:.2f} s"
+
+
+def motion_out_of_sample_text(s: Mapping[str, Any]) -> str:
+    """The out-of-sample test of the motion (``--thorough``): per direction a table of every model's held-out RMS
+    error, median smoothed error and horizon, half-fitted against whole-record-fitted, and what it says."""
+    o = s.get("out_of_sample_motion")
+    if not o:
+        return ("**Out of sample.** Every horizon above is in-sample. The test that fits each loss model to one half "
+                "of the energy record and predicts the other half's motion runs with ``--thorough``.")
+    span = s["prediction_s"]
+    tables = []
+    for name, d in o["directions"].items():
+        fitted, predicts = name.split("_predicts_")
+        rows = []
+        for m in d["order"]:
+            x, w = d["scores"][m], d["whole_record_scores"][m]
+            tie = " (tie)" if m in d["tie"] else ""
+            rows.append(f"| {model_title(m)}{tie} | {100 * x['rms_error_m']:.1f} ({100 * w['rms_error_m']:.1f}) | "
+                        f"{100 * x['median_smoothed_error_m']:.1f} ({100 * w['median_smoothed_error_m']:.1f}) | "
+                        f"{_short_horizon(x)} ({_short_horizon(w)}) |")
+        tables.append(f"Losses fitted to the {fitted} half, scored on the {predicts} half "
+                      f"({next(iter(d['scores'].values()))['n_frames']} frames); in brackets the same model fitted to "
+                      "the whole record (in-sample):\n\n| loss model | RMS error of the lower bob [cm] | median "
+                      "smoothed error [cm] | 5 cm horizon, smoothed |\n|---|---|---|---|\n" + "\n".join(rows))
+    return (f"**Out of sample: the motion.** Each supported loss model fitted to one half of the energy record alone "
+            f"(the split {o['split_after_t0_s']:.1f} s after t0, the energy test's), the main start run with it "
+            f"through the FMU for the whole {span:.1f} s, the lower bob compared on the half the fit never saw "
+            "(``out_of_sample_motion.png``).\n\n" + "\n\n".join(tables) + f"\n\n{o['text']}\n\n"
+            "![out of sample: the motion](out_of_sample_motion.png)")
+
+
 def _stats_text(stats: Mapping[str, Any]) -> str:
     """'median 13.3 s (16-84 %: 9.5 s to beyond the record)' of :func:`~.loss_uncertainty.horizon_stats`."""
     med = "beyond the record" if stats["median_censored"] else f"{stats['median_s']:.1f} s"
@@ -370,6 +404,8 @@ censored):
 {loss_models_text(s)}
 
 {loss_uncertainty_text(s)}
+
+{motion_out_of_sample_text(s)}
 
 **Goal**: {goal["statement"]}. Held {reached}, **{"met" if goal["met"] else "not met"}** (in-sample).
 The seed saw agreement until about 2 s, i.e. about {2.0 - s["t0_s"]:.1f} s after t0, by eye.
