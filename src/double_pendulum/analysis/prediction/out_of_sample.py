@@ -150,9 +150,9 @@ def motion_text(out: Mapping[str, Any]) -> str:
         parts.append(f"Losses fitted to the {name.replace('_predicts_', ' half, predicting the ')} half's motion: "
                      f"lowest RMS error of the lower bob {best}; {len(worse)} of {len(s)} models predict it worse "
                      "than their whole-record fit does." + contrast
-                     + (f" {', '.join(same)} fit{'s' if len(same) == 1 else ''} that half at the whole record's "
-                        "losses (the half's optimum lies within the fit's step tolerance of it), so their "
-                        "prediction is the in-sample one." if same else ""))
+                     + (f" Fitted to that half, {' and '.join(same)} land{'s' if len(same) == 1 else ''} at the "
+                        "whole record's losses (the half's optimum lies within the fit's step tolerance of it), so "
+                        f"{'its' if len(same) == 1 else 'their'} prediction is the in-sample one." if same else ""))
     return " ".join(parts) + (f" Ties: within {100 * out['tie_within_m']:.2f} cm, the track's own rod-length RMS; the "
                               "start is fitted to the first 1.5 s in both directions.")
 
