@@ -3,11 +3,10 @@ student understands, every number from the summary it is written into."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any
+from .summary_types import ChaosSummary
 
 
-def in_short(summary: Mapping[str, Any]) -> str:
+def in_short(summary: ChaosSummary) -> str:
     """What was run, what was found, how sure, from the ``chaos`` scenario's ``summary``."""
     lyap, runs, pred, flip = summary["lyapunov"], summary["fmu_runs"], summary["predictability"], summary["flip_map"]
     mm = 1000 * summary["start_uncertainty_m"]

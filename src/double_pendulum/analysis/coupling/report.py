@@ -7,13 +7,14 @@ from typing import Any
 
 from ...runs.results_io import report_opening
 from .stability import __doc__ as DERIVATION
+from .summary_types import CouplingSummary
 
 
 def _fmt(value: float) -> str:
     return "-" if value is None or (isinstance(value, float) and not math.isfinite(value)) else f"{value:.3g}"
 
 
-def _orders_table(summary: dict[str, Any]) -> list[str]:
+def _orders_table(summary: CouplingSummary) -> list[str]:
     """Fitted orders per case and method; an order whose errors follow no power of h is marked "(no order)"."""
     unresolved = summary["orders_unresolved"]
 
@@ -28,7 +29,7 @@ def _orders_table(summary: dict[str, Any]) -> list[str]:
     return lines
 
 
-def _order_note(summary: dict[str, Any]) -> list[str]:
+def _order_note(summary: CouplingSummary) -> list[str]:
     """What the orders mean: the iterative scheme's order is the angles'; the range of its other slopes."""
     iterative = [k for k in summary["order_angles"] if k.endswith("/ iterative")]
     angles = [summary["order_angles"][k] for k in iterative if summary["order_angles"][k] is not None]
@@ -47,7 +48,7 @@ def _order_note(summary: dict[str, Any]) -> list[str]:
     return [text]
 
 
-def _damping_lines(summary: dict[str, Any]) -> list[str]:
+def _damping_lines(summary: CouplingSummary) -> list[str]:
     """The derived limit at other damping ratios (``derived_limit_by_damping``), where the map has none."""
     lines = []
     for scheme, st in summary["stability"].items():
@@ -65,7 +66,7 @@ def _damping_lines(summary: dict[str, Any]) -> list[str]:
     return [*lines, ""] if lines else []
 
 
-def _opening(summary: dict[str, Any]) -> str:
+def _opening(summary: CouplingSummary) -> str:
     """Title, plain summary and the words used."""
     cheapest = summary["cheapest_to_1e-4_rad"]
     methods = sorted({b["method"] for b in cheapest.values()})
@@ -100,7 +101,7 @@ def _opening(summary: dict[str, Any]) -> str:
     })
 
 
-def _run_kind(summary: dict[str, Any]) -> str:
+def _run_kind(summary: CouplingSummary) -> str:
     """Which run this is, in words."""
     if summary["quick"]:
         return ("This is a quick run: a smoke test with a short stop time and few step sizes, whose numbers are not"
@@ -119,7 +120,7 @@ def _remedy_table(rows: list[dict[str, Any]]) -> list[str]:
     return lines
 
 
-def report_text(summary: dict[str, Any], rows: list[dict[str, Any]]) -> str:
+def report_text(summary: CouplingSummary, rows: list[dict[str, Any]]) -> str:
     """Markdown report of one run of the scenario."""
     limit = ["| scheme | h omega | derived mu_c | measured mu_c (between the last stable and the first unstable run) |",
              "|---|---|---|---|"]

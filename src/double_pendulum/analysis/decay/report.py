@@ -14,6 +14,7 @@ from ...runs.results_io import report_opening
 from ..track.measurement import FPS, SEED_TOTAL_MASS_KG, SG_POLYORDER, SG_WINDOW
 from .error_budget import budget_table
 from .fit import AUTOCORRELATION_LAG_S
+from .summary_types import DecaySummary
 
 
 def plus_minus(value: float, err: float, scale: float = 1.0, digits: int = 4) -> str:
@@ -21,7 +22,7 @@ def plus_minus(value: float, err: float, scale: float = 1.0, digits: int = 4) ->
     return f"{value * scale:.{digits}f} +- {err * scale:.{digits}f}"
 
 
-def comparison_rows(summary: dict[str, Any]) -> str:
+def comparison_rows(summary: DecaySummary) -> str:
     """Markdown table of the decay models: parameters with errors, chi2_red, dAIC, dBIC, Akaike weight."""
     lines = ["| model | parameters | chi2_red | dAIC | dBIC | Akaike weight |", "|---|---|---|---|---|---|"]
     for row in summary["model_comparison"]:
@@ -37,7 +38,7 @@ def comparison_rows(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def variant_rows(summary: dict[str, Any]) -> str:
+def variant_rows(summary: DecaySummary) -> str:
     """Markdown table of the exponential fit a [J], b [1/s] (errors inflated for correlation) per energy, weights."""
     labels = {
         "equal_weights": "Savitzky-Golay energy, equal weights",
@@ -58,7 +59,7 @@ def variant_rows(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def _geometry_section(s: dict[str, Any]) -> str:
+def _geometry_section(s: DecaySummary) -> str:
     """Frames, pivot, rod lengths [mm] and position noise."""
     pivot = s["pivot_origin_m"]
     noise = s["position_noise_m"]
@@ -79,7 +80,7 @@ def _geometry_section(s: dict[str, Any]) -> str:
 """
 
 
-def _energy_section(s: dict[str, Any]) -> str:
+def _energy_section(s: DecaySummary) -> str:
     """The energy, the derivative filters' gains and the calibrated error model."""
     em, sc = s["error_model"], s["scatter"]
     sg = s["derivative_filters"]["savgol"]["gain"]
@@ -107,7 +108,7 @@ dv = {em["seed_dv_m_per_s"]} m/s and no floor).
 """
 
 
-def _fit_section(s: dict[str, Any]) -> str:
+def _fit_section(s: DecaySummary) -> str:
     """The exponential fit, its correlation-inflated errors and the difference to the seed."""
     seed = s["seed"]
     return f"""## Exponential fit E = a exp(b t)
@@ -131,7 +132,7 @@ The same fit with other energies and weights (errors inflated for the correlatio
 """
 
 
-def _comparison_section(s: dict[str, Any]) -> str:
+def _comparison_section(s: DecaySummary) -> str:
     """The decay models compared; the free exponent p of dE/dt = -k E^p against 1/2, 1, 3/2."""
     rows = {r["model"]: r for r in s["model_comparison"]}
     power = rows["power"]
@@ -151,13 +152,13 @@ alternative "inverse square of time") p = 3/2 ({(p - 1.5) / sp_corr:+.1f} sigma,
 """
 
 
-def _tie_text(s: dict[str, Any]) -> str:
+def _tie_text(s: DecaySummary) -> str:
     """Which decay laws lie within dAIC 2 of the lowest (the record does not rank them)."""
     tied = [r["model"] for r in s["model_comparison"][1:] if r["delta_aic"] < 2.0]
     return f" ({', '.join(tied)} within dAIC 2 of it: the record does not rank them)" if tied else ""
 
 
-def _discussion_section(s: dict[str, Any]) -> str:
+def _discussion_section(s: DecaySummary) -> str:
     """Why a and b differ from the seed's: origin, velocity smoothing, energy model, weights, frames."""
     m1, m2 = s["masses_kg"]["m1"], s["masses_kg"]["m2"]
     cd20 = s["derivative_filters"]["central_difference"]["gain"]["20_rad_s"]
@@ -192,7 +193,7 @@ def _discussion_section(s: dict[str, Any]) -> str:
 """
 
 
-def _budget_section(s: dict[str, Any]) -> str:
+def _budget_section(s: DecaySummary) -> str:
     """The error budget's rows, then b as it is: statistical error, the range over named variants, the halves."""
     if "error_budget" not in s:
         return ""
@@ -278,7 +279,7 @@ def _lag_text(lag: float | None) -> str:
     return "no lag within the block" if lag is None else f"{lag:.2f} s"
 
 
-def _stationarity_section(s: dict[str, Any]) -> str:
+def _stationarity_section(s: DecaySummary) -> str:
     """The non-stationarity study: calibration drift, the energy's biases, b against the energy."""
     if "error_budget" not in s:
         return ""
@@ -323,7 +324,7 @@ What would settle it, and the record cannot:
 """
 
 
-def report_text(summary: dict[str, Any]) -> str:
+def report_text(summary: DecaySummary) -> str:
     """The Markdown report: figures from ``summary`` and the discussion of the differences to the seed."""
     sections = (_geometry_section, _energy_section, _fit_section, _budget_section, _stationarity_section,
                 _comparison_section, _discussion_section)
@@ -331,7 +332,7 @@ def report_text(summary: dict[str, Any]) -> str:
     return _opening(summary) + body
 
 
-def _opening(s: dict[str, Any]) -> str:
+def _opening(s: DecaySummary) -> str:
     """Title, plain summary and the words used."""
     st = s["error_budget"]["b_statement"]
     rows = {r["model"]: r for r in s["model_comparison"]}

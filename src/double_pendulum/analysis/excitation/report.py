@@ -10,6 +10,7 @@ from ...model.parameters import PendulumParameters
 from ...runs.results_io import report_opening
 from .drive import FLOQUET_TOLERANCE
 from .study import KapitzaResult, distance_to_bound, normal_modes, wedge_tip_frequency
+from .summary_types import AchesonSummary, ExcitationSummary, KapitzaSummary
 from .theory import equivalent_lengths
 
 UNIT_SUFFIXES = (("_rad_per_s", "rad/s"), ("_rad", "rad"), ("_m", "m"), ("_s", "s"))
@@ -27,7 +28,7 @@ def unit_headers(rows: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
     return [{header(k): v for k, v in row.items()} for row in rows]
 
 
-def kapitza_summary(k: KapitzaResult) -> dict[str, Any]:
+def kapitza_summary(k: KapitzaResult) -> KapitzaSummary:
     """The simulated threshold [m] (Floquet multipliers) against the exact bounds of the held input and of the
     continuous sinusoid and against ``sqrt(2 g l1)/omega``."""
     b = k.bisection
@@ -53,7 +54,7 @@ def kapitza_summary(k: KapitzaResult) -> dict[str, Any]:
     }
 
 
-def acheson_summary(rows: Sequence[Mapping[str, Any]], bands: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+def acheson_summary(rows: Sequence[Mapping[str, Any]], bands: Sequence[Mapping[str, Any]]) -> AchesonSummary:
     """The map's agreement with the linear theory (held input as simulated, and the continuous sinusoid) and
     where the measured stable band begins."""
     agree = sum(r["stable"] == r["theory_stable"] for r in rows)
@@ -97,7 +98,7 @@ def resonance_summary(rows: Sequence[Mapping[str, Any]], peaks: Sequence[Mapping
     return out
 
 
-def _opening(s: Mapping[str, Any], quick: bool) -> str:
+def _opening(s: ExcitationSummary, quick: bool) -> str:
     """Title, plain summary and the words used."""
     title = "Base excitation: the pendulum driven through its inputs" + (" (quick run)" if quick else "")
     return report_opening(title, [
@@ -124,7 +125,7 @@ def _opening(s: Mapping[str, Any], quick: bool) -> str:
     })
 
 
-def report(summary: Mapping[str, Any], peaks: Sequence[Mapping[str, Any]], quick: bool) -> str:
+def report(summary: ExcitationSummary, peaks: Sequence[Mapping[str, Any]], quick: bool) -> str:
     """The findings in words and tables (Markdown)."""
     s = summary
     lines = [

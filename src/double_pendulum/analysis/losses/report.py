@@ -16,6 +16,7 @@ from typing import Any
 from ...runs.results_io import report_opening
 from .holdout import holdout_section
 from .mechanisms import model_title
+from .summary_types import LossesSummary
 
 
 def _pm(value: float, err: float | None) -> str:
@@ -50,7 +51,7 @@ def model_table(rows: list[Mapping[str, Any]]) -> str:
     return "\n".join(lines)
 
 
-def parameter_lines(s: Mapping[str, Any]) -> str:
+def parameter_lines(s: LossesSummary) -> str:
     """The best model's parameters: value, error (with the correlation factor), profile interval, verdict."""
     out = []
     ident = s["identifiability"]["identified"]
@@ -74,7 +75,7 @@ def parameter_lines(s: Mapping[str, Any]) -> str:
     return "\n".join(out)
 
 
-def _factor_text(s: Mapping[str, Any]) -> str:
+def _factor_text(s: LossesSummary) -> str:
     """How far F is from changing which models tie (``supported_from_factor``)."""
     joins = {m: f for m, f in s.get("supported_from_factor", {}).items() if f is not None}
     if not joins:
@@ -84,7 +85,7 @@ def _factor_text(s: Mapping[str, Any]) -> str:
             f"numbers join the tie: {parts} (F = {s['correlation_factor_F']:.2f} here).")
 
 
-def _pair_text(s: Mapping[str, Any], max_corr: float = 0.95) -> str:
+def _pair_text(s: LossesSummary, max_corr: float = 0.95) -> str:
     """Within each supported pair of losses, whether the record fixes each loss or only their combination."""
     parts = []
     for r in s["models"]:
@@ -100,7 +101,7 @@ def _pair_text(s: Mapping[str, Any], max_corr: float = 0.95) -> str:
             "own, so the shares above are the total loss restated under the assumed pair): " + "; ".join(parts) + ".")
 
 
-def _correlation_note(s: Mapping[str, Any]) -> str:
+def _correlation_note(s: LossesSummary) -> str:
     """What a strong correlation of the parameters means for the shares."""
     if not any(s["identifiability"].get("strongly_correlated", {}).values()):
         return ""
@@ -108,7 +109,7 @@ def _correlation_note(s: Mapping[str, Any]) -> str:
             "below is the total loss restated under this one assumed pair of mechanisms.")
 
 
-def _regularisation_text(s: Mapping[str, Any]) -> str:
+def _regularisation_text(s: LossesSummary) -> str:
     """What the width of the friction sign function changes (``regularisation``), or nothing in a quick run."""
     reg = s.get("regularisation")
     if not reg:
@@ -127,7 +128,7 @@ FMU's), its joint losses by {fit['joint_work_relative_change']:+.1e} (relative) 
 {fit['delta_chi2']:+.1e}: far below what separates the models."""
 
 
-def correlation_text(s: Mapping[str, Any]) -> str:
+def correlation_text(s: LossesSummary) -> str:
     """The best model's parameter correlation matrix as text."""
     ident = s["identifiability"]
     names, corr = ident["parameters"], ident["correlation"]
@@ -137,7 +138,7 @@ def correlation_text(s: Mapping[str, Any]) -> str:
     return ", ".join(pairs)
 
 
-def goal_text(s: Mapping[str, Any]) -> str:
+def goal_text(s: LossesSummary) -> str:
     """The goal, met or not, in numbers."""
     g, h = s["goal"], s["residual_halves"]
     lines = [
@@ -157,7 +158,7 @@ def goal_text(s: Mapping[str, Any]) -> str:
     return "\n".join(lines) + "\n\n" + verdict
 
 
-def seed_friction_text(s: Mapping[str, Any]) -> str:
+def seed_friction_text(s: LossesSummary) -> str:
     """The fitted drag torque against the seed's rolling-friction estimate, as a torque at the pivot."""
     d = s.get("drag_torque_against_seed_rolling_friction")
     if not d:
@@ -176,7 +177,7 @@ def seed_friction_text(s: Mapping[str, Any]) -> str:
             " maker, not their type or seals, so this stays an assumption." + c_r)
 
 
-def noise_section(s: Mapping[str, Any]) -> str:
+def noise_section(s: LossesSummary) -> str:
     """AIC and BIC with F and with the AR(1) likelihood, side by side for every ranked model, and the ties."""
     nm = s.get("noise_model")
     if not nm:
@@ -215,7 +216,7 @@ def _whiteness_text(nm: Mapping[str, Any], n: int) -> str:
             "so its likelihood differences are approximate too.")
 
 
-def _opening(s: Mapping[str, Any]) -> str:
+def _opening(s: LossesSummary) -> str:
     """Title, plain summary and the words used."""
     title = "Loss identification: which mechanisms drain the seed's pendulum?"
     lost = (f"The camera track shows the pendulum losing {s['measured_loss_J']:.2f} J of energy over "
@@ -256,7 +257,7 @@ def _opening(s: Mapping[str, Any]) -> str:
     return report_opening(title, sentences, _terms(s))
 
 
-def _terms(s: Mapping[str, Any]) -> dict[str, str]:
+def _terms(s: LossesSummary) -> dict[str, str]:
     """The words the report uses, explained."""
     return {
         "chi2": "the sum over the frames of ((simulated - measured energy) / the energy's error)^2; smaller fits "
@@ -290,7 +291,7 @@ def _air_on_decay_text(air: Mapping[str, Any]) -> str:
             f"{air['share_on_measured_decay']:.0%} of the measured loss. ")
 
 
-def report_text(s: Mapping[str, Any]) -> str:
+def report_text(s: LossesSummary) -> str:
     """The whole report."""
     from .claims import SEPARATING_MEASUREMENTS, per_joint_text
 

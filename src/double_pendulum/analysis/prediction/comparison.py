@@ -58,6 +58,7 @@ from ..track.start_state import (
     state_start_values,
     track_window,
 )
+from .summary_types import Goal, HeadlineHorizon, Regime, RodLengthFloor
 
 THRESHOLDS_M = (0.02, 0.05)
 """Position errors [m] whose first crossing defines the prediction horizons (raw and smoothed)."""
@@ -140,7 +141,7 @@ def _horizons(
     return out
 
 
-def headline_horizon(prediction: Prediction, span_s: float, threshold: float = 0.05) -> dict[str, Any]:
+def headline_horizon(prediction: Prediction, span_s: float, threshold: float = 0.05) -> HeadlineHorizon:
     """The lower bob's smoothed horizon at ``threshold`` [m] as a claim: ``horizon_s`` [s] (the prediction's
     length ``span_s`` if never exceeded), ``censored`` (True then: the horizon is only known to exceed the
     record), the largest smoothed error [m] and when [s], the margin below the threshold [m] and the first
@@ -387,7 +388,7 @@ def _window_fit(runner: FmuRunner, item: tuple[Any, ...]) -> dict[str, Any]:
 # --- the regime ----------------------------------------------------------------------------------
 
 
-def regime(params: PendulumParameters, state: Sequence[float], t_end: float) -> dict[str, Any]:
+def regime(params: PendulumParameters, state: Sequence[float], t_end: float) -> Regime:
     """Regular or chaotic at the energy of ``state`` (frictionless ``params``, rods included)?
 
     The largest Lyapunov exponent by Benettin's method
@@ -440,7 +441,7 @@ def rod_length_floor(rec: Reconstruction, i0: int, n_frames: int) -> tuple[np.nd
     return offsets * FRAME_INTERVAL, np.abs(signed)
 
 
-def rod_floor_summary(rec: Reconstruction, i0: int, n_frames: int) -> dict[str, float]:
+def rod_floor_summary(rec: Reconstruction, i0: int, n_frames: int) -> RodLengthFloor:
     """Size of the track's rod-length error and its correlation with the lower rod's rate squared.
 
     The signed deviation |r2 - r1| - l2 is correlated with omega2^2 (Savitzky-Golay rates): a
@@ -559,7 +560,7 @@ def headline_entries(headlines: dict[str, dict[str, Any]]) -> dict[str, Any]:
     return entries
 
 
-def goal_entry(reached: float | None, prediction_s: float, goal_s: float) -> dict[str, Any]:
+def goal_entry(reached: float | None, prediction_s: float, goal_s: float) -> Goal:
     """The goal: the lower bob's smoothed error below 5 cm for at least ``goal_s`` [s] after t0 (least-squares
     start and geometry); ``reached`` [s] is None where the error never exceeded 5 cm within ``prediction_s``."""
     return {

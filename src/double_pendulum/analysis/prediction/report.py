@@ -17,6 +17,7 @@ from typing import Any
 from ...runs.results_io import report_opening
 from ..losses.mechanisms import model_title
 from ..track.measurement import FPS
+from .summary_types import PredictionSummary
 
 LABELS = {
     "seed_start_frictionless": "seed start (reconstruction at t0), frictionless point masses",
@@ -44,7 +45,7 @@ def fmt_horizon(value: float | None, span: float) -> str:
     return f"none in {span:.2f}" if value is None else f"{value:.2f}"
 
 
-def horizon_rows(s: Mapping[str, Any]) -> str:
+def horizon_rows(s: PredictionSummary) -> str:
     """Rows of :data:`HORIZON_HEADER`: the lower bob's smoothed and per-frame horizons [s] and rms error [mm]."""
     span = s["prediction_s"]
     rows = []
@@ -69,7 +70,7 @@ def geometry_text(geometry: Mapping[str, float], stderr: Mapping[str, float]) ->
     return ", ".join(parts)
 
 
-def sensitivity_rows(s: Mapping[str, Any]) -> str:
+def sensitivity_rows(s: PredictionSummary) -> str:
     """Markdown table of the smoothed horizons [s] per fit window of the start and geometry (``--thorough`` only;
     otherwise a sentence saying so and that the table's other windows come with ``--thorough``)."""
     span = s["prediction_s"]
@@ -97,7 +98,7 @@ def sensitivity_rows(s: Mapping[str, Any]) -> str:
     return "\n".join([head, "|---|---|---|---|---|---|---|---|---|---|", *rows])
 
 
-def state_rows(s: Mapping[str, Any]) -> str:
+def state_rows(s: PredictionSummary) -> str:
     """Rows comparing the seed's start state with the least-squares ones (value +- standard error)."""
     seed = s["starts"]["seed_reconstruction"]
     lsq = s["starts"]["least_squares"]
@@ -124,7 +125,7 @@ def claim_horizon(value: float, censored: bool) -> str:
     return f"not reached in the {value:.2f} s compared (censored)" if censored else f"{value:.2f} s"
 
 
-def horizon_claims_text(s: Mapping[str, Any]) -> str:
+def horizon_claims_text(s: PredictionSummary) -> str:
     """What the 5 cm horizons support: the three geometries side by side, the margin, in-sample, regime."""
     d = s["horizon_5cm_details"]
     main, fixed, shift = (d[k] for k in ("lsq_geometry_identified", "lsq_fixed_geometry_identified",
@@ -149,7 +150,7 @@ def horizon_claims_text(s: Mapping[str, Any]) -> str:
     )
 
 
-def cause_text(s: Mapping[str, Any]) -> str:
+def cause_text(s: PredictionSummary) -> str:
     """Model error or the fit's uncertainty? Compare the observed 5 cm horizon with the ensemble's."""
     span = s["prediction_s"]
     observed = s["horizons_smoothed_s"][MAIN_RUN]["lower_bob_5cm_s"]
@@ -168,7 +169,7 @@ def cause_text(s: Mapping[str, Any]) -> str:
             "uncertainty limits it.")
 
 
-def regime_text(s: Mapping[str, Any]) -> str:
+def regime_text(s: PredictionSummary) -> str:
     """The regime paragraph: the exponent, its decay, the energy against the flip energy, what limits the horizon."""
     r = s["regime"]
     checkpoints = ", ".join(f"{v:.3f} 1/s after {k.split('_after_')[1].replace('_s', '')} s"
@@ -189,7 +190,7 @@ def regime_text(s: Mapping[str, Any]) -> str:
             f"time of about {1 / r['largest_lyapunov_exponent_per_s']:.1f} s.")
 
 
-def loss_models_text(s: Mapping[str, Any]) -> str:
+def loss_models_text(s: PredictionSummary) -> str:
     """The main start under every loss model the record supports equally: each model's 5 cm horizons, the ranges."""
     sens = s["loss_model_sensitivity"]
     span = s["prediction_s"]
@@ -205,7 +206,7 @@ def loss_models_text(s: Mapping[str, Any]) -> str:
             "supports; the table above is the run with one of them.")
 
 
-def loss_uncertainty_text(s: Mapping[str, Any]) -> str:
+def loss_uncertainty_text(s: PredictionSummary) -> str:
     """The horizon's sensitivity to the damping level per model and, with ``--thorough``, the ensemble over the
     losses' and the start's covariance (median and 16-84 % range)."""
     u = s.get("loss_uncertainty")
@@ -231,7 +232,7 @@ def _short_horizon(score: Mapping[str, Any]) -> str:
     return f"{'> ' if score['horizon_5cm_censored'] else ''}{score['horizon_5cm_s']:.2f} s"
 
 
-def motion_out_of_sample_text(s: Mapping[str, Any]) -> str:
+def motion_out_of_sample_text(s: PredictionSummary) -> str:
     """The out-of-sample test of the motion (``--thorough``): per direction a table of every model's held-out RMS
     error, median smoothed error and horizon, half-fitted against whole-record-fitted, and what it says."""
     o = s.get("out_of_sample_motion")
@@ -282,13 +283,13 @@ def raw_range_text(sens: Mapping[str, Any]) -> str:
     return f"{lo:.1f} to {hi:.1f} s"
 
 
-def loss_text(s: Mapping[str, Any]) -> str:
+def loss_text(s: PredictionSummary) -> str:
     """The identified loss parameters: value +- standard error with units."""
     return ", ".join(f"{k} = {p['value']:.4g} +- {p['stderr']:.2g} {p['unit']}"
                      for k, p in s["model"]["loss_parameters"].items())  # fmt: skip
 
 
-def _loss_models_sentence(s: Mapping[str, Any]) -> str:
+def _loss_models_sentence(s: PredictionSummary) -> str:
     """The opening's sentence on the loss models the record cannot tell apart (empty with one model)."""
     sens = s["loss_model_sensitivity"]
     if sens["n_models"] < 2:
@@ -298,7 +299,7 @@ def _loss_models_sentence(s: Mapping[str, Any]) -> str:
             f"{raw_range_text(sens)} frame by frame, so the record supports that range, not one figure.")
 
 
-def _opening(s: Mapping[str, Any], quick: str) -> str:
+def _opening(s: PredictionSummary, quick: str) -> str:
     """Title, plain summary and the words used."""
     d = s["horizon_5cm_details"][MAIN_RUN]
     span = s["prediction_s"]
@@ -338,7 +339,7 @@ def _opening(s: Mapping[str, Any], quick: str) -> str:
     })
 
 
-def report_text(summary: Mapping[str, Any]) -> str:
+def report_text(summary: PredictionSummary) -> str:
     """The Markdown report: every figure from ``summary``."""
     s = summary
     quick = " (quick run)" if s["quick"] else ""

@@ -18,6 +18,7 @@ from typing import Any
 
 from ...runs.results_io import report_opening
 from .decay_map import k_of_key
+from .summary_types import SuspensionSummary
 
 
 def _format_or_dash(value: float | None, fmt: str = ".4g") -> str:
@@ -25,7 +26,7 @@ def _format_or_dash(value: float | None, fmt: str = ".4g") -> str:
     return "-" if value is None else format(value, fmt)
 
 
-def _measured_section(s: Mapping[str, Any]) -> str:
+def _measured_section(s: SuspensionSummary) -> str:
     """Section "Measured decay and start": the measured b and p, the fitted start state."""
     m, st = s["measured"], s["start_state"]
     shape = m["decay_shape"]
@@ -55,7 +56,7 @@ def _contour_text(points: Sequence[Mapping[str, Any]]) -> str:
     return "; ".join(f"k = {p['k']:.3g} N/m, c = {p['c']:.3g} N s/m ({p['branch']})" for p in points)
 
 
-def _map_section(s: Mapping[str, Any]) -> str:
+def _map_section(s: SuspensionSummary) -> str:
     """Section "The map b(k, c)": grid, table per M_s, iso-b branches, the law checks, monotonicity in c."""
     main = s["maps"][0]
     lines = []
@@ -130,7 +131,7 @@ trajectory's spectrum near omega_n, which changes from run to run.
 """
 
 
-def _other_masses_text(s: Mapping[str, Any]) -> str:
+def _other_masses_text(s: SuspensionSummary) -> str:
     """Where the maps at other suspension masses are: here, or with ``--thorough``."""
     if len(s["maps"]) > 1:
         return "\nThe other masses are mapped on every second k and c of the main grid."
@@ -140,7 +141,7 @@ def _other_masses_text(s: Mapping[str, Any]) -> str:
             "and adds coarser maps at M_s = 0.5 and 8 kg (68 more runs, about 2.5 times the map's CPU time).")
 
 
-def _branches_text(s: Mapping[str, Any]) -> str:
+def _branches_text(s: SuspensionSummary) -> str:
     """The three branches of the measured iso-b curve on the main map, in numbers."""
     main = s["maps"][0]
     pts = main["iso_b_measured"]
@@ -188,7 +189,7 @@ def _c_table(rows: Mapping[str, Sequence[float]], what: str) -> str:
     return "\n".join([f"| k [N/m] | c [N s/m] where {what} |", "|---|---|", *lines])
 
 
-def _identification_section(s: Mapping[str, Any]) -> str:
+def _identification_section(s: SuspensionSummary) -> str:
     """Section "Identification": c at the default k and M_s, the Fisher valley, c refitted along it."""
     i, v = s["identified"], s["valley"]
     f = v["fisher"]
@@ -274,7 +275,7 @@ def _valley_text(trace: Sequence[Mapping[str, Any]]) -> str:
     )
 
 
-def _refit_section(s: Mapping[str, Any]) -> str:
+def _refit_section(s: SuspensionSummary) -> str:
     """Section "Refit": b and p of the FMU runs against the measured ones, the window checks."""
     m = s["measured"]
     rows = "\n".join(
@@ -337,7 +338,7 @@ FLOW_HEADER = (
 """Header of the energy-flow table (one row per run of :func:`_flow_section`)."""
 
 
-def _flow_section(s: Mapping[str, Any]) -> str:
+def _flow_section(s: SuspensionSummary) -> str:
     """Section "How the energy flows into the suspension": the energy-flow table and the force spectrum."""
     sp = s["spectrum"]
     fmu_share = s["refit"]["identified"]["b_E_pendulum_per_s"] - s["refit"]["no suspension"]["b_E_pendulum_per_s"]
@@ -371,7 +372,7 @@ the stiff limit {sp["quasi_static_share_at_identified_per_s"]:.4f} 1/s, the reso
 """
 
 
-def _flow_text(s: Mapping[str, Any]) -> str:
+def _flow_text(s: SuspensionSummary) -> str:
     """What the energy-flow numbers of the identified (and the resonant) suspension say."""
     f = s["energy_flow"]["identified"]
     text = (
@@ -393,7 +394,7 @@ def _flow_text(s: Mapping[str, Any]) -> str:
     return text + "."
 
 
-def _opening(s: Mapping[str, Any], quick: str) -> str:
+def _opening(s: SuspensionSummary, quick: str) -> str:
     """Title, plain summary and the words used."""
     m, i, refit = s["measured"], s["identified"], s["refit"]["identified"]
     b0 = s["refit"]["no suspension"]["b_E_pendulum_per_s"]
@@ -428,7 +429,7 @@ def _opening(s: Mapping[str, Any], quick: str) -> str:
     })
 
 
-def report_text(summary: Mapping[str, Any]) -> str:
+def report_text(summary: SuspensionSummary) -> str:
     """The Markdown report: every figure from ``summary``."""
     quick = " (quick run: small grid, first seconds only)" if summary["quick"] else ""
     b0 = summary["refit"]["no suspension"]["b_E_pendulum_per_s"]
