@@ -92,11 +92,13 @@ HEADLINES: dict[str, tuple[Headline, ...]] = {
     "measured_vs_sim": (
         Headline("lower bob within 5 cm of the track (smoothed over 0.25 s), start and camera geometry fitted, with "
                  "each of the loss models the measured energy supports equally", "loss_model_sensitivity/"
-                 "smoothed_5cm_range_s", unit="s after t0", note="loss_model_sensitivity/statement"),
+                 "smoothed_5cm_range_s", unit="s after t0", note="loss_model_sensitivity/statement",
+                 resolution="smoothing/window_s"),
         Headline("the same, frame by frame: first more than 5 cm off after", "loss_model_sensitivity/raw_5cm_range_s",
-                 unit="s"),
+                 unit="s", resolution=1 / 30),  # one frame of the 30 fps track
         Headline("started the seed's way (its start, no friction): within 5 cm for",
-                 "horizons_smoothed_s/seed_start_frictionless/lower_bob_5cm_s", unit="s"),
+                 "horizons_smoothed_s/seed_start_frictionless/lower_bob_5cm_s", unit="s",
+                 resolution="smoothing/window_s"),
         Headline("the motion at the measured energy", "regime/verdict"),
     ),
     "free_swing": (
@@ -155,16 +157,16 @@ HEADLINES: dict[str, tuple[Headline, ...]] = {
     ),
     "cosimulation": (
         Headline("plain exchange (Jacobi), regular start: order of the angle error in the macro step",
-                 "order_angles/regular / default / jacobi"),
+                 "order_angles/regular / default / jacobi", resolution=0.01),
         Headline("iterative master (states saved and restored), regular start: order",
-                 "order_angles/regular / default / iterative"),
+                 "order_angles/regular / default / iterative", resolution=0.01),
         Headline("cheapest way to an angle error of 1e-4 rad, regular start",
                  "cheapest_to_1e-4_rad/regular / default/method"),
     ),
     "work_precision": (
         Headline("configurations run (solvers, tolerances, steps)", "configurations"),
         Headline("fastest to an error of 1e-6, regular case", "best_per_band/regular/max_error_le_1e-6/solver"),
-        Headline("its CPU time", "best_per_band/regular/max_error_le_1e-6/cpu_time_s", unit="s"),
+        Headline("its CPU time", "best_per_band/regular/max_error_le_1e-6/cpu_time_s", unit="s", resolution=0.01),
     ),
     "stability": (
         Headline("hard cases run", "cases"),
@@ -210,6 +212,27 @@ FIGURES: dict[str, tuple[tuple[str, str], ...]] = {
 """The key figures and animations the run's page shows of each scenario (file name, caption), in order."""
 
 
+CONCLUSIONS: dict[str, str] = {
+    "measured_vs_sim": "Started from a state fitted to the camera's first frames, the simulated pendulum keeps its "
+                       "lower bob within 5 cm of the measured one (smoothed) for {0}, whichever of the loss models "
+                       "the measured energy supports it uses; started the seed's way, for {2}.",
+    "chaos": "From a large start the motion is chaotic: a small difference grows e-fold at the rate of the largest "
+             "Lyapunov exponent, {0}, and hand releases within 5 mm of each other spread beyond 1 cm after {2}.",
+    "energy_decay": "The measured energy decays as E = a exp(b t) with b = {0} (statistical error); the choice of "
+                    "weights, window or energy shifts b by up to {1}.",
+    "loss_identification": "{0} loss models fit the measured energy about equally well, so the record does not tell "
+                           "which losses cause the decay: air drag's share of the loss is {1} among them.",
+    "base_excitation": "Shaking the pivot at 50 rad/s holds the single pendulum upright from an amplitude of {0} "
+                       "(Kapitza), and the simulated resonance peaks are within {2} of the damped linear theory.",
+    "cosimulation": "Split into two FMUs, plain exchange converges with order {0} in the macro step, the iterative "
+                    "master with order {1}.",
+    "work_precision": "The fastest way to an error of 1e-6 in the regular case is {1}.",
+}
+"""The run's conclusions at the top of its page: a sentence for each scenario that ran, ``{k}`` its k-th headline
+figure of :data:`HEADLINES` as the table shows it; the first five of the scenarios that ran, in :data:`READING_ORDER`
+(:class:`~double_pendulum.runs.page.ScenarioPage`'s ``conclusion``). No figure is written here."""
+
+
 def page(name: str, description: str) -> ScenarioPage:
     """What the run's page shows of scenario ``name`` (``description``: its one line)."""
-    return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()))
+    return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()), CONCLUSIONS.get(name, ""))

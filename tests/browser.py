@@ -137,6 +137,13 @@ class Browser:
         self.send("Page.navigate", url=url)
         self.events.append(self._wait(lambda m: m.get("method") == "Page.loadEventFired", "load event"))
 
+    def emulate(self, width: int, height: int, mobile: bool = True) -> None:
+        """Lay the open page out in a viewport of ``width`` x ``height`` CSS pixels, as a phone (``mobile``: the
+        page's viewport meta tag applies) or a desktop window; a window narrower than Chromium's own least width
+        (some 500 px) can only be had so."""
+        self.send("Emulation.setDeviceMetricsOverride", width=width, height=height, deviceScaleFactor=1,
+                  mobile=mobile)
+
     def evaluate(self, expression: str) -> Any:
         """The value of a JavaScript ``expression`` in the page."""
         result = self.send("Runtime.evaluate", expression=expression, returnByValue=True, awaitPromise=True)

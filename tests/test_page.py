@@ -18,7 +18,9 @@ from double_pendulum.runs.page import (
     Headline,
     RunInfo,
     ScenarioPage,
+    conclusion,
     format_figure,
+    headline_text,
     in_short,
     lookup,
     null_reason,
@@ -45,12 +47,49 @@ def test_lookup_walks_keys_lists_selectors_and_scales():
     (48.65185663245, 9.2e-05, "48.651857 \u00b1 0.000092"),
     (2.062512148422251, 0.0264751271309287, "2.063 \u00b1 0.026"),
     (1.5e-7, 2.5e-8, "(1.50 \u00b1 0.25) \u00d7 10^-7"),
-    (19.986653319986655, None, "19.99"),
+    (19.986653319986655, None, "20.0"), (0.0015656906443263265, None, "0.00157"), (3.436e-09, None, "3.44e-09"),
     ([0.0, 37.2], None, "0 to 37.2"),
+    ([2.7361, 2.7364], None, "2.74"),  # a range whose ends read the same is one value
     (19, None, "19"), (True, None, "yes"), ("regular", None, "regular"),
 ])
 def test_a_figure_is_shown_with_its_uncertainty_to_two_digits(value, uncertainty, text):
     assert format_figure(value, uncertainty) == text
+
+
+@pytest.mark.parametrize("value, resolution, text", [
+    (0.7340674007340675, 0.25, "0.7"), ([12.078745412078748, 19.986653319986655], 0.25, "12.1 to 20.0"),
+    ([11.14447781114448, 15.015015015015017], 1 / 30, "11.14 to 15.02"), (0.9996548821187504, 0.01, "1.00"),
+    (1234.5, 20.0, "1234"),
+])
+def test_a_figure_without_an_uncertainty_is_shown_to_its_resolution(value, resolution, text):
+    assert format_figure(value, None, resolution) == text
+
+
+def test_table_and_conclusion_show_a_figure_alike_and_a_missing_one_drops_the_sentence():
+    summary = {"h": [12.07, 19.98], "smoothing": {"window_s": 0.25}, "n": 5, "gone": None}
+    lines = (Headline("horizon", "h", unit="s", resolution="smoothing/window_s"), Headline("models", "n"),
+             Headline("nothing", "gone"), Headline("absent", "no/such/key"))
+    assert headline_text(lines[0], summary) == "12.1 to 20.0 s"
+    page = ScenarioPage("x", "x", lines, conclusion="{1} models hold it for {0}.")
+    assert conclusion(page, summary) == "5 models hold it for 12.1 to 20.0 s."
+    assert conclusion(ScenarioPage("x", "x", lines, conclusion="It is {2}."), summary) is None  # null
+    assert conclusion(ScenarioPage("x", "x", lines, conclusion="It is {3}."), summary) is None  # not in the summary
+    assert conclusion(ScenarioPage("x", "x", lines), summary) is None
+
+
+def test_the_conclusions_come_from_the_scenarios_that_ran_and_link_to_their_sections(tmp_path):
+    for name, value in (("a", 1.5), ("b", 2.5), ("c", 3.5)):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "summary.json").write_text(json.dumps({"v": value}))
+    pages = [ScenarioPage(name, name, (Headline("v", "v", unit="s"),), conclusion=f"{name} takes {{0}}.")
+             for name in "abc"]
+    text = page_html(tmp_path, _run(["a", "b", "c"], failed=["b"]), pages)
+    found = text.split('<ul class="conclusions">', 1)[1].split("</ul>", 1)[0]
+    assert 'a takes 1.50 s. (<a href="#a">a</a>)' in found and "c takes 3.50 s." in found
+    assert "b takes" not in found  # failed in this run
+    assert "c takes" not in page_html(tmp_path, _run(["a"]), pages)  # did not run
+    assert 'href="#contents"' not in text and '<nav id="contents">' in text and 'href="#conclusions"' in text
+    assert text.count('href="#top"') == 4 and 'id="top"' in text  # one a section, one always in the corner
 
 
 def test_a_null_is_shown_with_the_reason_its_summary_gives():
@@ -112,8 +151,7 @@ def test_the_page_shows_each_scenario_with_the_figures_its_summary_holds(quick_r
             value = lookup(summary, line.value)
             if value is None:
                 continue
-            uncertainty = lookup(summary, line.uncertainty) if line.uncertainty else None
-            assert html.escape(format_figure(value, uncertainty)) in section, (name, line.label)
+            assert html.escape(headline_text(line, summary)) in section, (name, line.label)
         assert 'class="short"' in section, f"{name}: no plain summary"
         assert f'href="{name}/summary.json"' in section
 
@@ -144,7 +182,7 @@ def test_the_page_in_a_real_browser_loads_every_image_plays_the_animations_and_l
             "Array.from(document.images).map(i => [i.getAttribute('src'), i.complete && i.naturalWidth > 0])")
         assert len(images) >= sum(len(figures) for figures in FIGURES.values())
         assert [src for src, loaded in images if not loaded] == []
-        assert browser.evaluate("document.querySelectorAll('section').length") == len(SCENARIOS)
+        assert browser.evaluate("document.querySelectorAll('section:not(#conclusions)').length") == len(SCENARIOS)
         gif = browser.evaluate(
             "(() => { const i = document.querySelector('img[src$=\"measured_vs_sim.gif\"]'); i.scrollIntoView(); "
             "const r = i.getBoundingClientRect(); "
@@ -157,6 +195,18 @@ def test_the_page_in_a_real_browser_loads_every_image_plays_the_animations_and_l
                 break
         assert later != first, "the animation does not play"
         shot = browser.screenshot(tmp_path / "index.png")
+        links = browser.evaluate(
+            "Array.from(document.querySelectorAll('#contents a, #conclusions a, a[href=\"#top\"]'))"
+            ".map(a => [a.closest('nav, section') ? a.closest('nav, section').id : '', a.getAttribute('href'), "
+            "!!document.getElementById(a.getAttribute('href').slice(1))])")
+        assert [href for _, href, found in links if not found] == []  # every link of contents and conclusions lands
+        assert {href for where, href, _ in links if where == "contents"} >= {f"#{name}" for name in SCENARIOS}
+        assert {href for where, href, _ in links if where == "conclusions"} <= {f"#{name}" for name in SCENARIOS}
+        assert browser.evaluate("getComputedStyle(document.querySelector('a.to-top')).position") == "fixed"
+        for width in (1280, 390):  # a desktop window and a phone: never wider than the screen
+            browser.emulate(width, 900, mobile=width < 500)
+            assert browser.evaluate("document.documentElement.scrollWidth") <= width
+            browser.screenshot(tmp_path / f"top_{width}.png", {"x": 0, "y": 0, "width": width, "height": 1500})
         assert browser.errors() == []
         assert {urlparse(url).scheme for url in browser.requested_urls()} == {"file"}  # nothing from the network
     assert shot.stat().st_size > 100_000

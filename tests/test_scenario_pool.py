@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import io
+import re
 import sys
 from pathlib import Path
 
@@ -11,6 +13,7 @@ from double_pendulum.scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READ
 from double_pendulum.cli import main
 from double_pendulum.runs import lines as scenario_lines
 from double_pendulum.runs import pool as scenario_pool
+from double_pendulum.runs import progress
 from double_pendulum.runs.pool import Costs
 from double_pendulum.runs.progress import ENV
 from double_pendulum.runs.workers import WORKERS_ENV
@@ -178,6 +181,9 @@ class _Bar:
             self.updates.append(n)
         self.n += n
 
+    def set_total(self, total: int) -> None:
+        self.total = total
+
     def __enter__(self) -> _Bar:
         return self
 
@@ -290,11 +296,59 @@ def test_a_child_header_is_numbered_in_the_order_scenarios_start():
     assert child.take("[2/11] b: second ...\n") == ("[8/11] b: second ...", None)
 
 
-def test_the_bar_credits_running_scenarios_with_their_time_so_far_up_to_a_cap():
-    weight = {"long": 100, "short": 10, "finished": 30}
+def test_the_bar_credits_running_scenarios_with_their_time_so_far_where_their_cpu_time_is_unknown():
+    weight = {"long": 100.0, "short": 10.0, "finished": 30.0}
     long_child = scenario_pool.Child(("long",), process=None, current="long", started=50.0)
     short_child = scenario_pool.Child(("short",), process=None, current="short", started=50.0)
-    # 20 s into both: the long one has 20 of its 100 s, the short one 9 of its 10 (the cap), finished ones all
-    assert scenario_pool.progress_done(weight, {"finished"}, [long_child, short_child], now=70.0) == 30 + 20 + 9
+    # 20 s into both: the long one has done 20 of its 100 s; the short one 20 s of its 10, so its share grows to
+    # 20 / CREDIT_CAP and the whole with it
+    work, whole = scenario_pool.progress_state(weight, {"finished": 30.0}, [long_child, short_child], now=70.0)
+    assert work == 30 + 20 + 20 and whole == pytest.approx(30 + 100 + 20 / scenario_pool.CREDIT_CAP)
     # a reported scenario counts whole, not twice
-    assert scenario_pool.progress_done(weight, {"finished", "short"}, [long_child, short_child], now=70.0) == 60
+    work, whole = scenario_pool.progress_state(weight, {"finished": 30.0, "short": 10.0}, [long_child, short_child],
+                                               now=70.0)  # fmt: skip
+    assert (work, whole) == (60, 140)
+
+
+def test_under_load_the_bar_follows_the_work_done_and_its_time_left_stays_bounded(monkeypatch):
+    """The run of issue 36 on a fake clock: chaos (expected 63 CPU s) and loss_identification (62) start side by
+    side on a machine so loaded that each child gets a tenth of a core; chaos needs three times its expected CPU
+    time, loss_identification's child goes on with the rest. The bar stood at 0.9 of the first two shares (112) for
+    14 minutes while its time left grew; now it moves with the children's CPU time, and the time left that the
+    plain-line counter prints never grows past its first estimate while work completes."""
+    clock = [0.0]
+    cpu = [0.0, 0.0]  # each child's CPU time [s]
+    monkeypatch.setattr(progress.time, "monotonic", lambda: clock[0])
+    weight = {"chaos": 63.0, "loss_identification": 62.0, "rest": 220.0}
+    chaos = scenario_pool.Child(("chaos",), process=None, current="chaos", started=0.0, cpu=lambda: cpu[0])
+    other = scenario_pool.Child(("loss_identification", "rest"), process=None, current="loss_identification",
+                                started=0.0, cpu=lambda: cpu[1])  # fmt: skip
+    lines = io.StringIO()
+    counter = progress.LineProgress(round(sum(weight.values())), "11 scenarios", unit="CPU s", file=lines)
+    done: dict[str, float] = {}
+    works = []
+    while "chaos" not in done:
+        clock[0] += 10.0
+        cpu[0], cpu[1] = cpu[0] + 1.0, cpu[1] + 1.0  # a tenth of a core each
+        if other.current == "loss_identification" and other.work_done(clock[0]) >= 62.0:
+            done["loss_identification"] = 62.0
+            other.current, other.started, other.cpu_started = "rest", clock[0], cpu[1]
+        if cpu[0] >= 3 * 63.0:
+            done["chaos"] = 3 * 63.0 / scenario_pool.CREDIT_CAP
+        work, whole = scenario_pool.progress_state(weight, done, [chaos, other], clock[0])
+        counter.set_total(max(round(whole), counter.total))
+        counter.update(max(0, int(work) - counter.n))
+        works.append(work)
+    assert all(later >= earlier for earlier, later in zip(works, works[1:]))
+    assert works[-1] > 3 * 63 + 62  # far past where the old bar stood still (112)
+    lefts = [_seconds(m) for m in re.findall(r"about (\S+) left", lines.getvalue())]
+    assert len(lefts) >= 10
+    assert max(lefts) <= lefts[0] and lefts[-1] < lefts[0] / 2  # the estimate does not run away while work is done
+
+
+def _seconds(clock: str) -> float:
+    """A progress line's m:ss or h:mm:ss [s]."""
+    seconds = 0.0
+    for part in clock.split(":"):
+        seconds = 60 * seconds + float(part)
+    return seconds

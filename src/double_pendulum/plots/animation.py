@@ -16,6 +16,7 @@ the frame is in the title, where it covers nothing.
 from __future__ import annotations
 
 import os
+import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,6 +37,11 @@ TRAIL_S = 1.0
 """How long [s] the lower bob's trail reaches back."""
 HOLD_LAST_MS = 1000
 """How long [ms] the last frame stays before the GIF starts again."""
+TITLE_PT = 12
+"""Font size [pt] of the title and the clock: at :data:`GIF_DPI` about 13 pixels, readable where the page shows the
+GIF at its own 400 pixels (9 pt, some 10 pixels, was not)."""
+LEGEND_PT = 10
+"""Font size [pt] of the legend and the axis labels."""
 
 
 @dataclass(frozen=True)
@@ -182,25 +188,30 @@ def animate_swings(
     for s in swings:
         trail, = ax.plot([], [], "-" if s.links else ".", color=s.colour, lw=1.0, ms=2.5, alpha=0.55,
                          label=f"{s.label}: lower bob, last {trail_s:g} s")
-        if s.links:
-            body, = ax.plot([], [], "-o", color=s.colour, lw=2.2, ms=7, mfc=s.colour, label=f"{s.label}: rods and bobs")
+        if s.links:  # dots on the bobs only: the pivot keeps its own marker, drawn above the rods
+            body, = ax.plot([], [], "-o", color=s.colour, lw=2.2, ms=7, mfc=s.colour, markevery=[1, 2],
+                            label=f"{s.label}: rods and bobs")
         else:
             body, = ax.plot([], [], "o", color=s.colour, ms=9, mfc="none", mew=2.0,
                             label=f"{s.label}: markers on both bobs")
         drawn.append((s, trail, body))
-    pivot, = ax.plot([], [], "k+", ms=9, label="pivot")
-    for s in swings:
-        ax.plot(*s.pivot, "+", color="k", ms=9)
+    pivots = sorted({s.pivot for s in swings})
+    pivot, = ax.plot([p[0] for p in pivots], [p[1] for p in pivots], "P", color="k", mfc="white", mew=1.4, ms=11,
+                     zorder=5, label="pivot")  # a white cross edged in black: seen on the rods and on the grid
     handles = [*(t for _, t, _ in drawn), pivot, *(b for _, _, b in drawn)]  # rows: a swing's trail and body
-    fig.legend(handles, [h.get_label() for h in handles], loc="outside lower center", ncols=2, fontsize=8,
+    fig.legend(handles, [h.get_label() for h in handles], loc="outside lower center", ncols=2, fontsize=LEGEND_PT - 1,
                frameon=False)
+    ax.xaxis.label.set_size(LEGEND_PT)
+    ax.yaxis.label.set_size(LEGEND_PT)
     clock = f"{time_label} = {{:.2f}} s (real time)"
-    ax.set_title(f"{title}\n{clock.format(times[-1])}", fontsize=9)  # the last line: the time's room in the layout
+    width = int(size_in[0] * 72 / (0.6 * TITLE_PT))  # characters a line holds at the title's size
+    title = "\n".join(textwrap.fill(line, width) for line in title.split("\n"))
+    ax.set_title(f"{title}\n{clock.format(times[-1])}", fontsize=TITLE_PT)  # the last line: the time's room
     _lay_out(fig)  # once: the frames only redraw what moves
     fig.set_layout_engine("none")
-    ax.set_title(f"{title}\n ", fontsize=9)  # the time goes on the (now blank) last line, frame by frame
+    ax.set_title(f"{title}\n ", fontsize=TITLE_PT)  # the time goes on the (now blank) last line, frame by frame
     heading = ax.text(*ax.title.get_position(), "", transform=ax.title.get_transform(), ha="center", va="baseline",
-                      fontsize=9)
+                      fontsize=TITLE_PT)
     trail_rows = max(1, int(round(trail_s / max(float(np.median(np.diff(times))) if len(times) > 1 else 1.0, 1e-9))))
 
     def draw(k: int) -> list:
@@ -213,9 +224,9 @@ def animate_swings(
             else:
                 body.set_data([s.x1[i], s.x2[i]], [s.y1[i], s.y2[i]])
         heading.set_text(clock.format(times[i]))
-        return [heading, *(a for _, t, b in drawn for a in (t, b))]
+        return [heading, *(a for _, t, b in drawn for a in (t, b)), pivot]  # the pivot last: above the rods
 
-    moving = [heading, *(a for _, t, b in drawn for a in (t, b))]
+    moving = [heading, *(a for _, t, b in drawn for a in (t, b)), pivot]
     for artist in moving:
         artist.set_animated(True)  # left out of the background
     fig.canvas.draw()

@@ -1,7 +1,8 @@
 """``index.html``: one page that shows a whole run, written into the output folder by every ``double-pendulum run``.
 
-At the top the run itself (date, version, mode, wall and CPU time, the command) and a list of the scenarios that
-ran; then, for each, its plain summary (the "In short" of its ``report.md``, or ``in_short`` of its
+At the top the run itself (date, version, mode, wall and CPU time, the command), what the run found (a sentence of
+each of up to five scenarios that ran, with their headline figures, linking to their sections: :func:`conclusion`)
+and a table of contents; then, for each, its plain summary (the "In short" of its ``report.md``, or ``in_short`` of its
 ``summary.json``), its headline figures with their uncertainty, read from its ``summary.json`` as the scenario
 wrote them (:class:`Headline`: nothing on the page is a number typed by hand), its key figures and animations,
 and links to its report, its CSV files, its ``summary.json`` and its other figures. Scenario folders of earlier
@@ -39,17 +40,24 @@ class Headline:
     uncertainty: str | None = None
     unit: str = ""
     note: str | None = None
+    resolution: float | str | None = None
+    """Without an uncertainty: the smallest difference the data resolve, in the value's unit (after its scale), a
+    number or a path into the summary (e.g. a smoothing window [s]); the value is rounded to its first significant
+    digit's decimal (:func:`format_figure`). None: :data:`SIGNIFICANT` significant digits."""
 
 
 @dataclass(frozen=True)
 class ScenarioPage:
-    """What the page shows of one scenario: its ``description``, its :class:`Headline` figures and its key
-    ``figures`` (file name and caption, in the order shown)."""
+    """What the page shows of one scenario: its ``description``, its :class:`Headline` figures, its key
+    ``figures`` (file name and caption, in the order shown) and its sentence of the run's ``conclusion``."""
 
     name: str
     description: str
     headlines: Sequence[Headline] = ()
     figures: Sequence[tuple[str, str]] = ()
+    conclusion: str = ""
+    """One sentence of the run's conclusions at the top of the page, with ``{0}``, ``{1}``, ... where the headline
+    figures of that index go, formatted as in the table (:func:`conclusion`); "" for none."""
 
 
 @dataclass(frozen=True)
@@ -114,29 +122,79 @@ def null_reason(summary: Any, path: str) -> str | None:
     return reason
 
 
-def _decimals(uncertainty: float) -> int:
-    """Decimals that show ``uncertainty`` (> 0) to two significant digits."""
-    return max(0, 1 - math.floor(math.log10(uncertainty)))
+SIGNIFICANT = 3
+"""Significant digits of a headline value that has neither an uncertainty nor a resolution."""
 
 
-def format_figure(value: Any, uncertainty: Any = None) -> str:
-    """A headline value as text: a number with its uncertainty as ``v +- u`` (u to two significant digits, v to
-    the same decimal), a number alone to four significant digits, a range ``lo to hi``, yes/no, or the text."""
+def _decimals(uncertainty: float, digits: int = 2) -> int:
+    """Decimals that show ``uncertainty`` (> 0) to ``digits`` significant digits."""
+    return max(0, digits - 1 - math.floor(math.log10(uncertainty)))
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def format_figure(value: Any, uncertainty: Any = None, resolution: Any = None) -> str:
+    """A headline value as text, the one format of the page's table and its conclusions.
+
+    A number with its uncertainty u > 0 as ``v +- u`` (u to two significant digits, v to the same decimal); a number
+    with a ``resolution`` r > 0 (the smallest difference its data resolve) to the decimal of r's first significant
+    digit (r = 0.25 s: one decimal); any other float to :data:`SIGNIFICANT` significant digits; a range ``lo to hi``
+    (each end so), one value where both ends read the same; yes/no; or the text."""
     if isinstance(value, bool):
         return "yes" if value else "no"
-    if isinstance(value, list) and len(value) == 2 and all(isinstance(v, (int, float)) for v in value):
-        return f"{format_figure(value[0])} to {format_figure(value[1])}"
+    if isinstance(value, list) and len(value) == 2 and all(_is_number(v) for v in value):
+        low, high = (format_figure(v, None, resolution) for v in value)
+        return low if low == high else f"{low} to {high}"
     if isinstance(value, int):
         return str(value)
     if not isinstance(value, float):
         return str(value)
-    if isinstance(uncertainty, (int, float)) and not isinstance(uncertainty, bool) and uncertainty > 0:
+    if _is_number(uncertainty) and uncertainty > 0:
         exponent = math.floor(math.log10(abs(value))) if value and not 1e-3 <= abs(value) < 1e5 else 0
         v, u = value / 10**exponent, float(uncertainty) / 10**exponent
         digits = _decimals(u)
         text = f"{v:.{digits}f} \u00b1 {u:.{digits}f}"
         return f"({text}) \u00d7 10^{exponent}" if exponent else text
-    return f"{value:.4g}"
+    if not math.isfinite(value) or value == 0:
+        return f"{value:g}"
+    if _is_number(resolution) and resolution > 0:
+        return f"{value:.{_decimals(float(resolution), 1)}f}"
+    if not 1e-3 <= abs(value) < 1e5:
+        return f"{value:.{SIGNIFICANT - 1}e}"
+    return f"{value:.{_decimals(abs(value), SIGNIFICANT)}f}"
+
+
+def headline_text(line: Headline, summary: Mapping[str, Any]) -> str | None:
+    """The headline ``line`` of ``summary`` as the page shows it (:func:`format_figure`, with its unit); "none: why"
+    for a null; None if the summary does not have it (e.g. a setting of the thorough run only)."""
+    try:
+        value = lookup(summary, line.value)
+        uncertainty = lookup(summary, line.uncertainty) if line.uncertainty else None
+        resolution = lookup(summary, line.resolution) if isinstance(line.resolution, str) else line.resolution
+    except (KeyError, IndexError, StopIteration, TypeError):
+        return None
+    if value is None:
+        return "none: " + (null_reason(summary, line.value) or "no value in summary.json")
+    return format_figure(value, uncertainty, resolution) + (f" {line.unit}" if line.unit else "")
+
+
+def conclusion(page: ScenarioPage, summary: Mapping[str, Any]) -> str | None:
+    """The scenario's sentence for the run's conclusions: :attr:`ScenarioPage.conclusion` with its headline figures
+    put in as the table shows them; None if it has none, or if a figure it needs is missing or null."""
+    if not page.conclusion:
+        return None
+    figures = []
+    for index in map(int, re.findall(r"\{(\d+)\}", page.conclusion)):
+        text = headline_text(page.headlines[index], summary) if index < len(page.headlines) else None
+        if text is None or text.startswith("none:"):
+            return None
+        figures.append((index, text))
+    sentence = page.conclusion
+    for index, text in figures:
+        sentence = sentence.replace(f"{{{index}}}", text)
+    return sentence
 
 
 def in_short(folder: Path, summary: Mapping[str, Any]) -> str:
@@ -167,15 +225,9 @@ def _link(href: str, text: str) -> str:
 def _headline_rows(page: ScenarioPage, summary: Mapping[str, Any]) -> list[str]:
     rows = []
     for line in page.headlines:
-        try:
-            value = lookup(summary, line.value)
-            uncertainty = lookup(summary, line.uncertainty) if line.uncertainty else None
-        except (KeyError, IndexError, StopIteration, TypeError):
+        shown = headline_text(line, summary)
+        if shown is None:
             continue  # not in this run's summary (e.g. a setting of the thorough run only)
-        if value is None:
-            shown = "none: " + (null_reason(summary, line.value) or "no value in summary.json")
-        else:
-            shown = format_figure(value, uncertainty) + (f" {line.unit}" if line.unit else "")
         note = ""
         if line.note:
             try:
@@ -208,6 +260,20 @@ def _mode(summary: Mapping[str, Any]) -> str:
     return "quick run" if summary.get("quick") else "thorough run" if summary.get("thorough") else "default run"
 
 
+def _read_summary(folder: Path) -> tuple[dict[str, Any] | None, str]:
+    """A scenario folder's ``summary.json``: (the summary, "") or (None, why not: "" if there is none)."""
+    path = folder / "summary.json"
+    if not path.is_file():
+        return None, ""
+    try:
+        return json.loads(path.read_text(encoding="utf-8")), ""
+    except (OSError, ValueError) as error:  # the page is written whatever a scenario left
+        return None, f"Its summary.json cannot be read ({error})."
+
+
+BACK = '<p class="back"><a href="#top">back to the top</a></p>'
+
+
 def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
     folder = out / page.name
     head = f'<section id="{page.name}"><h2>{html.escape(page.name)}</h2><p class="what">' \
@@ -217,13 +283,10 @@ def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
         note = (" What it wrote is in " + _link(f"{kept}/", f"{kept}/") + ".") if (out / kept).is_dir() else ""
         earlier = " The results below are from an earlier run." if (folder / "summary.json").is_file() else ""
         head += f'<p class="failed">This scenario failed in this run.{note}{earlier}</p>'
+    summary, error = _read_summary(folder)
+    if summary is None:
+        return head + (f'<p class="failed">{html.escape(error)}</p>' if error else "") + BACK + "</section>"
     summary_path = folder / "summary.json"
-    if not summary_path.is_file():
-        return head + "</section>"
-    try:
-        summary = json.loads(summary_path.read_text(encoding="utf-8"))
-    except (OSError, ValueError) as error:  # the page is written whatever a scenario left
-        return head + f'<p class="failed">Its summary.json cannot be read ({html.escape(str(error))}).</p></section>'
     written = datetime.fromtimestamp(summary_path.stat().st_mtime).strftime("%Y-%m-%d %H:%M")
     parts = [head, f'<p class="mode">{_mode(summary)}, written {written}</p>']
     text = in_short(folder, summary)
@@ -242,21 +305,50 @@ def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
                          f'alt="{html.escape(caption)}"></a><figcaption>{html.escape(caption)} '
                          f"({html.escape(name)})</figcaption></figure>")
     parts.append(_files(folder, shown))
-    return "\n".join(parts) + "</section>"
+    return "\n".join([*parts, BACK]) + "</section>"
 
 
 STYLE = """
 body { font-family: system-ui, sans-serif; max-width: 62rem; margin: 1.5rem auto; padding: 0 1rem; color: #222;
-       line-height: 1.45; }
+       line-height: 1.45; overflow-wrap: break-word; }
 h1 { font-size: 1.6rem; margin-bottom: 0.2rem; } h2 { margin-top: 2.5rem; border-bottom: 1px solid #ccc; }
 .run, .mode, .what, figcaption, .files { color: #555; } .what { font-style: italic; margin-top: 0; }
+.conclusions { font-size: 1.05em; } .conclusions li { margin: 0.35rem 0; }
 table.headlines { border-collapse: collapse; margin: 0.8rem 0; } .headlines td, .headlines th {
   border-bottom: 1px solid #e4e4e4; padding: 0.25rem 0.8rem 0.25rem 0; text-align: left; vertical-align: top; }
 .headlines .value { white-space: nowrap; font-variant-numeric: tabular-nums; } .note { color: #666; font-size: 0.9em; }
 figure { margin: 1rem 0; } img { max-width: 100%; height: auto; border: 1px solid #eee; }
-.failed { color: #a00; font-weight: bold; } .files { font-size: 0.92em; } code { font-size: 0.95em; }
-nav li { margin: 0.15rem 0; }
+.failed { color: #a00; font-weight: bold; } .files { font-size: 0.92em; overflow-wrap: anywhere; }
+code { font-size: 0.95em; overflow-wrap: anywhere; } nav li { margin: 0.15rem 0; } .back { font-size: 0.9em; }
+a.to-top { position: fixed; right: 0.8rem; bottom: 0.8rem; padding: 0.2rem 0.6rem; background: #fff;
+  border: 1px solid #bbb; border-radius: 0.3rem; font-size: 0.9em; text-decoration: none; }
+@media (max-width: 40rem) {
+  body { margin: 0.8rem auto; padding: 0 0.7rem; } h1 { font-size: 1.35rem; }
+  .headlines thead { display: none; } .headlines tr { display: block; border-bottom: 1px solid #e4e4e4;
+    padding: 0.35rem 0; } .headlines td { display: block; border: none; padding: 0.05rem 0; }
+  .headlines .value { white-space: normal; font-weight: bold; } .headlines .note:empty { display: none; }
+}
 """
+"""The page's style sheet. Below 40rem (a phone) a headline table's rows become blocks, label above value above
+note, so that the page is never wider than the screen."""
+
+
+MOST_CONCLUSIONS = 5
+"""At most this many sentences of conclusions at the top of the page."""
+
+
+def _conclusions(out: Path, ran: Sequence[ScenarioPage], failed: set[str]) -> list[str]:
+    """The run's conclusions: the sentence of each scenario that wrote its results in this run and declares one
+    (:func:`conclusion`), in the page's order, at most :data:`MOST_CONCLUSIONS`, each linking to its section."""
+    items = []
+    for page in ran:
+        if page.name in failed or not page.conclusion or len(items) == MOST_CONCLUSIONS:
+            continue
+        summary, _ = _read_summary(out / page.name)
+        sentence = conclusion(page, summary) if summary is not None else None
+        if sentence:
+            items.append(f'<li>{html.escape(sentence)} ({_link(f"#{page.name}", page.name)})</li>')
+    return items
 
 
 def page_html(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> str:
@@ -267,20 +359,29 @@ def page_html(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> str:
     failed = set(run.failed)
     status = f"{len(ran) - len(failed & {p.name for p in ran})} of {len(ran)} scenarios wrote their results"
     when = run.started.astimezone().strftime("%Y-%m-%d %H:%M %Z")
-    head = ["<h1>Double pendulum: the results of a run</h1>",
+    head = ['<h1 id="top">Double pendulum: the results of a run</h1>',
             f'<p class="run">{html.escape(when)} &middot; double-pendulum-fmu {html.escape(run.version)} &middot; '
             f"{html.escape(run.mode)} run &middot; {run.wall_s:.0f} s (CPU {run.cpu_s:.0f} s) &middot; "
-            f"<code>{html.escape(run.command)}</code><br>{status}.</p>",
-            "<nav><ul>"]
+            f"<code>{html.escape(run.command)}</code><br>{status}.</p>"]
+    found = _conclusions(out, ran, failed)
+    if found:
+        head += ['<section id="conclusions"><h2>What this run found</h2><ul class="conclusions">', *found,
+                 "</ul></section>"]
+    head.append('<nav id="contents"><h2>Contents</h2><ul>')
+    if found:
+        head.append(f'<li>{_link("#conclusions", "What this run found")}</li>')
     for p in ran:
         mark = " (failed)" if p.name in failed else ""
         head.append(f'<li><a href="#{p.name}">{html.escape(p.name)}</a>{mark}: {html.escape(p.description)}</li>')
+    if earlier:
+        head.append(f'<li>{_link("#earlier", "From earlier runs in this folder")}</li>')
     head.append("</ul></nav>")
     body = [_section(out, p, p.name in failed) for p in ran]
     if earlier:
         items = "".join(f"<li>{_link(f'{p.name}/summary.json', p.name)}: {html.escape(p.description)}</li>"
                         for p in earlier)
-        body.append(f'<section id="earlier"><h2>From earlier runs in this folder</h2><ul>{items}</ul></section>')
+        body.append(f'<section id="earlier"><h2>From earlier runs in this folder</h2><ul>{items}</ul>{BACK}</section>')
+    body.append('<a class="to-top" href="#top">&uarr; top</a>')
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
             f"<title>Double pendulum: results of a {html.escape(run.mode)} run</title><style>{STYLE}</style>"

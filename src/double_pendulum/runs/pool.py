@@ -24,10 +24,13 @@ running in its child (a child's header line ``[k/N] NAME: ...`` says which, k co
 the order they start); their progress counters are plain lines (``DOUBLE_PENDULUM_PROGRESS=lines``: two
 tqdm bars would overwrite each other), while the parent shows one bar over the scenarios, each weighted
 by its expected CPU time, so that its rate and time left mean something. A running scenario is credited
-with the time it has run so far (a child keeps a core busy), up to :data:`CREDIT_CAP` of its share; its
-whole share is added when its ``wrote`` or ``FAILED`` line arrives, what is left of a child's share when
-the child ends. So the bar moves from the start at about the rate the cores work, and its first estimates
-of the time left are not inflated by the scenarios that have not finished yet.
+with the work it has done so far: the CPU time its child (with the child's own workers) has used since the
+scenario started (:func:`tree_cpu_s`; where that cannot be read, the time it has run), so on a loaded machine
+the bar moves as slowly as the work does, not with the clock. A scenario that needs more than its expected
+CPU time is given more: its share grows to keep :data:`CREDIT_CAP` of it done while it runs, and the bar's
+total with it (:func:`progress_state`), so the bar never stands still while work is done and its time left,
+(total - done) over the rate of work, stays bounded. Its whole share is added when its ``wrote`` or ``FAILED``
+line arrives, what is left of a child's share when the child ends.
 
 Ctrl-C reaches the children too (they share the terminal's process group): each discards its unfinished
 scenario and ends; the parent waits up to :data:`STOP_GRACE_S` for them, kills what is left, and a
@@ -42,7 +45,7 @@ import subprocess
 import sys
 import threading
 import time
-from collections.abc import Callable, Collection, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
@@ -58,7 +61,27 @@ POLL_S = 0.2
 STOP_GRACE_S = 5.0
 """How long [s] interrupted children may take to clean up before they are killed."""
 CREDIT_CAP = 0.9
-"""At most this fraction of a running scenario's share of the progress bar is credited before it reports."""
+"""At most this fraction of a running scenario's share of the progress bar is credited before it reports: a
+scenario that has done more work than that grows its share (:func:`progress_state`)."""
+
+
+def tree_cpu_s(pid: int) -> float | None:
+    """CPU time [s] (user and system) that process ``pid`` has used, with the children it has waited for and the
+    descendants still running, from Linux's ``/proc``; None where that cannot be read (not Linux, or the process
+    has gone)."""
+    ticks, stack, first = 0, [pid], True
+    while stack:
+        process = stack.pop()
+        try:
+            fields = Path(f"/proc/{process}/stat").read_text().rsplit(")", 1)[1].split()
+            ticks += sum(int(value) for value in fields[11:15])  # utime, stime, cutime, cstime
+            for task in Path(f"/proc/{process}/task").iterdir():
+                stack += [int(child) for child in (task / "children").read_text().split()]
+        except (OSError, ValueError, IndexError):
+            if first:
+                return None
+        first = False
+    return ticks / os.sysconf("SC_CLK_TCK")
 
 
 @dataclass(frozen=True)
@@ -208,6 +231,19 @@ class Child:
     number: Callable[[], str] | None = None
     """The next "k/N" for a header line (the parent counts the scenarios in the order they start); None: the
     child's own."""
+    cpu: Callable[[], float | None] | None = None
+    """The CPU time [s] the child has used so far (:func:`tree_cpu_s` of its process); None: not known."""
+    cpu_started: float | None = None
+    """:attr:`cpu` when :attr:`current` started."""
+
+    def __post_init__(self) -> None:
+        self.cpu_started = self.cpu() if self.cpu else None
+
+    def work_done(self, now: float) -> float:
+        """The work [CPU s] done on :attr:`current` so far: the CPU time used since it started, or where that is
+        not known the time [s] since it started (time.monotonic ``now``)."""
+        used = self.cpu() if self.cpu and self.cpu_started is not None else None
+        return now - self.started if used is None else max(0.0, used - self.cpu_started)
 
     def take(self, line: str) -> tuple[str, str | None]:
         """Read a line of the child: switch :attr:`current` on a header line (numbered in the order the
@@ -216,6 +252,7 @@ class Child:
         header = header_name(line, self.names)
         if header is not None:
             self.current, self.started = header, time.monotonic()
+            self.cpu_started = self.cpu() if self.cpu else None
             line = line if self.number is None else renumbered(line, self.number())
         reported = outcome(line, self.names)
         text = marked(reported[0] if reported else self.current, line)
@@ -256,7 +293,7 @@ def start_child(names: Sequence[str], command: list[str], lock: threading.Lock,
     run, for its header line)."""
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, bufsize=1,
                                env=child_environment(workers))  # fmt: skip
-    child = Child(tuple(names), process, current=names[0], number=number)
+    child = Child(tuple(names), process, current=names[0], number=number, cpu=lambda: tree_cpu_s(process.pid))
     for stream, target in ((process.stdout, lambda: sys.stdout), (process.stderr, lambda: sys.stderr)):
         thread = threading.Thread(target=_relay, args=(child, stream, target, lock, reported), daemon=True)
         thread.start()
@@ -302,13 +339,23 @@ def _failures_of_ended(child: Child, lock: threading.Lock) -> tuple[list[str], l
     return failures, unreported
 
 
-def progress_done(weight: Mapping[str, int], done: Collection[str], running: Sequence[Child], now: float) -> int:
-    """Expected CPU seconds [s] done at ``now`` (time.monotonic): the whole ``weight`` of the scenarios ``done``,
-    and the time each running child's current scenario has run so far, up to :data:`CREDIT_CAP` of its
-    weight (a child keeps a core busy)."""
-    credit = sum(min(now - child.started, CREDIT_CAP * weight[child.current]) for child in running
-                 if child.current not in done)  # fmt: skip
-    return int(sum(weight[name] for name in done) + credit)
+def progress_state(weight: Mapping[str, float], done: Mapping[str, float], running: Sequence[Child],
+                   now: float) -> tuple[float, float]:  # fmt: skip
+    """(work done, whole work) [expected CPU s] at ``now`` (time.monotonic), and in :attr:`Child.work_done` terms:
+    the scenarios ``done`` count what they were given (their share, or more if they overran), a running child's
+    current scenario the work it has done so far, its share at least that over :data:`CREDIT_CAP` (one that
+    overruns its expected CPU time grows the whole instead of standing still at the cap), every other scenario its
+    ``weight``."""
+    work = dict(weight)
+    work.update(done)
+    credit = 0.0
+    for child in running:
+        if child.current in done:
+            continue
+        used = child.work_done(now)
+        work[child.current] = max(weight[child.current], used / CREDIT_CAP)
+        credit += used
+    return sum(done.values()) + credit, sum(work.values())
 
 
 def run_in_children(
@@ -318,22 +365,23 @@ def run_in_children(
     one scenario per child, or in a quick run ``jobs`` children with a group each); return the names
     of those that failed, in the order of ``names``. Ctrl-C stops every child and raises
     KeyboardInterrupt once they have cleaned up."""
-    weight = {name: max(1, round(costs.cpu_s(name, quick))) for name in names}
+    weight = {name: float(max(1, round(costs.cpu_s(name, quick)))) for name in names}
     lock = threading.Lock()
     waiting, running, failed = scenario_groups(names, costs, quick=quick, jobs=jobs, thorough=thorough), [], []
     order = [name for group in waiting for name in group]  # the children's own "k/N": until their header is seen
     workers = max(1, jobs // max(1, len(waiting)))  # fewer children than cores: the spare cores to their sweeps
     starts = itertools.count(1)
-    done: set[str] = set()  # scenarios whose whole share the bar holds
+    done: dict[str, float] = {}  # scenarios whose whole share the bar holds, and that share
+    shares = dict(weight)  # each scenario's share as last seen (grown if it overran)
 
     def number() -> str:
         return f"{next(starts)}/{len(names)}"
 
     def reported(name: str) -> None:
-        done.add(name)
+        done[name] = shares[name]
 
     label = f"{len(names)} scenarios, progress in expected CPU seconds"
-    with progress_bar(sum(weight.values()), label, unit="CPU s") as bar:
+    with progress_bar(round(sum(weight.values())), label, unit="CPU s") as bar:
         try:
             while waiting or running:
                 while waiting and len(running) < jobs:
@@ -346,9 +394,16 @@ def run_in_children(
                     running.remove(child)
                     failures, unreported = _failures_of_ended(child, lock)
                     failed.extend(failures)
-                    done.update(unreported)
+                    with lock:
+                        done.update((name, shares[name]) for name in unreported)
                 with lock:
-                    bar.update(max(0, progress_done(weight, done, running, time.monotonic()) - bar.n))
+                    for child in running:
+                        if child.current not in done:
+                            shares[child.current] = max(weight[child.current],
+                                                        child.work_done(time.monotonic()) / CREDIT_CAP)
+                    work, whole = progress_state(weight, done, running, time.monotonic())
+                    bar.set_total(max(round(whole), bar.total))
+                    bar.update(max(0, int(work) - bar.n))
         except KeyboardInterrupt:
             acknowledge()
             _stop(running)

@@ -120,6 +120,10 @@ class LineProgress:
         self._write(f"{self.n}/{self.total} ({100 * fraction:.0f} %), {_clock(elapsed)} elapsed, "
                     f"{self._rate(elapsed)}, about {_clock(left)} left")
 
+    def set_total(self, total: int) -> None:
+        """Make the loop ``total`` items long from now on (a run that turns out to need more work than expected)."""
+        self.total = max(int(total), 0)
+
     def set_description(self, desc: str | None = None, refresh: bool = True) -> None:
         if desc:
             self.desc = desc
@@ -171,6 +175,11 @@ class _Bar:
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._bar, name)
+
+    def set_total(self, total: int) -> None:
+        """Make the bar ``total`` items long from now on."""
+        self._bar.total = int(total)
+        self._bar.refresh()
 
     def __enter__(self) -> _Bar:
         return self

@@ -86,7 +86,8 @@ def _opening(summary: CouplingSummary) -> str:
            f"1e-4 rad in every case run." if cheapest else "no run reached an angle error of 1e-4 rad."),
         "A suspension much lighter than the pendulum makes plain exchange blow up: the measured stability limits "
         + ("agree with the derived ones" if holds else "do NOT all agree with the derived ones")
-        + " (below); the CPU times are from a shared machine and rank only runs that differ clearly.",
+        + " (the report's stability section); the CPU times are from a shared machine and rank only runs that "
+        "differ clearly.",
     ], {
         "macro step h": "the interval at which the master exchanges values between the FMUs",
         "monolithic": "the pendulum and its suspension integrated as one system in one FMU: the reference",

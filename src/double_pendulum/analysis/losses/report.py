@@ -253,7 +253,8 @@ def _opening(s: LossesSummary) -> str:
                          f"{s['suspension_fixed']['M_s_kg']:g} kg): no damping makes it fit better than a rigid pivot.")
     sentences.append("How sure: every fit is judged on the same record it was fitted to, and the verdict "
                      "that the candidates tie holds unless the frames' errors are far more correlated than the "
-                     "data indicate (see F below).")
+                     f"data indicate (neighbouring frames' errors are alike, so n frames count as "
+                     f"n / {s['correlation_factor_F']:.2f} independent ones).")
     return report_opening(title, sentences, _terms(s))
 
 

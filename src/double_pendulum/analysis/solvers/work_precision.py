@@ -247,7 +247,7 @@ def _opening(rows: list[dict[str, Any]], best: dict[str, dict[str, Any]], spread
         "tolerances or step sizes, and each run's largest error against a far more accurate reference was set "
         "against the CPU time it took.",
         (f"The fastest run to reach an error band was {top}'s in {winners[top]} of the {reached} bands reached "
-         "(tables below: per case and band the fastest solver and its setting)." if top else
+         "(the report's tables give, per case and band, the fastest solver and its setting)." if top else
          "No run reached an error band in this run."),
         f"How sure: {noise}, and errors below a reference's own error floor are not resolved.",
     ], {
