@@ -27,13 +27,13 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
-from . import __version__
-from .component.variables import INTERFACES
-from .fmu.build import DEFAULT_FMU_PATH, build_all
-from .fmu.loader import LoaderUnavailable
-from .runs.interrupts import acknowledge, handling_interrupts, interrupted
-from .runs.lines import failed_line, header_line, wrote_line
-from .scenarios import SCENARIOS
+from .. import __version__
+from ..component.variables import INTERFACES
+from ..fmu.build import DEFAULT_FMU_PATH, build_all
+from ..fmu.loader import LoaderUnavailable
+from ..runs.interrupts import acknowledge, handling_interrupts, interrupted
+from ..runs.lines import failed_line, header_line, wrote_line
+from ..scenarios import SCENARIOS
 
 PROG = "double-pendulum"
 
@@ -129,13 +129,13 @@ def fmu_set(fmu: Path) -> list[Path]:
 def fmu_set_is_current(fmu: Path) -> bool:
     """Whether ``fmu`` is newer than its sources and, for an FMU named as ``build`` names it, the rest of
     :func:`fmu_set` is there and current too (an FMU of another name is checked alone)."""
-    from .fmu.build import fmu_is_current
+    from ..fmu.build import fmu_is_current
 
     if not fmu_is_current(fmu):
         return False
     if fmu.name != DEFAULT_FMU_PATH.name:
         return True
-    from .fmu.build_fmi3 import adapter_sources as fmi3_sources
+    from ..fmu.build_fmi3 import adapter_sources as fmi3_sources
 
     built = fmu.stat().st_mtime
     others = fmu_set(fmu)[1:]
@@ -151,7 +151,7 @@ def _load_fmu(path: str, rebuild: bool):
     open the FMU with fmpy; unusable files become a CliError."""
     import zipfile
 
-    from .fmu.runner import FmuRunner
+    from ..fmu.runner import FmuRunner
 
     fmu = Path(path)
     if rebuild or not fmu_set_is_current(fmu):
@@ -200,7 +200,7 @@ def run_scenario(module, name: str, runner, out: Path, quick: bool, thorough: bo
     staging = out / f".{name}.incomplete"
     shutil.rmtree(staging, ignore_errors=True)
     staging.mkdir()
-    from .plots.style import draft_figures  # here, not at the top: matplotlib would slow down `list`
+    from ..plots.style import draft_figures  # here, not at the top: matplotlib would slow down `list`
 
     try:
         options = {"thorough": True} if thorough and accepts_thorough(module) else {}
@@ -247,9 +247,9 @@ def cmd_build(args: argparse.Namespace) -> int:
 def cmd_cross_check(args: argparse.Namespace) -> int:
     """Write the FMI Cross-Check tree into ``args.dir`` and check it (fmpy; with --simulate fmpy as importer;
     with --checker the FMI Compliance Checker). Exit status 1 if a check finds a problem."""
-    from .data import data_path
-    from .fmu.cross_check import case_of, import_with_fmpy, validate_tree, write_tree
-    from .fmu.reference_runs import build_case_fmus
+    from ..data import data_path
+    from ..fmu.cross_check import case_of, import_with_fmpy, validate_tree, write_tree
+    from ..fmu.reference_runs import build_case_fmus
 
     checker = None
     if args.checker is not None:
@@ -279,7 +279,7 @@ def cmd_cross_check(args: argparse.Namespace) -> int:
 def _check_with_compliance_checker(checker: Path, folder: Path, case, root: Path) -> int:
     """Run the FMI Compliance Checker on one FMI 2.0 folder (its log and result go to
     ``DIR/compliance-checker/...``); print its summary; 1 if it reported an error."""
-    from .fmu.compliance_checker import run_checker
+    from ..fmu.compliance_checker import run_checker
 
     if case.fmi_version != "2.0":
         return 0
@@ -298,7 +298,7 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 def cmd_variables(args: argparse.Namespace) -> int:
     """Print the FMU's variables as the Markdown table in docs/fmu.md."""
-    from .component.variables import fmu_variables
+    from ..component.variables import fmu_variables
 
     print("| name | causality | type | unit | start | description |")
     print("|---|---|---|---|---|---|")
@@ -348,8 +348,8 @@ def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: 
 
 def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path, jobs: int) -> list[str]:
     """Build the FMU if needed, then run the scenarios in child processes, ``jobs`` at a time."""
-    from .runs.pool import Costs, run_in_children
-    from .scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF
+    from ..runs.pool import Costs, run_in_children
+    from ..scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF
 
     _load_fmu(args.fmu, args.rebuild).close()  # build once here, and fail early on an unusable FMU
     if args.quick:
@@ -368,7 +368,7 @@ def private_tempdir() -> Iterator[Path]:
     """A temporary folder of this run under ``$TMPDIR``, made the temporary folder of this process and of the
     processes it starts (``TMPDIR``), removed with all it holds at the end, however the run ends; the runners
     this process keeps (:func:`~double_pendulum.analysis.sweep.close_runners`) are closed first."""
-    from .analysis.sweep import close_runners
+    from ..analysis.sweep import close_runners
 
     folder = Path(tempfile.mkdtemp(prefix="double-pendulum-run-"))
     saved_env, saved_tempdir = os.environ.get("TMPDIR"), tempfile.tempdir
@@ -396,8 +396,8 @@ def _run_command(args: argparse.Namespace) -> str:
 def write_run_page(out: Path, args: argparse.Namespace, names: tuple[str, ...], failed: list[str],
                    started: datetime.datetime, wall_s: float, cpu_s: float) -> Path:  # fmt: skip
     """Write ``out/index.html``, the page of this run (:mod:`double_pendulum.runs.page`)."""
-    from .runs.page import RunInfo, write_index
-    from .scenarios import READING_ORDER, page
+    from ..runs.page import RunInfo, write_index
+    from ..scenarios import READING_ORDER, page
 
     mode = "quick" if args.quick else "thorough" if args.thorough else "default"
     run = RunInfo(started, __version__, mode, wall_s, cpu_s, _run_command(args), names, tuple(failed))
@@ -413,7 +413,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     out = _writable_folder(args.out)
     if args.fmu is None:
         args.fmu = str(default_fmu_path(out))
-    from .runs.workers import default_workers  # one scenario per core this process may use
+    from ..runs.workers import default_workers  # one scenario per core this process may use
 
     jobs = min(len(names), args.jobs or default_workers())
     started, start, cpu_start = datetime.datetime.now(datetime.UTC), time.perf_counter(), _cpu_seconds()
@@ -442,8 +442,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     """Run a case of one's own through the FMU (:mod:`double_pendulum.case`): CSV, figure, animation, summary."""
     from fmpy import read_model_description
 
-    from .case import Case, run_case
-    from .fmu.start_values import StartValueError, parse_start_values
+    from ..case import Case, run_case
+    from ..fmu.start_values import StartValueError, parse_start_values
 
     if args.me and args.fmi != "3":
         raise CliError("--me needs --fmi 3: the FMI 2.0 FMU is co-simulation only")
@@ -617,7 +617,3 @@ def entry() -> None:
         code = code or 141
     sys.stderr.flush()
     raise SystemExit(code)
-
-
-if __name__ == "__main__":
-    entry()
