@@ -14,7 +14,8 @@ from double_pendulum.scenarios import SCENARIOS
 
 import double_pendulum
 from double_pendulum.cli import main
-from double_pendulum.cli.run import default_fmu_path, fmu_set, fmu_set_is_current, run_scenario
+from double_pendulum.cli.fmus import default_fmu_path, fmu_set, fmu_set_is_current
+from double_pendulum.cli.run import run_scenario
 from double_pendulum.runs.results_io import read_results_csv
 
 
@@ -183,7 +184,7 @@ def _recorded_runs(monkeypatch) -> list[str]:
     import contextlib
 
     runs: list[str] = []
-    monkeypatch.setattr("double_pendulum.cli.run._load_fmu", lambda path, rebuild: contextlib.nullcontext())
+    monkeypatch.setattr("double_pendulum.cli.run.load_fmu", lambda path, rebuild: contextlib.nullcontext())
     monkeypatch.setattr("double_pendulum.cli.run.run_scenario", lambda module, name, *args: runs.append(name))
     return runs
 
