@@ -14,7 +14,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     """Run a case of one's own through the FMU (:mod:`double_pendulum.case`): CSV, figure, animation, summary."""
     from fmpy import read_model_description
 
-    from ..case import Case, run_case
+    from ..case import Case, run_case, start_state_words
     from ..fmu.start_values import StartValueError, parse_start_values
 
     if args.me and args.fmi != "3":
@@ -35,11 +35,13 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(f"simulating {case.words()} through {fmu} with fmpy ...", flush=True)
         outcome = run_case(case, out, animate=not args.no_animation)
     names = ", ".join(path.name for path in outcome.files)
+    state = f"start state: {start_state_words(outcome.start_state)}"
     if outcome.message is not None:
         print(f"{PROG}: the FMU stopped the run at t = {outcome.summary.get('end_time_s', 0.0):g} s: "
-              f"{outcome.message} (wrote {names} in {out})", file=sys.stderr)
+              f"{outcome.message} (wrote {names} in {out}; {state})", file=sys.stderr)
         return 1
-    print(f"wrote {names} in {out} ({outcome.summary['rows']} rows, {outcome.summary['wall_time_s']:.1f} s)")
+    print(f"wrote {names} in {out} ({outcome.summary['rows']} rows, {outcome.summary['wall_time_s']:.1f} s); "
+          f"{state}")
     return 0
 
 
