@@ -13,7 +13,9 @@ from conftest import quick_run_leftovers, quick_scenario
 from double_pendulum.scenarios import SCENARIOS
 
 import double_pendulum
-from double_pendulum.cli import default_fmu_path, fmu_set, fmu_set_is_current, main, run_scenario
+from double_pendulum.cli import main
+from double_pendulum.cli.fmus import default_fmu_path, fmu_set, fmu_set_is_current
+from double_pendulum.cli.run import run_scenario
 from double_pendulum.runs.results_io import read_results_csv
 
 
@@ -171,7 +173,7 @@ def test_ctrl_c_exits_130_with_one_line(tmp_path, capsys, monkeypatch, fmu_path)
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr("double_pendulum.cli.run_scenario", interrupted)
+    monkeypatch.setattr("double_pendulum.cli.run.run_scenario", interrupted)
     assert main(["run", "free_swing", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 130
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "interrupted" in err
@@ -182,8 +184,8 @@ def _recorded_runs(monkeypatch) -> list[str]:
     import contextlib
 
     runs: list[str] = []
-    monkeypatch.setattr("double_pendulum.cli._load_fmu", lambda path, rebuild: contextlib.nullcontext())
-    monkeypatch.setattr("double_pendulum.cli.run_scenario", lambda module, name, *args: runs.append(name))
+    monkeypatch.setattr("double_pendulum.cli.run.load_fmu", lambda path, rebuild: contextlib.nullcontext())
+    monkeypatch.setattr("double_pendulum.cli.run.run_scenario", lambda module, name, *args: runs.append(name))
     return runs
 
 

@@ -7,6 +7,7 @@ import types
 import pytest
 
 from double_pendulum import cli
+from double_pendulum.cli.run import accepts_thorough
 from double_pendulum.runs import progress
 
 
@@ -44,8 +45,8 @@ def test_thorough_goes_only_to_scenarios_that_take_it_and_excludes_quick(capsys)
     def without(runner, out, *, quick=False):
         return None
 
-    assert cli.accepts_thorough(types.SimpleNamespace(run=with_option))
-    assert not cli.accepts_thorough(types.SimpleNamespace(run=without))
+    assert accepts_thorough(types.SimpleNamespace(run=with_option))
+    assert not accepts_thorough(types.SimpleNamespace(run=without))
     assert cli.main(["run", "free_swing", "--quick", "--thorough"]) == 2
     assert "exclude each other" in capsys.readouterr().err
 
@@ -54,7 +55,7 @@ def test_thorough_goes_only_to_scenarios_that_take_it_and_excludes_quick(capsys)
 def test_the_heavy_scenarios_have_a_thorough_setting(name):
     import importlib
 
-    assert cli.accepts_thorough(importlib.import_module(f"double_pendulum.scenarios.{name}"))
+    assert accepts_thorough(importlib.import_module(f"double_pendulum.scenarios.{name}"))
 
 
 def test_a_loop_cut_short_by_ctrl_c_says_interrupted_not_done(capsys, monkeypatch):

@@ -11,11 +11,13 @@ import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 
-from double_pendulum.case import FILES
+from double_pendulum import case as case_module
+from double_pendulum.case import FILES, START_STATE, start_state, start_state_words
 from double_pendulum.cli import main
 from double_pendulum.fmu.runner import FmuRunner
 from double_pendulum.fmu.start_values import StartValueError, closest_name, parse_start_values
 from double_pendulum.model.outputs import OUTPUT_NAMES
+from double_pendulum.model.parameters import InitialState
 from double_pendulum.runs.results_io import read_results_csv
 
 
@@ -29,15 +31,32 @@ def _one_error_line(capsys) -> str:
     return err
 
 
-def test_a_case_writes_csv_figure_animation_and_summary_with_fmpy_s_numbers(fmu_path, tmp_path, capsys):
+def test_a_case_writes_csv_figure_animation_and_summary_with_fmpy_s_numbers(fmu_path, tmp_path, capsys,
+                                                                             monkeypatch):
+    titles = []
+    plot_case = case_module.plot_case
+    monkeypatch.setattr(case_module, "plot_case", lambda *a, title: titles.append(title) or plot_case(*a, title=title))
     out = tmp_path / "case"
     argv = ["simulate", "--set", "phi1_0=2", "--set", "air_drag=true", "--stop", "3", "--step", "0.02",
             "--fmu", str(fmu_path), "--out", str(out)]
     assert main(argv) == 0
     assert sorted(p.name for p in out.iterdir()) == sorted(FILES)  # nothing else, no staging folder left
-    assert "wrote simulation.csv, simulation.png, simulation.gif, summary.json" in capsys.readouterr().out
+    line = capsys.readouterr().out.splitlines()[-1]
+    assert line.startswith("wrote simulation.csv, simulation.png, simulation.gif, summary.json")
     summary = json.loads((out / "summary.json").read_text())
     assert summary["start_values"] == {"phi1_0": 2.0, "air_drag": True} and summary["status"] == "finished"
+    # the start state it used, all four, the ones not set at the model's defaults: in the line, summary and title
+    defaults = InitialState()
+    state = ("phi1_0 = 2 rad (set), phi2_0 = 1 rad (default), omega1_0 = 0 rad/s (default), "
+             "omega2_0 = 0 rad/s (default)")
+    assert (defaults.phi2_0, defaults.omega1_0, defaults.omega2_0) == (1.0, 0.0, 0.0)
+    assert line.endswith(f"; start state: {state}")
+    assert summary["start_state"] == {
+        "phi1_0": {"value": 2.0, "unit": "rad", "source": "set"},
+        "phi2_0": {"value": defaults.phi2_0, "unit": "rad", "source": "default"},
+        "omega1_0": {"value": defaults.omega1_0, "unit": "rad/s", "source": "default"},
+        "omega2_0": {"value": defaults.omega2_0, "unit": "rad/s", "source": "default"}}
+    assert len(titles) == 1 and f"start state: {state}" in titles[0].splitlines()
     written = read_results_csv(out / "simulation.csv")
     with open(out / "simulation.csv") as fh:
         assert '"time [s]","phi1 [rad]"' in fh.readline()  # units in the column names
@@ -101,8 +120,10 @@ def test_a_value_the_fmu_refuses_is_one_line_with_the_fmu_s_reason(fmu_path, tmp
     assert main(["simulate", "--set", "l1=-1", "--fmu", str(fmu_path), "--out", str(out)]) == 1
     err = _one_error_line(capsys)
     assert "l1" in err and "must be > 0" in err
+    assert "start state: phi1_0 = 1 rad (default), phi2_0 = 1 rad (default)" in err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["status"] == "stopped by the FMU" and "l1" in summary["fmu_message"]
+    assert [entry["source"] for entry in summary["start_state"].values()] == ["default"] * 4
 
 
 def test_an_interrupted_case_changes_nothing_and_leaves_nothing(fmu_path, tmp_path, capsys, monkeypatch):
@@ -140,6 +161,18 @@ def test_set_checks_range_variability_and_type_of_any_fmu():
                            ("d=1", "fixed calculatedParameter"), ("k=1", "set twice")):
         with pytest.raises(StartValueError, match=words.replace(".", r"\.").replace("[", r"\[")):
             parse_start_values(["k=1", setting] if setting == "k=1" else [setting], md)
+
+
+def test_the_start_state_takes_what_was_set_and_the_rest_from_the_model_description():
+    md = _description(_variable("phi1_0", start="0.3", unit="rad"), _variable("omega1_0", start="0", unit="rad/s"),
+                      _variable("phi2_0", start="1.5", declaredType=SimpleNamespace(unit="rad")),
+                      _variable("omega2_0", start="-2", unit="rad/s"), _variable("air_drag", "Boolean", start="false"))
+    state = start_state({"omega1_0": 4, "air_drag": True}, md)
+    assert tuple(value.name for value in state) == START_STATE == ("phi1_0", "phi2_0", "omega1_0", "omega2_0")
+    assert [(value.value, value.unit, value.given) for value in state] == [
+        (0.3, "rad", False), (1.5, "rad", False), (4.0, "rad/s", True), (-2.0, "rad/s", False)]
+    assert start_state_words(state) == ("phi1_0 = 0.3 rad (default), phi2_0 = 1.5 rad (default), "
+                                        "omega1_0 = 4 rad/s (set), omega2_0 = -2 rad/s (default)")
 
 
 def test_the_closest_parameter_is_named_whatever_the_case_of_the_letters():

@@ -9,7 +9,11 @@ numbers are fmpy's, bit for bit, ``summary.json`` says which call gives them) an
 * ``simulation.png``: angles, energies, the energy budget and the bobs' paths, drawn from the CSV file;
 * ``simulation.gif``: the pendulum in real time, drawn from the CSV file (at most the first
   :data:`MAX_ANIMATION_S` seconds);
-* ``summary.json``: the call, the start values, how the run ended and its energies.
+* ``summary.json``: the call, the start values, the start state used, how the run ended and its energies.
+
+The start state it used, all four of :data:`START_STATE` with units, each given or the FMU's default
+(:func:`start_state`), is said in the summary, the figure's title and the command's line: ``--set phi1_0=2``
+alone starts the lower rod at the FMU's ``phi2_0``, which the user did not choose.
 
 The files are made in a folder of their own inside the output folder and moved into it once all are written,
 so an interrupted run changes nothing there and leaves nothing behind. When the FMU stops the run (a bad value
@@ -19,6 +23,7 @@ FMU's message in the summary and the figure.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import shutil
 import tempfile
@@ -32,6 +37,7 @@ import numpy as np
 from .fmu.runner import FmuRunError, FmuRunner
 from .fmu.start_values import value_text
 from .model.outputs import OUTPUT_NAMES
+from .model.parameters import InitialState
 from .plots import animate_swings, swing
 from .plots.case import plot_case
 from .runs.interrupts import acknowledge, interrupted
@@ -42,6 +48,10 @@ MAX_ANIMATION_S = 30.0
 FILES = ("simulation.csv", "simulation.png", "simulation.gif", "summary.json")
 """What :func:`run_case` writes, in that order."""
 FMI_TYPES = {"CoSimulation": "co-simulation", "ModelExchange": "model exchange"}
+START_STATE = tuple(spec.name for spec in dataclasses.fields(InitialState))
+"""The pendulum's start state as the FMU names its parameters: the angles phi1_0, phi2_0 [rad] of the rods from
+the downward vertical and their rates omega1_0, omega2_0 [rad/s] (the model's
+:class:`~double_pendulum.model.parameters.InitialState`)."""
 
 
 @dataclass(frozen=True)
@@ -71,18 +81,54 @@ class Case:
 
 
 @dataclass(frozen=True)
+class StartValue:
+    """One quantity of the start state a run used: its FMU ``name``, ``value`` in ``unit``, and whether the user
+    ``given`` it (``--set``) or it is the FMU's default (the start value of its modelDescription)."""
+
+    name: str
+    value: float
+    unit: str
+    given: bool
+
+    def words(self) -> str:
+        """``phi2_0 = 1 rad (default)``."""
+        return f"{self.name} = {value_text(self.value)} {self.unit} ({'set' if self.given else 'default'})"
+
+
+def start_state(start_values: dict[str, Any], model_description: Any) -> list[StartValue]:
+    """The start state (:data:`START_STATE`) a run of an FMU of ``model_description`` (fmpy's) with
+    ``start_values`` begins from: each value given, else the variable's start value in the modelDescription,
+    with the variable's unit."""
+    variables = {v.name: v for v in model_description.modelVariables}
+    state = []
+    for name in START_STATE:
+        variable = variables[name]
+        unit = variable.unit or (variable.declaredType.unit if variable.declaredType else None) or ""
+        given = name in start_values
+        state.append(StartValue(name, float(start_values[name] if given else variable.start), unit, given))
+    return state
+
+
+def start_state_words(state: list[StartValue]) -> str:
+    """The start state in a line: ``phi1_0 = 2 rad (set), phi2_0 = 1 rad (default), ...``."""
+    return ", ".join(value.words() for value in state)
+
+
+@dataclass(frozen=True)
 class Outcome:
     """What :func:`run_case` wrote (``files`` in the output folder) and the run's ``summary``; ``message``: why the
-    FMU stopped the run (None if it ran to the stop time)."""
+    FMU stopped the run (None if it ran to the stop time); ``start_state``: the start state it used."""
 
     files: list[Path]
     summary: dict[str, Any]
     message: str | None
+    start_state: list[StartValue]
 
 
-def _summary(case: Case, runner: FmuRunner, result: np.ndarray | None, message: str | None,
-             wall_s: float) -> dict[str, Any]:  # fmt: skip
-    """``summary.json``: the call, the case and how the run ended, with the energies of the rows returned."""
+def _summary(case: Case, runner: FmuRunner, state: list[StartValue], result: np.ndarray | None,
+             message: str | None, wall_s: float) -> dict[str, Any]:  # fmt: skip
+    """``summary.json``: the call, the case, the start state used (each quantity's value, unit and ``set`` or
+    ``default``) and how the run ended, with the energies of the rows returned."""
     md = runner.model_description
     experiment = md.defaultExperiment
     summary: dict[str, Any] = {
@@ -92,6 +138,8 @@ def _summary(case: Case, runner: FmuRunner, result: np.ndarray | None, message: 
         "fmi_version": md.fmiVersion,
         "fmi_type": case.fmi_type,
         "start_values": case.start_values,
+        "start_state": {value.name: {"value": value.value, "unit": value.unit,
+                                     "source": "set" if value.given else "default"} for value in state},
         "stop_time_s": case.stop_time,
         "output_interval_s": case.output_interval,
         "status": "finished" if message is None else "stopped by the FMU",
@@ -115,18 +163,20 @@ def _summary(case: Case, runner: FmuRunner, result: np.ndarray | None, message: 
     return summary
 
 
-def _title(case: Case, summary: dict[str, Any]) -> str:
+def _title(case: Case, state: list[StartValue], summary: dict[str, Any]) -> str:
+    """The figure's title: the case, the start state it used (given or default), how the run ended."""
     kind = FMI_TYPES.get(case.fmi_type, case.fmi_type)
     line = f"your case: {case.words()}, FMI {summary['fmi_version']} {kind} through fmpy"
+    line += f"\nstart state: {start_state_words(state)}"
     if summary["fmu_message"] is not None:
         line += f"\nstopped by the FMU at t = {summary.get('end_time_s', 0.0):g} s: {summary['fmu_message']}"
     return line
 
 
-def _draw(folder: Path, case: Case, summary: dict[str, Any], animate: bool) -> None:
+def _draw(folder: Path, case: Case, state: list[StartValue], summary: dict[str, Any], animate: bool) -> None:
     """The figure and the animation, drawn from ``simulation.csv`` as written."""
     result = read_results_csv(folder / "simulation.csv")
-    plot_case(result, folder / "simulation.png", title=_title(case, summary))
+    plot_case(result, folder / "simulation.png", title=_title(case, state, summary))
     rows = result["time"] <= MAX_ANIMATION_S + 1e-9
     if animate and rows.sum() > 1:
         shown = float(result["time"][rows][-1])
@@ -155,10 +205,12 @@ def run_case(case: Case, out: Path, *, animate: bool = True) -> Outcome:
                 if interrupted():
                     raise KeyboardInterrupt from None
                 result, message = error.partial_result, str(error).split(" -- FMU says: ")[-1]
-            summary = _summary(case, runner, result, message, time.perf_counter() - start)
+            wall_s = time.perf_counter() - start
+            state = start_state(case.start_values, runner.model_description)
+            summary = _summary(case, runner, state, result, message, wall_s)
             if result is not None and len(result):
                 write_results_csv(staging / "simulation.csv", result, runner.units)
-                _draw(staging, case, summary, animate)
+                _draw(staging, case, state, summary, animate)
         write_json(staging / "summary.json", summary)
         written = []
         for name in FILES:  # this run's set replaces an earlier run's whole: no file of that one stays beside it
@@ -167,7 +219,7 @@ def run_case(case: Case, out: Path, *, animate: bool = True) -> Outcome:
                 written.append(out / name)
             else:
                 (out / name).unlink(missing_ok=True)
-        return Outcome(written, summary, message)
+        return Outcome(written, summary, message, state)
     except KeyboardInterrupt:
         acknowledge()  # the run stops here: a repeated interrupt must not cut the clean-up below short
         raise

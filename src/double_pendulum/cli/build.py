@@ -1,0 +1,101 @@
+"""``double-pendulum build`` (the FMUs) and ``double-pendulum cross-check`` (the FMI Cross-Check tree of the
+reference cases, checked by fmpy and, if given, the FMI Compliance Checker)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from pathlib import Path
+
+from ..fmu.build import DEFAULT_FMU_PATH, build_all
+from ..fmu.loader import LoaderUnavailable
+from .common import CliError, private_tempdir, writable_folder
+
+
+def cmd_build(args: argparse.Namespace) -> int:
+    print(f"building the FMUs next to {args.output} ...", flush=True)
+    try:
+        paths = build_all(args.output)
+    except LoaderUnavailable as error:
+        raise CliError(f"cannot build the FMUs: {error}") from None
+    except OSError as error:
+        raise CliError(f"cannot build the FMUs at {args.output}: {error.strerror or error}") from None
+    for path in paths:
+        print(f"built {path}")
+    return 0
+
+
+def cmd_cross_check(args: argparse.Namespace) -> int:
+    """Write the FMI Cross-Check tree into ``args.dir`` and check it (fmpy; with --simulate fmpy as importer;
+    with --checker the FMI Compliance Checker). Exit status 1 if a check finds a problem."""
+    from ..data import data_path
+    from ..fmu.cross_check import case_of, import_with_fmpy, validate_tree, write_tree
+    from ..fmu.reference_runs import build_case_fmus
+
+    checker = None
+    if args.checker is not None:
+        checker = Path(args.checker)
+        if not (checker.is_file() and os.access(checker, os.X_OK)):
+            raise CliError(f"--checker {args.checker}: not an executable file (the FMI Compliance Checker, "
+                           "fmuCheck.linux64)")
+    root = writable_folder(args.dir, "give another DIR")
+    print(f"building the cross-check FMUs and writing {root / 'fmus'} ...", flush=True)
+    with private_tempdir() as tmp:
+        folders = write_tree(root, build_case_fmus(tmp / "fmus"), data_path("reference/fmu"))
+        count, problems = validate_tree(root)
+        print(f"{len(folders)} FMU folders written; fmpy's cross-check validator checked {count}: "
+              f"{len(problems)} problems", flush=True)
+        failed = len(problems)
+        for problem in problems:
+            print(f"  {problem}", file=sys.stderr)
+        for folder in folders if args.simulate else ():
+            _, problem = import_with_fmpy(folder)
+            failed += problem is not None
+            print(f"  fmpy as importer, {folder.relative_to(root / 'fmus')}: {problem or 'passed'}", flush=True)
+        for folder in folders if checker else ():
+            failed += _check_with_compliance_checker(checker, folder, case_of(folder), root)
+    return 1 if failed else 0
+
+
+def _check_with_compliance_checker(checker: Path, folder: Path, case, root: Path) -> int:
+    """Run the FMI Compliance Checker on one FMI 2.0 folder (its log and result go to
+    ``DIR/compliance-checker/...``); print its summary; 1 if it reported an error."""
+    from ..fmu.compliance_checker import run_checker
+
+    if case.fmi_version != "2.0":
+        return 0
+    out = root / "compliance-checker" / folder.relative_to(root / "fmus")
+    report = run_checker(checker, folder, case, out)
+    bad = report.errors + report.fatal + (report.returncode != 0)
+    print(f"  FMI Compliance Checker, {folder.relative_to(root / 'fmus')}: {report.warnings} warnings, "
+          f"{report.errors} errors{f', {report.fatal} fatal' if report.fatal else ''} (log: {out})", flush=True)
+    return int(bool(bad))
+
+
+def add_build_parser(sub: argparse._SubParsersAction) -> None:
+    """``build``'s options."""
+    p_build = sub.add_parser("build", help="build DoublePendulum.fmu, Suspension.fmu, the coupled system and "
+                             "fmi3/DoublePendulum.fmu",
+                             description="Build DoublePendulum.fmu and, next to it, Suspension.fmu, "
+                             "PendulumOnSuspension.ssp (SSP, for libcosim), PendulumOnSuspension.fmu "
+                             "(fmpy's container FMU) and fmi3/DoublePendulum.fmu (FMI 3.0, Model Exchange and "
+                             "Co-Simulation).")
+    p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="DoublePendulum FMU path or folder")
+    p_build.set_defaults(func=cmd_build)
+
+
+def add_cross_check_parser(sub: argparse._SubParsersAction) -> None:
+    """``cross-check``'s options."""
+    p_cross = sub.add_parser(
+        "cross-check", help="write the FMI Cross-Check tree of the FMUs (with reference results) and check it",
+        description="Build the FMUs of the reference cases and write DIR/fmus/<2.0|3.0>/<cs|me>/linux64/"
+        "double-pendulum-fmu/<version>/<Model>/ with the FMU, <Model>_ref.csv, _ref.opt, _in.csv and ReadMe.md "
+        "(FMI Cross-Check rules v4.1), then validate it with fmpy's cross-check validator.")
+    p_cross.add_argument("dir", metavar="DIR", help="the cross-check repository (or any folder) to write into")
+    p_cross.add_argument("--simulate", action="store_true",
+                         help="also run every FMU in fmpy as an importer and compare with its reference")
+    p_cross.add_argument("--checker", metavar="PATH", default=None,
+                         help="also run the FMI Compliance Checker (fmuCheck.linux64) on every FMI 2.0 FMU with its "
+                         "input file; logs go to DIR/compliance-checker/")
+    p_cross.set_defaults(func=cmd_cross_check)
