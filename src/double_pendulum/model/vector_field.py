@@ -68,17 +68,15 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, NamedTuple
+from typing import NamedTuple
 
 from .codegen import compile_function
 from .dynamics import LINK_ACCELERATIONS, fixed_pivot_vector_field
 from .energy import kinetic_energy_moving_pivot, potential_energy, suspension_energy
 from .forces import bearing_drag_torque, bearing_torque, quadratic_drag, rod_drag_integrals
+from .inputs import InputHold, InputValues
 from .links import link_coefficients, plate_lengths
 from .parameters import AirDragParameters, BearingParameters, PendulumParameters, SuspensionParameters
-
-if TYPE_CHECKING:
-    from .inputs import InputHold, InputValues
 
 MAX_FRICTION_ITERATIONS = 50
 
