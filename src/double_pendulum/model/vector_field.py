@@ -70,7 +70,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import NamedTuple
 
-from .codegen import compile_function
+from ..codegen import compile_function
 from .dynamics import LINK_ACCELERATIONS, fixed_pivot_vector_field
 from .energy import kinetic_energy_moving_pivot, potential_energy, suspension_energy
 from .forces import bearing_drag_torque, bearing_torque, quadratic_drag, rod_drag_integrals
@@ -384,7 +384,7 @@ ma_x = m1 * acc1x + m2 * acc2x + hr1 * (axs + acc1x) + hr2 * (acc1x + acc2x)
 ma_y = m1 * acc1y + m2 * acc2y + hr1 * (ays + acc1y) + hr2 * (acc1y + acc2y)
 """
 """Bob accelerations and the rate of change of the pendulum's momentum, as a snippet
-(:mod:`~double_pendulum.model.codegen`; see :func:`_momentum_rate_function`)."""
+(:mod:`~double_pendulum.codegen`; see :func:`_momentum_rate_function`)."""
 
 
 def _momentum_constants(p: PendulumParameters) -> dict[str, float]:
