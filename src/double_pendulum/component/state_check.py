@@ -38,7 +38,7 @@ from ..model import suspension as _suspension
 from ..model.inputs import INPUT_NAMES
 from ..model.outputs import OUTPUT_NAMES
 from ..model.parameters import ParameterError, check_value
-from ..model.vector_field import every_state
+from ..model.scene import every_state
 from ..solvers.integrator import LANDING_REST, Integrator
 from ..solvers.registry import METHODS
 from .settings import PIVOT_INPUT_MODES
