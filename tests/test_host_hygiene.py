@@ -202,6 +202,8 @@ def test_thousands_of_instantiate_free_cycles_in_fmpy_cost_no_memory(unzipped, t
           f"RSS {readings[500][0]:.0f} -> {readings[3500][0]:.0f} KiB")
     assert result["alive"] == 1
     assert all(slaves == 0 for _, slaves, _ in readings.values()), readings
-    tracked = [objects for _, _, objects in readings.values()]
+    # after the warm-up, as the slope: the interpreter's first full (generation 2) collection falls in the
+    # warm-up, near cycle 250, and frees or untracks import-time objects once (~590 fewer tracked, then flat)
+    tracked = [objects for k, (_, _, objects) in readings.items() if k >= 500]
     assert max(tracked) - min(tracked) < 50, readings
     assert slope < 0.2, readings

@@ -22,7 +22,7 @@ from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.component.model_exchange import PendulumStates
 from double_pendulum.component.state_check import SHOWN_LENGTH, StateError
 from double_pendulum.component.suspension import SuspensionCoSimulation
-from double_pendulum.model.vector_field import ModelError
+from double_pendulum.model.scene import ModelError
 from double_pendulum.solvers import METHODS
 
 STEP = 0.01

@@ -5,7 +5,8 @@ The runtime, which the FMU bundles and runs (pure Python, standard library only)
 * :mod:`.model` -- parameters, kinematics, equations of motion, forces, energies, the assembled
   vector field and the outputs;
 * :mod:`.solvers` -- the integrators, separate from the vector field;
-* :mod:`.component` -- the co-simulation component the FMU adapter drives, and its variables.
+* :mod:`.component` -- the co-simulation component the FMU adapter drives, and its variables;
+* :mod:`.codegen` -- the one code generator of the model's and the solvers' straight-line functions.
 
 What studies it (NumPy, SciPy, Matplotlib, fmpy; never bundled):
 

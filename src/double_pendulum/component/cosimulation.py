@@ -47,10 +47,10 @@ from ..model.parameters import (
     SuspensionParameters,
     check_value,
 )
+from ..model.scene import ModelError
 from ..model.vector_field import (
     Model,
     ModelConfig,
-    ModelError,
     build_model,
     build_vector_field,
     energies,

@@ -8,7 +8,7 @@ field (:func:`double_pendulum.model.vector_field.build_vector_field`, the same f
 co-simulation integrates), nothing re-derived here.
 
 **Continuous states** :data:`STATES`: every state any scene can have, in the order of
-:func:`~double_pendulum.model.vector_field.state_layout`,
+:func:`~double_pendulum.model.scene.state_layout`,
 
 .. math::
 
@@ -44,6 +44,7 @@ from typing import Any
 
 from ..model import inputs as _inputs
 from ..model import vector_field as _vector_field
+from ..model.scene import every_state
 from . import cosimulation as _cosimulation
 from . import state_check as _state_check
 
@@ -51,7 +52,7 @@ InputHold, InputValues, INPUT_NAMES = _inputs.InputHold, _inputs.InputValues, _i
 INPUT_ZEROS = _inputs.ZERO_INPUTS
 
 
-STATES: tuple[str, ...] = _vector_field.every_state()
+STATES: tuple[str, ...] = every_state()
 # The suspension's states are not the outputs xs, ys, vxs, vys: those report the prescribed pivot
 # (an input) in a direction without a suspension state. These are the suspension mass's own.
 LOCAL_STATES = {"xs": "suspension.x", "vxs": "suspension.vx", "ys": "suspension.y", "vys": "suspension.vy"}

@@ -38,7 +38,7 @@ from ..model import suspension as _suspension
 from ..model.inputs import INPUT_NAMES
 from ..model.outputs import OUTPUT_NAMES
 from ..model.parameters import ParameterError, check_value
-from ..model.vector_field import every_state
+from ..model.scene import every_state
 from ..solvers.integrator import LANDING_REST, Integrator
 from ..solvers.registry import METHODS
 from .settings import PIVOT_INPUT_MODES
@@ -274,7 +274,7 @@ def integrator_state(parent: str, key: Key, value: Any, solver: str, size: int) 
     s = entries(parent, key, value, INTEGRATOR_KEYS)
     path = item(parent, key)
     method = METHODS[solver]
-    landing = getattr(method, "landing_method", None)
+    landing = method.landing_method
     times = (s["t0"], s["t_prev"], s["t"], s["h"])
     if not _floats(times, True):
         for name in ("t0", "t_prev", "t", "h"):
@@ -288,7 +288,7 @@ def integrator_state(parent: str, key: Key, value: Any, solver: str, size: int) 
     fy = s["fy"]
     if fy is not None:
         numbers(path, "fy", fy, size, finite=method.adaptive)
-    elif not getattr(method, "deferrable_f_new", False):
+    elif not method.deferrable_f_new:
         fail(path, "fy", fy, f"but {solver} never defers f(t, y)")
     rest_limit = LANDING_REST if landing is not None else 0
     nfev, n_steps, n_rejected, grid_start, rest = (

@@ -14,7 +14,8 @@ from typing import Any, NamedTuple
 
 from ..model import suspension
 from ..model.inputs import INPUTS
-from ..model.outputs import INPUT_DEPENDENCIES, OUTPUTS, PORT_NAMES, Quantity
+from ..model.outputs import INPUT_DEPENDENCIES, OUTPUTS, PORT_NAMES
+from ..model.quantities import Quantity
 from .cosimulation import PARAMETER_GROUPS
 from .suspension import INPUT_START, PARAMETER_FIELDS
 

@@ -53,7 +53,7 @@ from . import bundle, loader, presets
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
-RUNTIME_SUBPACKAGES = ("model", "solvers", "component")
+RUNTIME_SUBPACKAGES = ("model", "solvers", "component", "codegen")
 DEFAULT_FMU_PATH = Path("build") / f"{MODEL_IDENTIFIER}.fmu"
 
 # SI base-unit exponents of every unit the interfaces use (FMI 2.0 section 2.2.2, FMI 3.0 2.4.3).

@@ -34,7 +34,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from .codegen import compile_function
+from ..codegen import compile_function
 from .links import link_coefficients
 from .parameters import PendulumParameters
 
@@ -50,7 +50,7 @@ alpha1 = (b1 * j2 - a12 * b2) / det
 alpha2 = (j1 * b2 - a12 * b1) / det
 """
 """The equations above solved for :math:`(\\ddot\\varphi_1, \\ddot\\varphi_2)` = ``(alpha1, alpha2)``
-[rad/s^2] by Cramer's rule, as a snippet (:mod:`double_pendulum.model.codegen`): from ``phi1, phi2``
+[rad/s^2] by Cramer's rule, as a snippet (:mod:`double_pendulum.codegen`): from ``phi1, phi2``
 [rad], ``omega1, omega2`` [rad/s], ``q1, q2`` [N m] and the coefficients ``j1, j2, k`` [kg m^2],
 ``gs1, gs2`` [N m]. The one copy of these equations: :func:`link_accelerations` and the fast
 vector fields are compiled from it."""

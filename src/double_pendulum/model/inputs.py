@@ -45,7 +45,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import NamedTuple
 
-from .outputs import Quantity
+from .quantities import Quantity
 
 INPUTS: tuple[Quantity, ...] = (
     Quantity(

@@ -15,23 +15,11 @@ the pivot's motion and the pivot force depend on them directly (see :data:`INPUT
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, NamedTuple
-
+from .inputs import InputValues
 from .kinematics import positions
 from .links import link_coefficients
-from .vector_field import Model
-
-if TYPE_CHECKING:
-    from .inputs import InputValues
-
-
-class Quantity(NamedTuple):
-    """An output variable: name, unit (FMI unit string) and description."""
-
-    name: str
-    unit: str
-    description: str
-
+from .quantities import Quantity
+from .vector_field import Model, energies
 
 OUTPUTS: tuple[Quantity, ...] = (
     Quantity("phi1", "rad", "angle of the upper rod from the downward vertical"),
@@ -120,8 +108,6 @@ def energy_outputs(
 
     ``initial_energy`` is E_total at the start; ``None`` means this state is the start.
     """
-    from .vector_field import energies
-
     e_kin, e_pot, e_sus = energies(model.config, y, model.layout, u)
     e_pend = e_kin + e_pot
     e_total = e_pend + e_sus

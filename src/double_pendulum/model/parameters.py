@@ -245,14 +245,6 @@ class InitialState(Validated):
         return [self.phi1_0, self.phi2_0, self.omega1_0, self.omega2_0]
 
 
-def field_specs(cls: type) -> list[tuple[str, Any, str, str, str]]:
-    """Return ``(name, default, unit, description, rule)`` for every field of ``cls``."""
-    return [
-        (f.name, f.default, f.metadata["unit"], f.metadata["description"], f.metadata["rule"])
-        for f in fields(cls)
-    ]
-
-
 @dataclass(frozen=True)
 class SuspensionLoad(Validated):
     """The static load of the stand-alone ``Suspension`` FMU (see :mod:`double_pendulum.model.suspension`).

@@ -37,8 +37,8 @@ from collections.abc import Callable
 from typing import NamedTuple
 
 from .energy import suspension_energy
-from .outputs import Quantity
 from .parameters import SuspensionLoad, SuspensionParameters
+from .quantities import Quantity
 
 STATE_NAMES = ("x", "vx", "y", "vy", "W_suspension", "W_in")
 PARAMETER_NAMES = ("M_s", "k_x", "k_y", "c_x", "c_y")  # taken from SuspensionParameters

@@ -1,7 +1,7 @@
 """Integrators, kept apart from the right-hand sides they integrate.
 
-* :mod:`.runge_kutta` — explicit methods (one step, error estimate, dense output) and the
-  method interface;
+* :mod:`.method` — the contract every method keeps (:class:`~.method.Method`);
+* :mod:`.runge_kutta` — explicit methods (one step, error estimate, dense output);
 * :mod:`.rosenbrock` — Rodas4, linearly implicit and L-stable, for stiff scenes;
 * :mod:`.gauss` — Gauss-Legendre collocation (symmetric, energy error bounded over long runs);
 * :mod:`.linalg` — the small dense LU they need;

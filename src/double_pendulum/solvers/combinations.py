@@ -3,13 +3,14 @@
 An explicit Runge-Kutta step is dominated by sums like ``y + h * sum_j a_ij k_j`` over a handful
 of components: as Python loops they cost more than the right-hand sides themselves. This module
 writes each such sum out as one straight-line Python expression per component, with the
-coefficients as literals, compiles it with :func:`compile` and caches the function by
-``(coefficients, n)``. The arithmetic is exactly the loop's, in the same order (results are
+coefficients as literals, compiles it with the runtime's one code generator
+(:func:`double_pendulum.codegen.define`) and caches the function by ``(coefficients, n)``.
+The arithmetic is exactly the loop's, in the same order (results are
 bit-identical); only the interpreter overhead goes (the stage sums of a DOP853 step on the
 pendulum's 4 states: about 6.5 us instead of 12).
 
 The generated source contains nothing but float literals, indices and the argument names, so it
-is safe to ``exec``.
+is safe to compile and run.
 """
 
 from __future__ import annotations
@@ -17,7 +18,8 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from functools import cache
-from typing import Any
+
+from ..codegen import define
 
 SparseRow = tuple[tuple[int, float], ...]
 
@@ -26,19 +28,9 @@ def _terms(row: SparseRow, c: int) -> str:
     return " + ".join(f"{a!r} * k{j}[{c}]" for j, a in row) or "0.0"
 
 
-def _define(source: str, name: str, **globals_: Any) -> Callable:
-    """The function ``name`` that ``source`` defines, with ``globals_`` as its globals.
-
-    Every source here is generated from float literals, indices and argument names only.
-    """
-    namespace: dict = dict(globals_)
-    exec(compile(source, f"<{name}>", "exec"), namespace)  # noqa: S102 - literals and indices only
-    return namespace[name]
-
-
 def _compile(name: str, args: str, row: SparseRow, body: str) -> Callable:
     unpack = "".join(f"    k{j} = ks[{j}]\n" for j in sorted({j for j, _ in row}))
-    return _define(f"def {name}({args}):\n{unpack}    return [{body}]\n", name)
+    return define(f"def {name}({args}):\n{unpack}    return [{body}]\n", name)
 
 
 @cache
@@ -54,7 +46,7 @@ def step_combination(row: SparseRow, n: int) -> Callable[[list[float], float, Se
     )
     unpack = "".join(f"    k{j} = ks[{j}]\n" for j in sorted({j for j, _ in row}))
     source = f"def stage(y, h, ks):\n{unpack}{scaled}    return [{body}]\n"
-    return _define(source, "stage")
+    return define(source, "stage")
 
 
 @cache
@@ -89,7 +81,7 @@ def explicit_stages(a: tuple[SparseRow, ...], c: tuple[float, ...], n_stages: in
         source += scaled + f"    k{i} = f(t + {c[i]!r} * h, {state})\n" + unpack(f"k{i}")
     scaled, y_new = combination(b, "hb")
     source += scaled + f"    return {y_new}, [{', '.join(f'k{i}' for i in range(n_stages))}]\n"
-    return _define(source, "stages")
+    return define(source, "stages")
 
 
 @cache
@@ -110,7 +102,7 @@ def scaled_error_norm(row: SparseRow, n: int) -> Callable[..., float]:
         lines.append(f"    s{c} = atol + rtol * (b{c} if b{c} > a{c} else a{c})")
         terms.append(f"(e{c} / s{c}) ** 2")
     lines.append(f"    return sqrt((0.0 + {' + '.join(terms)}) / {n})")
-    return _define("\n".join(lines) + "\n", "norm", sqrt=math.sqrt)
+    return define("\n".join(lines) + "\n", "norm", {"sqrt": math.sqrt})
 
 
 def dense_columns(
@@ -138,7 +130,7 @@ def dense_columns(
         hermite = [f"2.0 * dy{c} - h * (fy[{c}] + f_new[{c}])", f"h * fy[{c}] - dy{c}", f"dy{c}"]
         columns.append(f"({', '.join([*reversed(ds), *hermite])})")
     source += f"    return [{', '.join(columns)}]\n"
-    return _define(source, "dense")
+    return define(source, "dense")
 
 
 @cache
@@ -163,7 +155,7 @@ def two_estimate_error_norm(row5: SparseRow, row3: SparseRow, n: int) -> Callabl
     lines.append("    if n5 == 0.0 and n3 == 0.0:")
     lines.append("        return 0.0")
     lines.append(f"    return abs(h) * n5 / sqrt((n5 + 0.01 * n3) * {n})")
-    return _define("\n".join(lines) + "\n", "norm", sqrt=math.sqrt)
+    return define("\n".join(lines) + "\n", "norm", {"sqrt": math.sqrt})
 
 
 def sparse(weights: Sequence[float]) -> SparseRow:
@@ -192,4 +184,4 @@ def alternating_horner(n: int, m: int) -> Callable[[Sequence[Sequence[float]], S
             expr = f"{expr} * {'x' if i % 2 == 0 else 'u'}"
         results.append(f"{expr} + y[{c}]")
     lines.append(f"    return [{', '.join(results)}]")
-    return _define("\n".join(lines) + "\n", "horner")
+    return define("\n".join(lines) + "\n", "horner")

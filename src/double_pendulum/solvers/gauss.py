@@ -56,10 +56,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import ClassVar
 
 from .combinations import sparse
 from .integrator import SolverError
-from .runge_kutta import VectorField, _stage_input, hermite_interpolant
+from .method import Method, VectorField
+from .runge_kutta import _stage_input, hermite_interpolant
 
 MAX_ITERATIONS = 100
 ROUNDING_LEVEL = 1e-13  # largest relative increment still taken as rounding noise
@@ -85,24 +87,21 @@ def _relative_change(old: list[list[float]], new: list[list[float]], y: list[flo
     return worst
 
 
-class GaussLegendre:
-    """Base class of the ``s``-stage Gauss-Legendre methods; subclasses give the tableau.
+class GaussLegendre(Method):
+    """Base class of the ``s``-stage Gauss-Legendre methods; subclasses give the tableau, ``name``,
+    ``order``, ``dense_order``, ``n_stages`` and ``evals_per_step``.
 
     ``evals_per_step`` is set by every :meth:`step` to the evaluations of that call:
-    ``s`` per fixed-point iteration plus ``f(t + h, y_new)``.
+    ``s`` per fixed-point iteration plus ``f(t + h, y_new)``; the class value is the fewest (one
+    iteration).
     """
 
-    name = ""
     adaptive = False
-    order = 0
-    error_order = 0
-    dense_order = 0
-    evals_per_step = 0
+    error_order = None
     dense_evals = 0
-    n_stages = 0  # len(C), set by each subclass
-    C: tuple[float, ...] = ()
-    A: tuple[tuple[float, ...], ...] = ()
-    B: tuple[float, ...] = ()
+    C: ClassVar[tuple[float, ...]]
+    A: ClassVar[tuple[tuple[float, ...], ...]]
+    B: ClassVar[tuple[float, ...]]
 
     def __init__(self) -> None:
         self._a_rows = tuple(sparse(row) for row in self.A)
@@ -163,6 +162,7 @@ class Gauss2(GaussLegendre):
 
     name = "gauss2"
     n_stages = 1
+    evals_per_step = 2
     order = 2
     dense_order = 2  # the Hermite interpolant inherits the O(h^3) local error of y_new
     C = (0.5,)
@@ -175,6 +175,7 @@ class Gauss4(GaussLegendre):
 
     name = "gauss4"
     n_stages = 2
+    evals_per_step = 3
     order = 4
     dense_order = 3
     C = (0.5 - _R3 / 6.0, 0.5 + _R3 / 6.0)

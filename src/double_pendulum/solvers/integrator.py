@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .runge_kutta import VectorField
+from .method import Method, VectorField
 
 SAFETY = 0.9
 MIN_FACTOR = 0.2
@@ -66,7 +66,7 @@ class Integrator:
         f: VectorField,
         t0: float,
         y0: list[float],
-        method: Any,
+        method: Method,
         *,
         rtol: float = 1e-9,
         atol: float = 1e-12,
@@ -98,7 +98,7 @@ class Integrator:
         self.fy_prev = list(self.fy)
         self.stages: list[list[float]] = []
         self._interp = None
-        self.landing_method = getattr(method, "landing_method", None)
+        self.landing_method = method.landing_method
         self.last_method = method  # the method of the last step (its dense output)
         self.landing_rest = 0
         if method.adaptive:
@@ -192,7 +192,7 @@ class Integrator:
                     f"{method.name}: step size underflow (h = {h:.3g} s) at t = {self.t:.6g} s; "
                     "the problem may be stiff or the state has blown up"
                 )
-            if landing and getattr(method, "deferrable_f_new", False):
+            if landing and method.deferrable_f_new:
                 # f(t_stop, y_new) waits until needed: a restart at t_stop replaces it (FSAL saved)
                 y_new, f_new, stages = method.step(self.f, self.t, self.y, self.fy, h, with_f_new=False)
                 self.nfev += method.evals_per_step - 1

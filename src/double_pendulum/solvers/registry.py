@@ -6,10 +6,11 @@ from typing import Any
 
 from .gauss import Gauss2, Gauss4
 from .integrator import Integrator
+from .method import Method, VectorField
 from .rosenbrock import Rodas4
-from .runge_kutta import ClassicRK4, Dop853, Dopri5, ExplicitEuler, VectorField
+from .runge_kutta import ClassicRK4, Dop853, Dopri5, ExplicitEuler
 
-METHODS: dict[str, type] = {
+METHODS: dict[str, type[Method]] = {
     "dop853": Dop853,
     "dopri5": Dopri5,
     "rk4": ClassicRK4,
@@ -30,8 +31,8 @@ def check_solver_name(name: str) -> None:
         raise UnknownSolverError(f"invalid solver = {name!r}: must be one of {', '.join(sorted(METHODS))}")
 
 
-def make_method(name: str) -> Any:
-    """Return a fresh method object for ``name``."""
+def make_method(name: str) -> Method:
+    """Return a fresh method object for ``name`` (it keeps the :class:`~.method.Method` contract)."""
     check_solver_name(name)
     return METHODS[name]()
 

@@ -66,7 +66,8 @@ import math
 from collections.abc import Callable, Sequence
 
 from .linalg import LUDecomposition, SingularMatrixError, lu_factor
-from .runge_kutta import VectorField, _stage_input, scaled_rms
+from .method import AdaptiveMethod, VectorField
+from .runge_kutta import _stage_input, scaled_rms
 
 GAMMA = 0.25
 ALPHA = (0.0, 0.386, 0.21, 0.63, 1.0, 1.0)
@@ -158,7 +159,7 @@ def iteration_matrix(jac: Sequence[Sequence[float]], diagonal: float) -> list[li
     return out
 
 
-class Rodas4:
+class Rodas4(AdaptiveMethod):
     """Hairer-Wanner's RODAS: Rosenbrock 4(3), stiffly accurate, L-stable, 3rd-order dense output.
 
     ``evals_per_step`` is set by every :meth:`step` to the evaluations of that call: 6 (five

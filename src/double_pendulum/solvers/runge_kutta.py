@@ -1,23 +1,11 @@
 """Explicit Runge-Kutta methods over Python lists of floats.
 
-Each method is a small object with the same interface (the integrator in
-:mod:`double_pendulum.solvers.integrator` drives any of them):
-
-* ``step(f, t, y, fy, h)`` -> ``(y_new, f_new, stages)``: one step of size ``h`` from ``(t, y)``
-  with ``fy = f(t, y)`` given, returning the new state, ``f(t + h, y_new)`` (reused as the first
-  stage of the next step) and the stage derivatives needed by the error estimate and the
-  dense output;
-* ``error_norm(y, y_new, stages, h, rtol, atol)`` (adaptive methods): the scaled RMS norm of the
-  local error estimate, a step is accepted when it is <= 1;
-* ``interpolant(f, t, y, y_new, fy, f_new, h, stages)`` -> ``g(theta)``: the continuous
-  extension on ``t + theta * h``, ``0 <= theta <= 1``, of the order given by ``dense_order``.
-
-Attributes: ``name``, ``adaptive``, ``order``, ``error_order`` (order of the error estimate),
-``dense_order``, ``evals_per_step`` (right-hand side evaluations of one ``step`` call; the
-integrator reads it after each call, so a method whose cost varies, e.g. with a Jacobian or an
-iteration, sets it in ``step``), ``dense_evals`` (evaluations of one ``interpolant`` call) and
-``n_stages`` (how many vectors ``step`` returns as its stages; a saved integrator state has as many,
-:mod:`double_pendulum.component.state_check`).
+Each method keeps the contract of :mod:`double_pendulum.solvers.method` (:class:`~.method.Method`,
+adaptive ones :class:`~.method.AdaptiveMethod`), which the integrator in
+:mod:`double_pendulum.solvers.integrator` drives: ``step``, ``interpolant`` (dense output),
+``error_norm`` (adaptive methods), and the attributes ``name``, ``adaptive``, ``order``,
+``error_order`` (``None`` for a fixed step), ``dense_order``, ``evals_per_step``, ``dense_evals``,
+``n_stages``.
 The implicit methods are in :mod:`.rosenbrock` (stiff) and :mod:`.gauss` (symplectic).
 
 Lists of floats are used instead of NumPy arrays: for a state of 4 to 11 components a Python
@@ -41,8 +29,8 @@ from .combinations import (
     two_estimate_error_norm,
     weighted_sum,
 )
+from .method import AdaptiveMethod, Method, VectorField
 
-VectorField = Callable[[float, list[float]], list[float]]
 SparseRows = Sequence[Sequence[tuple[int, float]]]
 
 
@@ -79,11 +67,6 @@ def _stage_input(y: list[float], h: float, row: Sequence[tuple[int, float]], ks:
     return step_combination(row if isinstance(row, tuple) else tuple(row), len(y))(y, h, ks)
 
 
-def _weighted_sum(ks: list[list[float]], weights: Sequence[float]) -> list[float]:
-    """Return ``sum_j w_j k_j`` over the non-zero weights (any weights; cached by content)."""
-    return weighted_sum(sparse(weights), len(ks[0]))(ks)
-
-
 def _stages(a: SparseRows, c: Sequence[float], n_stages: int, b: SparseRows, n: int) -> Callable:
     """:func:`~double_pendulum.solvers.combinations.explicit_stages` of a module-level tableau."""
     return _tableau_kernel(a, n, "stages", lambda: explicit_stages(a, tuple(c), n_stages, b, n))
@@ -109,7 +92,7 @@ def scaled_rms(err: list[float], y: list[float], y_new: list[float], rtol: float
     return math.sqrt(total / len(err))
 
 
-class Dopri5:
+class Dopri5(AdaptiveMethod):
     """Dormand-Prince 5(4) pair, FSAL, with Shampine's 4th-order dense output."""
 
     name = "dopri5"
@@ -142,7 +125,7 @@ class Dopri5:
         return evaluate
 
 
-class Dop853:
+class Dop853(AdaptiveMethod):
     """Hairer's DOP853: 8th-order propagation, 5th/3rd-order error estimates, 7th-order dense output."""
 
     name = "dop853"
@@ -182,13 +165,13 @@ class Dop853:
         return partial(alternating_horner(n, 7), columns, y)
 
 
-class ClassicRK4:
+class ClassicRK4(Method):
     """The classic 4th-order Runge-Kutta method (fixed step), cubic Hermite dense output."""
 
     name = "rk4"
     adaptive = False
     order = 4
-    error_order = 0
+    error_order = None
     dense_order = 3
     evals_per_step = 4  # f_new is the next step's first stage
     n_stages = 4
@@ -202,13 +185,13 @@ class ClassicRK4:
         return hermite_interpolant(y, y_new, fy, f_new, h)
 
 
-class ExplicitEuler:
+class ExplicitEuler(Method):
     """Explicit Euler (first order, fixed step): the seed report's scheme, for comparison only."""
 
     name = "euler"
     adaptive = False
     order = 1
-    error_order = 0
+    error_order = None
     dense_order = 1
     evals_per_step = 1
     n_stages = 1  # fy

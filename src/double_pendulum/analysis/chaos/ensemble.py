@@ -138,7 +138,7 @@ def rod_field(config: Any) -> Callable[[float, list[float]], list[float]]:
 
 
 def model_field(config: Any) -> BatchField:
-    """The scene ``config`` (:class:`~double_pendulum.model.vector_field.ModelConfig`) as a batch field.
+    """The scene ``config`` (:class:`~double_pendulum.model.scene.ModelConfig`) as a batch field.
 
     Without any mechanism this is :func:`pendulum_field` (vectorised). With friction it evaluates
     the model's own float vector field (:func:`double_pendulum.model.vector_field.build_vector_field`) column by
