@@ -139,8 +139,3 @@ def identity_record(model_identifier: str, token: str, identity: str) -> bytes:
     package, entry = package_name(identity), entry_name(identity, model_identifier)
     return (f"# The FMU these resources belong to (written by double_pendulum.fmu.bundle).\n"
             f"model={model_identifier}\ntoken={token}\npackage={package}\nentry={entry}\n").encode()
-
-
-def entry_module(files: dict[str, bytes]) -> str:
-    """The entry module named in an FMU's ``resources/slavemodule.txt``."""
-    return files["resources/slavemodule.txt"].decode().strip()

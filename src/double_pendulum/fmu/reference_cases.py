@@ -205,14 +205,6 @@ def input_table(case: ReferenceCase) -> list[tuple[float, ...]] | None:
     return rows
 
 
-def case_named(fmi_version: str, fmi_type: str, model: str) -> ReferenceCase:
-    """The case of one folder of the tree."""
-    for case in CASES:
-        if (case.fmi_version, case.fmi_type, case.model) == (fmi_version, fmi_type, model):
-            return case
-    raise KeyError(f"no reference case {fmi_version}/{fmi_type}/{model}")
-
-
 def fmu_file(case: ReferenceCase) -> str:
     """The case's FMU in a folder of built case FMUs (:func:`double_pendulum.fmu.reference_runs.build_case_fmus`):
     ``<fmi_version>/<model>.fmu`` (an FMI 3 FMU serves both its interfaces)."""
