@@ -1,3 +1,4 @@
-"""Build the FMU and run the component: through fmpy (:mod:`.runner`), libcosim (:mod:`.hosts`)
-or in-process (:mod:`.simulate`). Not bundled into the FMU; :mod:`.build` decides what is.
+"""Build the FMU and run the component: through fmpy (:mod:`double_pendulum.fmu.runner`), libcosim
+(:mod:`double_pendulum.fmu.hosts`) or in-process (:mod:`double_pendulum.fmu.simulate`). Not bundled into the
+FMU; :mod:`double_pendulum.fmu.staging` decides what is.
 """

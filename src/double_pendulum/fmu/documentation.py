@@ -65,7 +65,7 @@ footer { margin-top: 3em; font-size: 0.8em; color: #57606a; }
 
 
 def _module_doc(name: str) -> str:
-    return importlib.import_module(f"{__package__.rpartition('.')[0]}.{name}").__doc__ or ""
+    return importlib.import_module(f"{__package__.partition('.')[0]}.{name}").__doc__ or ""
 
 
 def model_section(sources: Sequence[str]) -> str:

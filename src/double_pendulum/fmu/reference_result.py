@@ -8,8 +8,8 @@ carries, baked presets included, the default inputs), every :func:`interval` [s]
 with the component(s) the FMU runs (:func:`double_pendulum.fmu.doc_plot.run`; the container's two components as
 it couples them). An importer that simulates the FMU with its defaults and that output interval should get
 these numbers: fmpy does, to rounding under Co-Simulation and within the tolerance under Model Exchange
-(``tests/test_reference_result.py``). The cross-check tree's references (:mod:`.reference_cases`) are other
-cases, with inputs and tight tolerances.
+(``tests/test_reference_result.py``). The cross-check tree's references
+(:mod:`double_pendulum.fmu.reference_cases`) are other cases, with inputs and tight tolerances.
 """
 
 from __future__ import annotations
