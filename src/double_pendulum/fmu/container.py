@@ -15,7 +15,7 @@ other, or on threads with ``parallelDoStep``): inputs held over the step, Jacobi
 
 The container exposes, as flat variables named ``<component>.<variable>``, parameters (the
 pendulum's initial state, the suspension's ``M_s, k, c, F_static_y``, and whatever else the
-monolith's start values split by :func:`~double_pendulum.fmu.coupling.split_values` set; their
+monolith's start values split by :func:`~double_pendulum.fmu.masters.coupling.split_values` set; their
 start values are those values) and the coupling and energy outputs of both components.
 
 fmpy 0.3.32 writes a connection's ``variableType`` as the FMI 2 type name ("Real") where the
@@ -34,7 +34,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, split_values
+from .masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, split_values
 from .presets import literal
 
 SYSTEM_NAME = "PendulumOnSuspension"

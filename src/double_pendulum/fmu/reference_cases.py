@@ -46,7 +46,7 @@ FRICTION = {"phi1_0": 1.5, "phi2_0": 0.5, "air_drag": True, "rod_drag": True, "b
             "bearing_drag": True, "tau_b1": 1e-3, "tau_b2": 1e-3, "m_rod1": 0.07, "m_rod2": 0.07,
             "L_rod1": 0.35, "L_rod2": 0.25, **TIGHT}
 CONTAINER_VALUES = {"phi1_0": 1.5, "phi2_0": 1.5, **TIGHT}
-"""The container's scene (monolith names, split by :func:`double_pendulum.fmu.coupling.split_values`)."""
+"""The container's scene (monolith names, split by :func:`double_pendulum.fmu.masters.coupling.split_values`)."""
 PIVOT_AMPLITUDE, PIVOT_FREQUENCY = 0.02, 1.5  # [m], [Hz] of the driven case's horizontal pivot motion
 
 

@@ -91,7 +91,7 @@ def ssp_reference_files(values: Mapping[str, Any], stop_time: float, macro_step:
     all outputs are passed; two extra exchanges while initialising), macro step ``macro_step`` [s], to
     ``stop_time`` [s], :data:`SSP_STATES` every :func:`interval`. Computed at build in-process with the two
     components; ``run_coupled`` reproduces libcosim to rounding (``tests/test_engines.py``)."""
-    from .coupling import run_coupled, split_values
+    from .masters.coupling import run_coupled, split_values
     from .presets import COMPONENTS
 
     every = interval(0.0, stop_time, macro_step, macro_step)

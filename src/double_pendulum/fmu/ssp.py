@@ -4,9 +4,9 @@ An SSP file (System Structure and Parameterization, the FMI family's standard fo
 FMUs) is a zip holding ``SystemStructure.ssd`` and the FMUs it references, here
 ``resources/DoublePendulum.fmu`` and ``resources/Suspension.fmu``. The SSD lists the two
 components with their connectors, the eight connections of
-:mod:`double_pendulum.fmu.coupling` and, per component, an inline parameter set
+:mod:`double_pendulum.fmu.masters.coupling` and, per component, an inline parameter set
 (``ssd:ParameterBindings/ssd:ParameterValues/ssv:ParameterSet``) with the values of
-:func:`~double_pendulum.fmu.coupling.split_values`: the pendulum's start values with its own
+:func:`~double_pendulum.fmu.masters.coupling.split_values`: the pendulum's start values with its own
 suspension off, the suspension's ``M_s, k, c`` and ``F_static_y = -(m1 + m2) g``.
 
 libcosim (libcosimpy ``CosimExecution.from_ssp_file``) reads exactly this subset of SSP 1.0:
@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from .coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, split_values
+from .masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, split_values
 
 SYSTEM_NAME = "PendulumOnSuspension"
 PENDULUM, SUSPENSION = "DoublePendulum", "Suspension"
