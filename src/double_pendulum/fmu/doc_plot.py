@@ -22,7 +22,7 @@ from typing import Any
 from ..component.suspension import INPUT_START
 from ..component.variables import INTERFACES
 from . import presets
-from .simulate import communication_points
+from .masters.simulate import communication_points
 
 SUSPENSION_STEP = {"F_x": 1.0, "F_y": INPUT_START["F_y"] - 1.0}
 """The Suspension plot's load [N]: 1 N horizontally and 1 N down on top of the static load, from t = 0."""
