@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from double_pendulum.fmu import elf_needs, loader
+from double_pendulum.fmu import loader
+from double_pendulum.fmu.carries import elf_needs
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "fmu.md"
 GLIBC_FLOOR = "GLIBC_2.17"  # CentOS 7, manylinux2014

@@ -9,7 +9,7 @@ Nothing here is a second copy of the documentation: the page is assembled from
   :mod:`double_pendulum.fmu.docstring_html`;
 * the parameter groups' docstrings and switches (:data:`SWITCH_GROUPS`: the switches of a scene);
 * the FMU's binaries, read for what each needs of the target machine
-  (:mod:`double_pendulum.fmu.elf_needs`), the CPython recorded at build and the loader's docstring (how
+  (:mod:`double_pendulum.fmu.carries.elf_needs`), the CPython recorded at build and the loader's docstring (how
   the FMU finds its Python, :mod:`double_pendulum.fmu.loader`);
 * the result plot ``result.png`` of the FMU's default run (:mod:`double_pendulum.fmu.doc_plot`).
 
@@ -29,7 +29,8 @@ from xml.etree import ElementTree as ET
 from .. import __version__
 from ..component.variables import INTERFACES
 from ..model.parameters import MAX_START_ANGLE, AirDragParameters, BearingParameters, SuspensionParameters
-from . import elf_needs, presets
+from . import presets
+from .carries import elf_needs
 from .docstring_html import docstring_html, inline_html, summary
 
 MODEL_SOURCES: dict[str, tuple[str, ...]] = {
