@@ -140,7 +140,7 @@ BUILD_MODULES = (
     "double_pendulum.fmu.docstring_html",
     "double_pendulum.fmu.icons",
     "double_pendulum.fmu.terminals",
-    "double_pendulum.fmu.tex_html",
+    "double_pendulum.fmu.carries.tex_html",
     "double_pendulum.fmu.carries.elf_needs",
     "double_pendulum.fmu.loader",
 )
