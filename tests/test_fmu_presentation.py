@@ -15,8 +15,8 @@ import pytest
 from fmpy import read_model_description, simulate_fmu
 
 from double_pendulum.fmu import doc_plot, documentation, terminals
+from double_pendulum.fmu.carries.docstring_html import docstring_html, inline_html
 from double_pendulum.fmu.carries.tex_html import UnsupportedTeX, tex_to_html
-from double_pendulum.fmu.docstring_html import docstring_html, inline_html
 
 FMUS = ("DoublePendulum.fmu", "Suspension.fmu", "PendulumOnSuspension.fmu", "fmi3/DoublePendulum.fmu")
 PNG = b"\x89PNG\r\n\x1a\n"

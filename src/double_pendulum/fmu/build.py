@@ -137,7 +137,7 @@ BUILD_MODULES = (
     "double_pendulum.fmu.presentation",
     "double_pendulum.fmu.documentation",
     "double_pendulum.fmu.doc_plot",
-    "double_pendulum.fmu.docstring_html",
+    "double_pendulum.fmu.carries.docstring_html",
     "double_pendulum.fmu.icons",
     "double_pendulum.fmu.terminals",
     "double_pendulum.fmu.carries.tex_html",

@@ -6,7 +6,7 @@ Nothing here is a second copy of the documentation: the page is assembled from
   variable table with units and start values) and the validity rules of the interface's parameters
   (:mod:`double_pendulum.component.variables`: the "valid values" column);
 * the model's module docstrings (the equations, :data:`MODEL_SOURCES`), rendered by
-  :mod:`double_pendulum.fmu.docstring_html`;
+  :mod:`double_pendulum.fmu.carries.docstring_html`;
 * the parameter groups' docstrings and switches (:data:`SWITCH_GROUPS`: the switches of a scene);
 * the FMU's binaries, read for what each needs of the target machine
   (:mod:`double_pendulum.fmu.carries.elf_needs`), the CPython recorded at build and the loader's docstring (how
@@ -31,7 +31,7 @@ from ..component.variables import INTERFACES
 from ..model.parameters import MAX_START_ANGLE, AirDragParameters, BearingParameters, SuspensionParameters
 from . import presets
 from .carries import elf_needs
-from .docstring_html import docstring_html, inline_html, summary
+from .carries.docstring_html import docstring_html, inline_html, summary
 
 MODEL_SOURCES: dict[str, tuple[str, ...]] = {
     "DoublePendulum": ("model.dynamics", "model.links", "model.kinematics", "model.forces", "model.inputs"),

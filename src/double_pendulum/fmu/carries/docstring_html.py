@@ -19,7 +19,7 @@ import html
 import inspect
 import re
 
-from .carries.tex_html import tex_to_html
+from .tex_html import tex_to_html
 
 INLINE = re.compile(r":(?P<role>\w+):`(?P<target>[^`]+)`|``(?P<code>.+?)``|\*\*(?P<strong>.+?)\*\*"
                     r"|(?<![\w*])\*(?P<em>[^*\s][^*]*?)\*(?!\w)")
