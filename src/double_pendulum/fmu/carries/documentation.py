@@ -26,12 +26,12 @@ from collections.abc import Mapping, Sequence
 from dataclasses import fields
 from xml.etree import ElementTree as ET
 
-from .. import __version__
-from ..component.variables import INTERFACES
-from ..model.parameters import MAX_START_ANGLE, AirDragParameters, BearingParameters, SuspensionParameters
-from . import presets
-from .carries import elf_needs
-from .carries.docstring_html import docstring_html, inline_html, summary
+from ... import __version__
+from ...component.variables import INTERFACES
+from ...model.parameters import MAX_START_ANGLE, AirDragParameters, BearingParameters, SuspensionParameters
+from .. import presets
+from . import elf_needs
+from .docstring_html import docstring_html, inline_html, summary
 
 MODEL_SOURCES: dict[str, tuple[str, ...]] = {
     "DoublePendulum": ("model.dynamics", "model.links", "model.kinematics", "model.forces", "model.inputs"),
