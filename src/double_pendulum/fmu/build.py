@@ -136,7 +136,7 @@ BUILD_MODULES = (
     "double_pendulum.fmu.presets",
     "double_pendulum.fmu.presentation",
     "double_pendulum.fmu.carries.documentation",
-    "double_pendulum.fmu.doc_plot",
+    "double_pendulum.fmu.carries.doc_plot",
     "double_pendulum.fmu.carries.docstring_html",
     "double_pendulum.fmu.icons",
     "double_pendulum.fmu.terminals",

@@ -3,7 +3,7 @@
 :func:`presentation_files` gives the files, by their path in the FMU:
 
 * ``documentation/index.html`` and ``documentation/result.png`` (:mod:`double_pendulum.fmu.carries.documentation`,
-  :mod:`double_pendulum.fmu.doc_plot`);
+  :mod:`double_pendulum.fmu.carries.doc_plot`);
 * the icon: ``model.png`` (FMI 2.0) and ``terminalsAndIcons/icon.png`` (FMI 3.0, and FMI 2.0.4's
   back-port), :mod:`double_pendulum.fmu.icons`;
 * ``terminalsAndIcons/terminalsAndIcons.xml`` with the terminals of the FMU's variables and their
@@ -24,8 +24,8 @@ from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from . import doc_plot, icons, reference_result, terminals
-from .carries import documentation
+from . import icons, reference_result, terminals
+from .carries import doc_plot, documentation
 
 CONTAINER = "PendulumOnSuspension"
 CONTAINER_PLOT_TIME = 2.0  # [s] of the container's result plot (its default experiment runs 10 s)

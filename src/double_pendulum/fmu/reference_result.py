@@ -5,7 +5,7 @@
 
 The result is the FMU's default experiment (its ``DefaultExperiment`` start and stop, the start values the FMU
 carries, baked presets included, the default inputs), every :func:`interval` [s], computed at build in-process
-with the component(s) the FMU runs (:func:`double_pendulum.fmu.doc_plot.run`; the container's two components as
+with the component(s) the FMU runs (:func:`double_pendulum.fmu.carries.doc_plot.run`; the container's two components as
 it couples them). An importer that simulates the FMU with its defaults and that output interval should get
 these numbers: fmpy does, to rounding under Co-Simulation and within the tolerance under Model Exchange
 (``tests/test_reference_result.py``). The cross-check tree's references
@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from . import doc_plot
+from .carries import doc_plot
 
 FOLDER = "extra/org.fmi-standard.fmi-ls-ref"
 MANIFEST = f"{FOLDER}/fmi-ls-manifest.xml"

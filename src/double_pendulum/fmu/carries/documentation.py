@@ -11,7 +11,7 @@ Nothing here is a second copy of the documentation: the page is assembled from
 * the FMU's binaries, read for what each needs of the target machine
   (:mod:`double_pendulum.fmu.carries.elf_needs`), the CPython recorded at build and the loader's docstring (how
   the FMU finds its Python, :mod:`double_pendulum.fmu.loader`);
-* the result plot ``result.png`` of the FMU's default run (:mod:`double_pendulum.fmu.doc_plot`).
+* the result plot ``result.png`` of the FMU's default run (:mod:`double_pendulum.fmu.carries.doc_plot`).
 
 The page is plain HTML with its style inline and no script, so the simple HTML views of FMI tools show
 it as a browser does.

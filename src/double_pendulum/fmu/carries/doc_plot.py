@@ -19,10 +19,10 @@ import json
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ..component.suspension import INPUT_START
-from ..component.variables import INTERFACES
-from . import presets
-from .masters.simulate import communication_points
+from ...component.suspension import INPUT_START
+from ...component.variables import INTERFACES
+from .. import presets
+from ..masters.simulate import communication_points
 
 SUSPENSION_STEP = {"F_x": 1.0, "F_y": INPUT_START["F_y"] - 1.0}
 """The Suspension plot's load [N]: 1 N horizontally and 1 N down on top of the static load, from t = 0."""
@@ -88,7 +88,7 @@ def _coupled(values: Mapping[str, Any], stop_time: float, interval: float, names
     outputs after that: the outputs that follow their inputs at once (the pivot force, the suspension's
     acceleration) are recorded after the exchange too.
     """
-    from .masters.coupling import sequential_exchange
+    from ..masters.coupling import sequential_exchange
 
     every = round(interval / macro_step)
     if every < 1 or abs(every * macro_step - interval) > 1e-9 * interval:
