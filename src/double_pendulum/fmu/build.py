@@ -138,7 +138,7 @@ BUILD_MODULES = (
     "double_pendulum.fmu.carries.documentation",
     "double_pendulum.fmu.carries.doc_plot",
     "double_pendulum.fmu.carries.docstring_html",
-    "double_pendulum.fmu.icons",
+    "double_pendulum.fmu.carries.icons",
     "double_pendulum.fmu.terminals",
     "double_pendulum.fmu.carries.tex_html",
     "double_pendulum.fmu.carries.elf_needs",

@@ -15,7 +15,7 @@ let an FMU group variables into terminals for a graphical tool. Every FMU of the
 ``angles`` (DoublePendulum, the container), ``bus``
     the rod angles and rates a controller reads.
 
-Each terminal has a picture (:func:`double_pendulum.fmu.icons.terminal_icon`) on the icon's edge:
+Each terminal has a picture (:func:`double_pendulum.fmu.carries.icons.terminal_icon`) on the icon's edge:
 pivot and mount at the top, torques on the left, angles on the right. Terminals naming variables the
 FMU lacks are left out (the container has no inputs and only the angles).
 """
