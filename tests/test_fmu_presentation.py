@@ -14,8 +14,7 @@ import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 
-from double_pendulum.fmu import terminals
-from double_pendulum.fmu.carries import doc_plot, documentation
+from double_pendulum.fmu.carries import doc_plot, documentation, terminals
 from double_pendulum.fmu.carries.docstring_html import docstring_html, inline_html
 from double_pendulum.fmu.carries.tex_html import UnsupportedTeX, tex_to_html
 

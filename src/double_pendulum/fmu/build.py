@@ -139,7 +139,7 @@ BUILD_MODULES = (
     "double_pendulum.fmu.carries.doc_plot",
     "double_pendulum.fmu.carries.docstring_html",
     "double_pendulum.fmu.carries.icons",
-    "double_pendulum.fmu.terminals",
+    "double_pendulum.fmu.carries.terminals",
     "double_pendulum.fmu.carries.tex_html",
     "double_pendulum.fmu.carries.elf_needs",
     "double_pendulum.fmu.loader",

@@ -7,7 +7,7 @@
 * the icon: ``model.png`` (FMI 2.0) and ``terminalsAndIcons/icon.png`` (FMI 3.0, and FMI 2.0.4's
   back-port), :mod:`double_pendulum.fmu.carries.icons`;
 * ``terminalsAndIcons/terminalsAndIcons.xml`` with the terminals of the FMU's variables and their
-  pictures (:mod:`double_pendulum.fmu.terminals`);
+  pictures (:mod:`double_pendulum.fmu.carries.terminals`);
 * ``documentation/licenses/<distribution>.txt``: the licence of everything the FMU bundles
   (:func:`licence_files`);
 * ``extra/org.fmi-standard.fmi-ls-ref/``: the reference result of the default experiment, in Reference-FMUs'
@@ -24,8 +24,8 @@ from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from . import reference_result, terminals
-from .carries import doc_plot, documentation, icons
+from . import reference_result
+from .carries import doc_plot, documentation, icons, terminals
 
 CONTAINER = "PendulumOnSuspension"
 CONTAINER_PLOT_TIME = 2.0  # [s] of the container's result plot (its default experiment runs 10 s)

@@ -26,7 +26,7 @@ from collections.abc import Iterable, Sequence
 from typing import NamedTuple
 from xml.etree import ElementTree as ET
 
-from .masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS
+from ..masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS
 
 FILE = "terminalsAndIcons/terminalsAndIcons.xml"
 FMI_VERSION = "3.0"  # the FMI version whose definition the file follows, also in an FMI 2.0 FMU
