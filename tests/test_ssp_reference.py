@@ -12,8 +12,8 @@ import pytest
 
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.component.suspension import SuspensionCoSimulation
+from double_pendulum.fmu.carries.reference_result import FOLDER, LIBCOSIM_INITIAL_EXCHANGES, MANIFEST, SSP_STATES
 from double_pendulum.fmu.masters.coupling import run_coupled, split_values
-from double_pendulum.fmu.reference_result import FOLDER, LIBCOSIM_INITIAL_EXCHANGES, MANIFEST, SSP_STATES
 
 MACRO_STEP = 1e-3  # the built SSP's
 HORIZON = 2.0  # [s] compared: libcosim takes about 1 s of CPU a simulated second here

@@ -11,7 +11,7 @@
 * ``documentation/licenses/<distribution>.txt``: the licence of everything the FMU bundles
   (:func:`licence_files`);
 * ``extra/org.fmi-standard.fmi-ls-ref/``: the reference result of the default experiment, in Reference-FMUs'
-  layout (:mod:`double_pendulum.fmu.reference_result`).
+  layout (:mod:`double_pendulum.fmu.carries.reference_result`).
 
 The build adds them in :func:`double_pendulum.fmu.staging.rewrite_fmu` (DoublePendulum, Suspension, the
 FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.container.write_container` (the container).
@@ -24,8 +24,7 @@ from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from . import reference_result
-from .carries import doc_plot, documentation, icons, terminals
+from .carries import doc_plot, documentation, icons, reference_result, terminals
 
 CONTAINER = "PendulumOnSuspension"
 CONTAINER_PLOT_TIME = 2.0  # [s] of the container's result plot (its default experiment runs 10 s)

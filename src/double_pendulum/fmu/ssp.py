@@ -124,7 +124,7 @@ def write_ssp(
     """Write the ``.ssp`` at ``dest`` holding both FMUs; ``values``: the monolith's start values (defaults if None).
 
     ``reference=True`` (the build's SSP) adds the reference result of its default experiment,
-    ``extra/org.fmi-standard.fmi-ls-ref/`` as in the FMUs (:func:`~double_pendulum.fmu.reference_result.
+    ``extra/org.fmi-standard.fmi-ls-ref/`` as in the FMUs (:func:`~double_pendulum.fmu.carries.reference_result.
     ssp_reference_files`: the states as libcosim steps them; about 1.5 s of CPU for the 10 s).
     """
     dest = Path(dest)
@@ -137,7 +137,7 @@ def write_ssp(
         archive.write(pendulum_fmu, f"resources/{PENDULUM}.fmu")
         archive.write(suspension_fmu, f"resources/{SUSPENSION}.fmu")
         if reference:
-            from .reference_result import ssp_reference_files
+            from .carries.reference_result import ssp_reference_files
 
             for name, data in ssp_reference_files(values or {}, stop_time, macro_step).items():
                 archive.writestr(name, data)

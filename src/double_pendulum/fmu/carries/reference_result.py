@@ -18,7 +18,7 @@ from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from .carries import doc_plot
+from . import doc_plot
 
 FOLDER = "extra/org.fmi-standard.fmi-ls-ref"
 MANIFEST = f"{FOLDER}/fmi-ls-manifest.xml"
@@ -91,8 +91,8 @@ def ssp_reference_files(values: Mapping[str, Any], stop_time: float, macro_step:
     all outputs are passed; two extra exchanges while initialising), macro step ``macro_step`` [s], to
     ``stop_time`` [s], :data:`SSP_STATES` every :func:`interval`. Computed at build in-process with the two
     components; ``run_coupled`` reproduces libcosim to rounding (``tests/test_engines.py``)."""
-    from .masters.coupling import run_coupled, split_values
-    from .presets import COMPONENTS
+    from ..masters.coupling import run_coupled, split_values
+    from ..presets import COMPONENTS
 
     every = interval(0.0, stop_time, macro_step, macro_step)
     pendulum_values, suspension_values = split_values(values)
