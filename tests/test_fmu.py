@@ -317,7 +317,7 @@ def test_every_fmu_claims_only_the_platform_it_ran_on_and_no_sources_that_do_not
 def test_every_fmu_carries_the_licences_of_what_it_bundles(fmu_path):
     """documentation/licenses/: the project's MIT licence and those of pythonfmu (FMI 2) or pythonfmu3 (FMI 3),
     and for the container fmpy's (its container binary), each the text the distribution ships."""
-    from double_pendulum.fmu.presentation import distribution_licence
+    from double_pendulum.fmu.carries.presentation import distribution_licence
 
     project = (Path(__file__).resolve().parents[1] / "LICENSE").read_bytes()
     folder = fmu_path.parent

@@ -1,6 +1,6 @@
 """What a tool shows of each FMU the build writes: documentation/index.html with its result plot, the icon
 (model.png, terminalsAndIcons/icon.png) and terminalsAndIcons.xml, valid against FMI 3.0's schema and
-naming only the FMU's own variables (double_pendulum.fmu.presentation)."""
+naming only the FMU's own variables (double_pendulum.fmu.carries.presentation)."""
 
 from __future__ import annotations
 

@@ -134,7 +134,7 @@ BUILD_MODULES = (
     "double_pendulum.fmu.staging",
     "double_pendulum.fmu.bundle",
     "double_pendulum.fmu.presets",
-    "double_pendulum.fmu.presentation",
+    "double_pendulum.fmu.carries.presentation",
     "double_pendulum.fmu.carries.documentation",
     "double_pendulum.fmu.carries.doc_plot",
     "double_pendulum.fmu.carries.docstring_html",

@@ -140,7 +140,7 @@ def write_container(
     ``compression`` is the zip method of the archive: ``zipfile.ZIP_STORED`` writes a container meant to be
     run once and removed about twice as fast (compressing the two bundled FMUs takes ~0.3 s).
     ``documented=True`` (the build's container) adds the documentation, icon and terminals
-    (:mod:`double_pendulum.fmu.presentation`; its result plot runs the coupled scene for 2 s in-process).
+    (:mod:`double_pendulum.fmu.carries.presentation`; its result plot runs the coupled scene for 2 s in-process).
     """
     from fmpy.container_fmu import write_configuration
     from fmpy.model_description import write_model_description
@@ -178,7 +178,7 @@ def write_container(
 
 def _add_presentation(root: Path) -> None:
     """Write the container's documentation, icon and terminals into the folder ``root`` it is zipped from."""
-    from .presentation import CONTAINER, presentation_files
+    from .carries.presentation import CONTAINER, presentation_files
 
     files = {path.relative_to(root).as_posix(): path.read_bytes() for path in root.rglob("*")
              if path.is_file() and (path.name in ("modelDescription.xml", "python.cfg", "bundle.json")

@@ -15,7 +15,7 @@ adapters, then :func:`rewrite_fmu` rewrites what the builder wrote:
   private names (``fmu_src/slave_common.py``);
 * the start values it is given (:mod:`double_pendulum.fmu.presets`);
 * what a tool shows of the FMU: ``documentation/``, the icon and ``terminalsAndIcons/``
-  (:mod:`double_pendulum.fmu.presentation`).
+  (:mod:`double_pendulum.fmu.carries.presentation`).
 
 Units in the modelDescription are SI (:data:`UNIT_EXPONENTS`: each unit's base-unit exponents).
 """
@@ -169,7 +169,7 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
                 defines: dict[str, str] | None = None, start_values: Mapping[str, Any] | None = None) -> None:
     """Rewrite the zip: the private layout of the bundled code, the completed modelDescription, bytecode,
     the loader (compiled with the FMU's GUID and ``defines``), ``bundle.json``, and what a tool shows of
-    the FMU (documentation, icon, terminals: :mod:`double_pendulum.fmu.presentation`).
+    the FMU (documentation, icon, terminals: :mod:`double_pendulum.fmu.carries.presentation`).
 
     ``complete`` completes the modelDescription. Precompiled bytecode spares every fresh extraction
     (fmpy extracts the FMU anew for each ``simulate_fmu`` call) the compilation of the bundled
@@ -194,7 +194,7 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
     files[f"resources/{loader.CONFIG_NAME}"] = loader.python_record().encode()
     files[bundle.IDENTITY_FILE] = bundle.identity_record(model_identifier, token, identity)
     files[BUNDLE_FILE] = json.dumps({"id": identity}).encode()
-    from .presentation import presentation_files  # here: matplotlib and numpy only when building
+    from .carries.presentation import presentation_files  # here: matplotlib and numpy only when building
 
     files.update(presentation_files(model_identifier, fmi_version, files, start_values))
     tmp = fmu.with_suffix(".fmu.tmp")

@@ -24,7 +24,7 @@ from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from .carries import doc_plot, documentation, icons, reference_result, terminals
+from . import doc_plot, documentation, icons, reference_result, terminals
 
 CONTAINER = "PendulumOnSuspension"
 CONTAINER_PLOT_TIME = 2.0  # [s] of the container's result plot (its default experiment runs 10 s)
