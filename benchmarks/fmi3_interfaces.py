@@ -34,7 +34,7 @@ import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
 
 from double_pendulum.analysis.solvers.reference import reference_solution
-from double_pendulum.fmu.build import build_fmu
+from double_pendulum.fmu.build.fmi2 import build_fmu
 from double_pendulum.fmu.build_fmi3 import build_fmu3
 from double_pendulum.fmu.masters.coupling import FmuSlave, run_coupled, split_values
 

@@ -132,7 +132,7 @@ def test_an_unknown_option_shows_the_usage_of_its_command(capsys):
 def test_corrupt_fmu_is_one_clear_line(tmp_path, capsys, monkeypatch):
     fmu = tmp_path / "broken.fmu"
     fmu.write_bytes(b"not a zip file")
-    monkeypatch.setattr("double_pendulum.fmu.build.fmu_is_current", lambda path: True)  # do not rebuild it
+    monkeypatch.setattr("double_pendulum.fmu.build.fmi2.fmu_is_current", lambda path: True)  # do not rebuild it
     assert main(["run", "free_swing", "--fmu", str(fmu), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "is not a usable FMU" in err and "BadZipFile" in err

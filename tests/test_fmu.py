@@ -272,11 +272,12 @@ def test_fmu_bundles_only_the_runtime(fmu_path):
 def test_without_a_c_compiler_the_build_stops_with_one_line_and_leaves_no_fmu(tmp_path, monkeypatch):
     """The FMU's binary is compiled from source: without a compiler there is no FMU to write, and the CLI
     says why in one line (no traceback, nothing half-written)."""
-    from double_pendulum.fmu import build, loader
+    from double_pendulum.fmu import loader
+    from double_pendulum.fmu.build import fmi2
 
     monkeypatch.setenv("CC", "/nonexistent/cc")
     with pytest.raises(loader.LoaderUnavailable, match="no C compiler found"):
-        build.build_fmu(tmp_path / "DoublePendulum.fmu")
+        fmi2.build_fmu(tmp_path / "DoublePendulum.fmu")
     assert not list(tmp_path.iterdir())
     done = subprocess.run([sys.executable, "-m", "double_pendulum.cli", "build", "-o", str(tmp_path / "out")],
                           capture_output=True, text=True, env={**os.environ, "CC": "/nonexistent/cc"})
@@ -287,14 +288,14 @@ def test_without_a_c_compiler_the_build_stops_with_one_line_and_leaves_no_fmu(tm
 def test_a_newer_build_module_makes_the_fmu_stale(fmu_path, tmp_path, monkeypatch):
     """The FMU holds what the build's own modules write (documentation, icon, terminals): a change to one
     of them, not only to the bundled code, means the FMU must be built again."""
-    from double_pendulum.fmu import build
+    from double_pendulum.fmu.build import fmi2
 
-    assert build.fmu_is_current(fmu_path)
+    assert fmi2.fmu_is_current(fmu_path)
     newer = tmp_path / "documentation.py"
     newer.write_text("")
     os.utime(newer, (fmu_path.stat().st_mtime + 60,) * 2)
-    monkeypatch.setattr(build, "build_sources", lambda: [newer])
-    assert not build.fmu_is_current(fmu_path)
+    monkeypatch.setattr(fmi2, "build_sources", lambda: [newer])
+    assert not fmi2.fmu_is_current(fmu_path)
 
 
 def test_every_fmu_claims_only_the_platform_it_ran_on_and_no_sources_that_do_not_build_it(fmu_path):

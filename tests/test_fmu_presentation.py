@@ -158,7 +158,7 @@ def test_the_containers_plot_is_the_container_run(fmu_path):
 
 
 def test_a_build_with_baked_start_values_documents_and_plots_them(tmp_path):
-    from double_pendulum.fmu.build import build_fmu
+    from double_pendulum.fmu.build.fmi2 import build_fmu
 
     fmu = build_fmu(tmp_path / "Chaotic.fmu", "DoublePendulum", {"phi1_0": 2.0, "phi2_0": 2.0})
     with zipfile.ZipFile(fmu) as z:

@@ -66,7 +66,7 @@ def test_zigs_compiler_builds_a_loader_that_runs_like_the_system_compilers(fmu_p
     versions, the same C libraries, the same numbers."""
     from fmpy import simulate_fmu
 
-    from double_pendulum.fmu.build import build_fmu
+    from double_pendulum.fmu.build.fmi2 import build_fmu
 
     monkeypatch.setenv("CC", f"{sys.executable} -m ziglang cc")
     assert "ziglang" in " ".join(loader.c_compiler())

@@ -29,7 +29,7 @@ from pathlib import Path
 
 from . import __version__
 from .component.variables import INTERFACES
-from .fmu.build import DEFAULT_FMU_PATH
+from .fmu.build.fmi2 import DEFAULT_FMU_PATH
 from .fmu.loader import LoaderUnavailable
 from .fmu.systems import build_all
 from .runs.interrupts import acknowledge, handling_interrupts, interrupted
@@ -130,7 +130,7 @@ def fmu_set(fmu: Path) -> list[Path]:
 def fmu_set_is_current(fmu: Path) -> bool:
     """Whether ``fmu`` is newer than its sources and, for an FMU named as ``build`` names it, the rest of
     :func:`fmu_set` is there and current too (an FMU of another name is checked alone)."""
-    from .fmu.build import fmu_is_current
+    from .fmu.build.fmi2 import fmu_is_current
 
     if not fmu_is_current(fmu):
         return False

@@ -1,6 +1,6 @@
 """Build every FMU of the project and the coupled system written from them.
 
-:func:`build_all` builds ``DoublePendulum`` and ``Suspension`` (FMI 2.0, :mod:`double_pendulum.fmu.build`), the
+:func:`build_all` builds ``DoublePendulum`` and ``Suspension`` (FMI 2.0, :mod:`double_pendulum.fmu.build.fmi2`), the
 FMI 3.0 ``DoublePendulum`` (:mod:`double_pendulum.fmu.build_fmi3`) and, from the first two,
 ``PendulumOnSuspension`` as an SSP (:mod:`double_pendulum.fmu.ssp`) and as fmpy's container FMU
 (:mod:`double_pendulum.fmu.container`).
@@ -11,7 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..component.variables import INTERFACES, MODEL_IDENTIFIER
-from .build import DEFAULT_FMU_PATH, build_fmu
+from .build.fmi2 import DEFAULT_FMU_PATH, build_fmu
 
 
 def build_all(dest: str | Path = DEFAULT_FMU_PATH) -> list[Path]:

@@ -36,9 +36,9 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from ..component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
-from . import bundle, loader, presets
-from .staging import (
+from ...component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
+from .. import bundle, loader, presets
+from ..staging import (
     adapter_sources,
     builder_imports_forgotten,
     check_platform_binary,
@@ -129,7 +129,7 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
 # The modules that write what the FMU holds besides the bundled code (its layout, documentation, icon,
 # terminals, baked start values): a change to one of them makes the built FMUs stale too.
 BUILD_MODULES = (
-    "double_pendulum.fmu.build",
+    "double_pendulum.fmu.build.fmi2",
     "double_pendulum.fmu.build_fmi3",
     "double_pendulum.fmu.staging",
     "double_pendulum.fmu.bundle",
