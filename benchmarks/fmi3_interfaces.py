@@ -35,7 +35,7 @@ from fmpy import extract, read_model_description, simulate_fmu
 
 from double_pendulum.analysis.solvers.reference import reference_solution
 from double_pendulum.fmu.build.fmi2 import build_fmu
-from double_pendulum.fmu.build_fmi3 import build_fmu3
+from double_pendulum.fmu.build.fmi3 import build_fmu3
 from double_pendulum.fmu.masters.coupling import FmuSlave, run_coupled, split_values
 
 CHAOTIC = {"phi1_0": 2.0, "phi2_0": 2.0}

@@ -248,7 +248,7 @@ def test_run_from_another_folder_keeps_every_fmu_in_the_out_folder(tmp_path, mon
     newer = tmp_path / "DoublePendulumFmi3.py"  # an FMI 3 adapter source changed since: the set is stale
     newer.write_text("")
     os.utime(newer, (fmu.stat().st_mtime + 60,) * 2)
-    monkeypatch.setattr("double_pendulum.fmu.build_fmi3.adapter_sources", lambda: [newer])
+    monkeypatch.setattr("double_pendulum.fmu.build.fmi3.adapter_sources", lambda: [newer])
     assert not fmu_set_is_current(fmu)
     monkeypatch.undo()
     (out / "fmu" / "PendulumOnSuspension.ssp").unlink()  # one missing: the next run builds the set again

@@ -136,7 +136,7 @@ def fmu_set_is_current(fmu: Path) -> bool:
         return False
     if fmu.name != DEFAULT_FMU_PATH.name:
         return True
-    from .fmu.build_fmi3 import adapter_sources as fmi3_sources
+    from .fmu.build.fmi3 import adapter_sources as fmi3_sources
 
     built = fmu.stat().st_mtime
     others = fmu_set(fmu)[1:]

@@ -1,6 +1,6 @@
 """What the FMI 2 and FMI 3 builds share: the bundled code staged for the builder, and the built zip rewritten.
 
-The FMI 2 build (:mod:`double_pendulum.fmu.build.fmi2`) and the FMI 3 build (:mod:`double_pendulum.fmu.build_fmi3`)
+The FMI 2 build (:mod:`double_pendulum.fmu.build.fmi2`) and the FMI 3 build (:mod:`double_pendulum.fmu.build.fmi3`)
 hand their FMI library's builder the runtime (``__init__``, :mod:`~double_pendulum.model`,
 :mod:`~double_pendulum.solvers`, :mod:`~double_pendulum.component`: :data:`RUNTIME_SUBPACKAGES`) and the
 adapters, then :func:`rewrite_fmu` rewrites what the builder wrote:

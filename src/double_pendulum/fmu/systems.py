@@ -1,7 +1,7 @@
 """Build every FMU of the project and the coupled system written from them.
 
 :func:`build_all` builds ``DoublePendulum`` and ``Suspension`` (FMI 2.0, :mod:`double_pendulum.fmu.build.fmi2`), the
-FMI 3.0 ``DoublePendulum`` (:mod:`double_pendulum.fmu.build_fmi3`) and, from the first two,
+FMI 3.0 ``DoublePendulum`` (:mod:`double_pendulum.fmu.build.fmi3`) and, from the first two,
 ``PendulumOnSuspension`` as an SSP (:mod:`double_pendulum.fmu.ssp`) and as fmpy's container FMU
 (:mod:`double_pendulum.fmu.container`).
 """
@@ -17,8 +17,8 @@ from .build.fmi2 import DEFAULT_FMU_PATH, build_fmu
 def build_all(dest: str | Path = DEFAULT_FMU_PATH) -> list[Path]:
     """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it,
     then the coupled system (:func:`build_systems`), then the FMI 3.0 ``DoublePendulum`` in the
-    subfolder ``fmi3/`` (:func:`double_pendulum.fmu.build_fmi3.build_fmu3`)."""
-    from .build_fmi3 import build_fmu3
+    subfolder ``fmi3/`` (:func:`double_pendulum.fmu.build.fmi3.build_fmu3`)."""
+    from .build.fmi3 import build_fmu3
 
     dest = Path(dest)
     first = build_fmu(dest, MODEL_IDENTIFIER)

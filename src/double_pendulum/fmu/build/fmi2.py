@@ -130,7 +130,7 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
 # terminals, baked start values): a change to one of them makes the built FMUs stale too.
 BUILD_MODULES = (
     "double_pendulum.fmu.build.fmi2",
-    "double_pendulum.fmu.build_fmi3",
+    "double_pendulum.fmu.build.fmi3",
     "double_pendulum.fmu.staging",
     "double_pendulum.fmu.bundle",
     "double_pendulum.fmu.presets",

@@ -24,11 +24,11 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from ..component.model_exchange import STATES
-from ..component.variables import INTERFACES, MODEL_IDENTIFIER
-from . import bundle, presets
-from .staging import adapter_sources as _adapter_sources
-from .staging import (
+from ...component.model_exchange import STATES
+from ...component.variables import INTERFACES, MODEL_IDENTIFIER
+from .. import bundle, presets
+from ..staging import adapter_sources as _adapter_sources
+from ..staging import (
     builder_imports_forgotten,
     check_platform_binary,
     copy_adapters,
