@@ -259,7 +259,7 @@ def test_fmu_ships_hash_checked_bytecode(fmu_path):
 
 def test_fmu_bundles_only_the_runtime(fmu_path):
     """resources/ holds the adapter, pythonfmu and the runtime subpackages: no analysis, plots or CLI."""
-    from double_pendulum.fmu.staging import RUNTIME_SUBPACKAGES
+    from double_pendulum.fmu.build.staging import RUNTIME_SUBPACKAGES
 
     with zipfile.ZipFile(fmu_path) as fmu:
         sources = [n for n in fmu.namelist() if n.startswith("resources/double_pendulum/") and n.endswith(".py")]

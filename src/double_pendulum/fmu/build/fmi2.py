@@ -17,7 +17,7 @@ modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the buil
 * states each output's direct dependencies on the inputs under ``ModelStructure/Outputs``
   (the interface's ``output_dependencies``; ``dependencies=""`` for none),
   which pythonfmu leaves open (open means: depends on every input);
-* then rewrites the zip as the FMI 3 build does (:func:`double_pendulum.fmu.staging.rewrite_fmu`): the
+* then rewrites the zip as the FMI 3 build does (:func:`double_pendulum.fmu.build.staging.rewrite_fmu`): the
   bundled code's private layout, the FMU's one binary (the loader), the baked start values and what a tool
   shows of the FMU.
 
@@ -38,7 +38,7 @@ from xml.etree import ElementTree as ET
 
 from ...component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
 from .. import bundle, loader, presets
-from ..staging import (
+from .staging import (
     adapter_sources,
     builder_imports_forgotten,
     check_platform_binary,
@@ -131,7 +131,7 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
 BUILD_MODULES = (
     "double_pendulum.fmu.build.fmi2",
     "double_pendulum.fmu.build.fmi3",
-    "double_pendulum.fmu.staging",
+    "double_pendulum.fmu.build.staging",
     "double_pendulum.fmu.bundle",
     "double_pendulum.fmu.presets",
     "double_pendulum.fmu.carries.presentation",

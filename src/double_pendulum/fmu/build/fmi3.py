@@ -3,7 +3,7 @@
 The adapter ``fmu_src/DoublePendulumFmi3.py`` maps the FMI 3 calls onto the same component as the
 FMI 2 FMU (Co-Simulation) and onto the runtime's vector field (Model Exchange,
 ``double_pendulum.component.model_exchange``); the runtime is bundled as for FMI 2
-(:mod:`double_pendulum.fmu.staging`), with pythonfmu3's Python part imported under a private name.
+(:mod:`double_pendulum.fmu.build.staging`), with pythonfmu3's Python part imported under a private name.
 The build then
 
 * adds ``UnitDefinitions`` for the units the adapter gives its Float64 variables;
@@ -27,8 +27,8 @@ from xml.etree import ElementTree as ET
 from ...component.model_exchange import STATES
 from ...component.variables import INTERFACES, MODEL_IDENTIFIER
 from .. import bundle, presets
-from ..staging import adapter_sources as _adapter_sources
-from ..staging import (
+from .staging import adapter_sources as _adapter_sources
+from .staging import (
     builder_imports_forgotten,
     check_platform_binary,
     copy_adapters,

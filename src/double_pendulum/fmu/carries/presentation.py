@@ -13,7 +13,7 @@
 * ``extra/org.fmi-standard.fmi-ls-ref/``: the reference result of the default experiment, in Reference-FMUs'
   layout (:mod:`double_pendulum.fmu.carries.reference_result`).
 
-The build adds them in :func:`double_pendulum.fmu.staging.rewrite_fmu` (DoublePendulum, Suspension, the
+The build adds them in :func:`double_pendulum.fmu.build.staging.rewrite_fmu` (DoublePendulum, Suspension, the
 FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.container.write_container` (the container).
 """
 

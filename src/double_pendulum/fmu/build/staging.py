@@ -35,9 +35,9 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from . import bundle, loader, presets
+from .. import bundle, loader, presets
 
-PACKAGE_DIR = Path(__file__).resolve().parents[1]
+PACKAGE_DIR = Path(__file__).resolve().parents[2]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
 RUNTIME_SUBPACKAGES = ("model", "solvers", "component")
 
@@ -194,7 +194,7 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
     files[f"resources/{loader.CONFIG_NAME}"] = loader.python_record().encode()
     files[bundle.IDENTITY_FILE] = bundle.identity_record(model_identifier, token, identity)
     files[BUNDLE_FILE] = json.dumps({"id": identity}).encode()
-    from .carries.presentation import presentation_files  # here: matplotlib and numpy only when building
+    from ..carries.presentation import presentation_files  # here: matplotlib and numpy only when building
 
     files.update(presentation_files(model_identifier, fmi_version, files, start_values))
     tmp = fmu.with_suffix(".fmu.tmp")
