@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 import sanitize
 
+from double_pendulum.fmu.build.systems import build_all
 from double_pendulum.fmu.runner import FmuRunner
-from double_pendulum.fmu.systems import build_all
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"

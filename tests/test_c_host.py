@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from double_pendulum.fmu import loader
-from double_pendulum.fmu.systems import build_all
+from double_pendulum.fmu.build.systems import build_all
 
 HOST_SOURCE = Path(__file__).parent / "c_host" / "fmi2_host.c"
 STEPS, STEP_SIZE = 1000, 1e-3

@@ -43,7 +43,7 @@ SCRIPT = textwrap.dedent("""
     out["libpythons"] = sorted({line.split()[-1] for line in maps.splitlines() if "libpython3" in line})
 
     # a build after the run: ours, and a user's own slave with pythonfmu's builder
-    from double_pendulum.fmu.systems import build_all
+    from double_pendulum.fmu.build.systems import build_all
     folder = Path(sys.argv[2])
     built = build_all(folder / "DoublePendulum.fmu")
     user = folder / "user_slave.py"

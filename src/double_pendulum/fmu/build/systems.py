@@ -10,15 +10,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..component.variables import INTERFACES, MODEL_IDENTIFIER
-from .build.fmi2 import DEFAULT_FMU_PATH, build_fmu
+from ...component.variables import INTERFACES, MODEL_IDENTIFIER
+from .fmi2 import DEFAULT_FMU_PATH, build_fmu
 
 
 def build_all(dest: str | Path = DEFAULT_FMU_PATH) -> list[Path]:
     """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it,
     then the coupled system (:func:`build_systems`), then the FMI 3.0 ``DoublePendulum`` in the
     subfolder ``fmi3/`` (:func:`double_pendulum.fmu.build.fmi3.build_fmu3`)."""
-    from .build.fmi3 import build_fmu3
+    from .fmi3 import build_fmu3
 
     dest = Path(dest)
     first = build_fmu(dest, MODEL_IDENTIFIER)
@@ -35,8 +35,8 @@ def build_systems(
 
     ``pendulum_fmu``: the DoublePendulum FMU; ``Suspension.fmu`` is expected next to it.
     """
-    from .container import write_container
-    from .ssp import write_ssp
+    from ..container import write_container
+    from ..ssp import write_ssp
 
     folder = Path(pendulum_fmu).parent
     fmus = (Path(pendulum_fmu), folder / "Suspension.fmu")
