@@ -5,7 +5,7 @@ Each FMU of :data:`double_pendulum.component.variables.INTERFACES` (``DoublePend
 onto a component through the shared ``fmu_src/double_pendulum_slave.py``; the package's runtime
 (``__init__``, :mod:`~double_pendulum.model`, :mod:`~double_pendulum.solvers`,
 :mod:`~double_pendulum.component`) and the adapters are bundled into the FMU's ``resources/``
-(:mod:`double_pendulum.fmu.bundle`: every module under a private name) so the FMU runs without the
+(:mod:`double_pendulum.fmu.build.bundle`: every module under a private name) so the FMU runs without the
 project installed, and nothing else is (no analysis, plots or CLI). pythonfmu's
 modelDescription lacks units and ``ModelStructure/InitialUnknowns``, so the build then
 
@@ -37,7 +37,8 @@ from typing import Any
 from xml.etree import ElementTree as ET
 
 from ...component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
-from .. import bundle, loader, presets
+from .. import loader, presets
+from . import bundle
 from .staging import (
     adapter_sources,
     builder_imports_forgotten,
@@ -132,7 +133,7 @@ BUILD_MODULES = (
     "double_pendulum.fmu.build.fmi2",
     "double_pendulum.fmu.build.fmi3",
     "double_pendulum.fmu.build.staging",
-    "double_pendulum.fmu.bundle",
+    "double_pendulum.fmu.build.bundle",
     "double_pendulum.fmu.presets",
     "double_pendulum.fmu.carries.presentation",
     "double_pendulum.fmu.carries.documentation",

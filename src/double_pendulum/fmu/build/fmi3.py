@@ -26,7 +26,8 @@ from xml.etree import ElementTree as ET
 
 from ...component.model_exchange import STATES
 from ...component.variables import INTERFACES, MODEL_IDENTIFIER
-from .. import bundle, presets
+from .. import presets
+from . import bundle
 from .staging import adapter_sources as _adapter_sources
 from .staging import (
     builder_imports_forgotten,

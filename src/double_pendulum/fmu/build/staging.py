@@ -5,7 +5,7 @@ hand their FMI library's builder the runtime (``__init__``, :mod:`~double_pendul
 :mod:`~double_pendulum.solvers`, :mod:`~double_pendulum.component`: :data:`RUNTIME_SUBPACKAGES`) and the
 adapters, then :func:`rewrite_fmu` rewrites what the builder wrote:
 
-* the bundled code's private layout (:mod:`double_pendulum.fmu.bundle`: every module under a private name)
+* the bundled code's private layout (:mod:`double_pendulum.fmu.build.bundle`: every module under a private name)
   with hash-checked bytecode;
 * the FMU's one binary: the loader of :mod:`double_pendulum.fmu.loader`, compiled from source with the FMU's
   GUID, which calls the Python side itself (the FMI library's binaries are left out), and
@@ -35,7 +35,8 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from .. import bundle, loader, presets
+from .. import loader, presets
+from . import bundle
 
 PACKAGE_DIR = Path(__file__).resolve().parents[2]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
@@ -73,7 +74,7 @@ def _adapters_dir() -> Path:
 
 
 def adapter_sources(fmi_version: int = 2) -> list[Path]:
-    """fmu_src's modules that the FMI ``fmi_version`` FMUs bundle (:data:`double_pendulum.fmu.bundle.ADAPTERS`).
+    """fmu_src's modules that the FMI ``fmi_version`` FMUs bundle (:data:`double_pendulum.fmu.build.bundle.ADAPTERS`).
 
     They live in the repository's ``fmu_src/``, installed as ``double_pendulum.adapters``.
     """
