@@ -18,7 +18,7 @@ import pytest
 from conftest import DATA
 from scipy.special import ellipk
 
-from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import loader
 from double_pendulum.fmu.masters.simulate import simulate
 from double_pendulum.fmu.runner import FmuRunError
 from double_pendulum.model.dynamics import linearised_normal_modes
@@ -272,8 +272,7 @@ def test_fmu_bundles_only_the_runtime(fmu_path):
 def test_without_a_c_compiler_the_build_stops_with_one_line_and_leaves_no_fmu(tmp_path, monkeypatch):
     """The FMU's binary is compiled from source: without a compiler there is no FMU to write, and the CLI
     says why in one line (no traceback, nothing half-written)."""
-    from double_pendulum.fmu import loader
-    from double_pendulum.fmu.build import fmi2
+    from double_pendulum.fmu.build import fmi2, loader
 
     monkeypatch.setenv("CC", "/nonexistent/cc")
     with pytest.raises(loader.LoaderUnavailable, match="no C compiler found"):

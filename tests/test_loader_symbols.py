@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import loader
 from double_pendulum.fmu.carries import elf_needs
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "fmu.md"

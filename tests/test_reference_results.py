@@ -24,7 +24,7 @@ import numpy as np
 import pytest
 from double_pendulum.data import data_path
 
-from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import loader
 from double_pendulum.fmu.reference_cases import CASES, ReferenceCase, fmu_file, input_names
 from double_pendulum.fmu.reference_runs import (
     RECORD,

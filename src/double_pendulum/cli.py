@@ -30,8 +30,8 @@ from pathlib import Path
 from . import __version__
 from .component.variables import INTERFACES
 from .fmu.build.fmi2 import DEFAULT_FMU_PATH
+from .fmu.build.loader import LoaderUnavailable
 from .fmu.build.systems import build_all
-from .fmu.loader import LoaderUnavailable
 from .runs.interrupts import acknowledge, handling_interrupts, interrupted
 from .runs.lines import failed_line, header_line, wrote_line
 from .scenarios import SCENARIOS

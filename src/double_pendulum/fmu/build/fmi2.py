@@ -37,8 +37,8 @@ from typing import Any
 from xml.etree import ElementTree as ET
 
 from ...component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
-from .. import loader, presets
-from . import bundle
+from .. import presets
+from . import bundle, loader
 from .staging import (
     adapter_sources,
     builder_imports_forgotten,
@@ -143,7 +143,7 @@ BUILD_MODULES = (
     "double_pendulum.fmu.carries.terminals",
     "double_pendulum.fmu.carries.tex_html",
     "double_pendulum.fmu.carries.elf_needs",
-    "double_pendulum.fmu.loader",
+    "double_pendulum.fmu.build.loader",
 )
 
 

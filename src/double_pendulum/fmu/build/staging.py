@@ -7,7 +7,7 @@ adapters, then :func:`rewrite_fmu` rewrites what the builder wrote:
 
 * the bundled code's private layout (:mod:`double_pendulum.fmu.build.bundle`: every module under a private name)
   with hash-checked bytecode;
-* the FMU's one binary: the loader of :mod:`double_pendulum.fmu.loader`, compiled from source with the FMU's
+* the FMU's one binary: the loader of :mod:`double_pendulum.fmu.build.loader`, compiled from source with the FMU's
   GUID, which calls the Python side itself (the FMI library's binaries are left out), and
   ``resources/python.cfg``, the building CPython;
 * ``resources/identity.cfg`` (model, GUID, entry module: the loader refuses another FMU's resources) and
@@ -35,8 +35,8 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from .. import loader, presets
-from . import bundle
+from .. import presets
+from . import bundle, loader
 
 PACKAGE_DIR = Path(__file__).resolve().parents[2]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.

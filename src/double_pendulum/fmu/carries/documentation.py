@@ -10,7 +10,7 @@ Nothing here is a second copy of the documentation: the page is assembled from
 * the parameter groups' docstrings and switches (:data:`SWITCH_GROUPS`: the switches of a scene);
 * the FMU's binaries, read for what each needs of the target machine
   (:mod:`double_pendulum.fmu.carries.elf_needs`), the CPython recorded at build and the loader's docstring (how
-  the FMU finds its Python, :mod:`double_pendulum.fmu.loader`);
+  the FMU finds its Python, :mod:`double_pendulum.fmu.build.loader`);
 * the result plot ``result.png`` of the FMU's default run (:mod:`double_pendulum.fmu.carries.doc_plot`).
 
 The page is plain HTML with its style inline and no script, so the simple HTML views of FMI tools show
@@ -184,7 +184,7 @@ def machine_section(files: Mapping[str, bytes], model: str) -> str:
                     f"<pre>{html.escape(chr(10).join(lines))}</pre>")
     intro = ("<p>The container's own binary (fmpy's <code>container_fmu</code>) needs no Python; its two FMUs, "
              "under <code>resources/</code>, do:</p>" if model == "PendulumOnSuspension" else "")
-    loader_doc = _module_doc("fmu.loader")
+    loader_doc = _module_doc("fmu.build.loader")
     head = "<thead><tr><th>binary</th><th>what it is</th><th>needs of the system</th></tr></thead>"
     return (f"{intro}\n<table>\n{head}\n<tbody>\n"
             + "\n".join(rows) + f"\n</tbody>\n</table>\n{recorded}\n"
