@@ -65,7 +65,7 @@ def simulate_ssp_with_libcosim(
     suspension_outputs: Sequence[str] = SUSPENSION_OUTPUTS,
     energy_scale: float = 1.0,
 ) -> np.ndarray:
-    """Run the SSP system (:mod:`double_pendulum.fmu.ssp`) in libcosim; return its rows at t = h, 2h, ...
+    """Run the SSP system (:mod:`double_pendulum.fmu.build.ssp`) in libcosim; return its rows at t = h, 2h, ...
 
     libcosim's fixed-step algorithm steps both FMUs side by side, reads their outputs and then
     sets the inputs (Jacobi, inputs held over the step; two more exchanges while initialising):

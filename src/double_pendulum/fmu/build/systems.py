@@ -2,7 +2,7 @@
 
 :func:`build_all` builds ``DoublePendulum`` and ``Suspension`` (FMI 2.0, :mod:`double_pendulum.fmu.build.fmi2`), the
 FMI 3.0 ``DoublePendulum`` (:mod:`double_pendulum.fmu.build.fmi3`) and, from the first two,
-``PendulumOnSuspension`` as an SSP (:mod:`double_pendulum.fmu.ssp`) and as fmpy's container FMU
+``PendulumOnSuspension`` as an SSP (:mod:`double_pendulum.fmu.build.ssp`) and as fmpy's container FMU
 (:mod:`double_pendulum.fmu.container`).
 """
 
@@ -36,7 +36,7 @@ def build_systems(
     ``pendulum_fmu``: the DoublePendulum FMU; ``Suspension.fmu`` is expected next to it.
     """
     from ..container import write_container
-    from ..ssp import write_ssp
+    from .ssp import write_ssp
 
     folder = Path(pendulum_fmu).parent
     fmus = (Path(pendulum_fmu), folder / "Suspension.fmu")

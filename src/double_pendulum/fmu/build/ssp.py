@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from .masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, split_values
+from ..masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, split_values
 
 SYSTEM_NAME = "PendulumOnSuspension"
 PENDULUM, SUSPENSION = "DoublePendulum", "Suspension"
@@ -137,7 +137,7 @@ def write_ssp(
         archive.write(pendulum_fmu, f"resources/{PENDULUM}.fmu")
         archive.write(suspension_fmu, f"resources/{SUSPENSION}.fmu")
         if reference:
-            from .carries.reference_result import ssp_reference_files
+            from ..carries.reference_result import ssp_reference_files
 
             for name, data in ssp_reference_files(values or {}, stop_time, macro_step).items():
                 archive.writestr(name, data)
