@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
+from double_pendulum.fmu.build.container import write_container
 from double_pendulum.fmu.build.fmi2 import build_fmu
 from double_pendulum.fmu.build.ssp import write_ssp
 from double_pendulum.fmu.build.systems import build_systems
-from double_pendulum.fmu.container import write_container
 from double_pendulum.fmu.hosts import simulate_container, simulate_ssp_with_libcosim
 from double_pendulum.fmu.masters.coupling import FmuSlave, run_coupled, split_values
 

@@ -115,7 +115,7 @@ def simulate_container(
     suspension_outputs: Sequence[str] = SUSPENSION_OUTPUTS,
     energy_scale: float = 1.0,
 ) -> np.ndarray:
-    """Run the container FMU (:mod:`double_pendulum.fmu.container`) in fmpy; rows at t = 0, h, 2h, ...
+    """Run the container FMU (:mod:`double_pendulum.fmu.build.container`) in fmpy; rows at t = 0, h, 2h, ...
 
     The container is an ordinary FMI 2.0 co-simulation FMU to fmpy (``FMU2Slave``); it is stepped
     with ``doStep(n h, h)``, ``macro_step`` [s] the container's fixed step (or a multiple of it).

@@ -40,9 +40,9 @@ RECORD = "references.json"
 def build_case_fmus(folder: str | Path) -> dict[str, Path]:
     """Build every FMU the cases run into ``folder``, as :func:`~double_pendulum.fmu.reference_cases.fmu_file`
     names them (``2.0/DoublePendulum.fmu``, ``3.0/DoublePendulumChaotic.fmu``, ...); return them by that name."""
+    from .build.container import write_container
     from .build.fmi2 import build_fmu
     from .build.fmi3 import build_fmu3
-    from .container import write_container
 
     folder = Path(folder)
     built: dict[str, Path] = {}

@@ -3,7 +3,7 @@
 :func:`build_all` builds ``DoublePendulum`` and ``Suspension`` (FMI 2.0, :mod:`double_pendulum.fmu.build.fmi2`), the
 FMI 3.0 ``DoublePendulum`` (:mod:`double_pendulum.fmu.build.fmi3`) and, from the first two,
 ``PendulumOnSuspension`` as an SSP (:mod:`double_pendulum.fmu.build.ssp`) and as fmpy's container FMU
-(:mod:`double_pendulum.fmu.container`).
+(:mod:`double_pendulum.fmu.build.container`).
 """
 
 from __future__ import annotations
@@ -35,7 +35,7 @@ def build_systems(
 
     ``pendulum_fmu``: the DoublePendulum FMU; ``Suspension.fmu`` is expected next to it.
     """
-    from ..container import write_container
+    from .container import write_container
     from .ssp import write_ssp
 
     folder = Path(pendulum_fmu).parent

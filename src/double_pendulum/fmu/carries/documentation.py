@@ -38,7 +38,7 @@ MODEL_SOURCES: dict[str, tuple[str, ...]] = {
     "DoublePendulumFmi3": ("model.dynamics", "model.links", "model.kinematics", "model.forces", "model.inputs",
                            "component.model_exchange"),
     "Suspension": ("model.suspension", "component.suspension"),
-    "PendulumOnSuspension": ("fmu.container",),
+    "PendulumOnSuspension": ("fmu.build.container",),
 }
 """The modules (under ``double_pendulum``) whose docstrings are the page's "The model" section."""
 SWITCH_GROUPS = {"DoublePendulum": (AirDragParameters, BearingParameters, SuspensionParameters)}

@@ -14,7 +14,7 @@
   layout (:mod:`double_pendulum.fmu.carries.reference_result`).
 
 The build adds them in :func:`double_pendulum.fmu.build.staging.rewrite_fmu` (DoublePendulum, Suspension, the
-FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.container.write_container` (the container).
+FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.build.container.write_container` (the container).
 """
 
 from __future__ import annotations

@@ -34,8 +34,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, split_values
-from .presets import literal
+from ..masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, split_values
+from ..presets import literal
 
 SYSTEM_NAME = "PendulumOnSuspension"
 PENDULUM, SUSPENSION = "DoublePendulum", "Suspension"
@@ -178,7 +178,7 @@ def write_container(
 
 def _add_presentation(root: Path) -> None:
     """Write the container's documentation, icon and terminals into the folder ``root`` it is zipped from."""
-    from .carries.presentation import CONTAINER, presentation_files
+    from ..carries.presentation import CONTAINER, presentation_files
 
     files = {path.relative_to(root).as_posix(): path.read_bytes() for path in root.rglob("*")
              if path.is_file() and (path.name in ("modelDescription.xml", "python.cfg", "bundle.json")
