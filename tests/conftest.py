@@ -14,7 +14,7 @@ import pytest
 import sanitize
 
 from double_pendulum.fmu.build.systems import build_all
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"

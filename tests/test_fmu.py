@@ -20,7 +20,7 @@ from scipy.special import ellipk
 
 from double_pendulum.fmu.build import loader
 from double_pendulum.fmu.masters.simulate import simulate
-from double_pendulum.fmu.runner import FmuRunError
+from double_pendulum.fmu.running.runner import FmuRunError
 from double_pendulum.model.dynamics import linearised_normal_modes
 from double_pendulum.model.outputs import OUTPUT_NAMES
 from double_pendulum.model.parameters import PendulumParameters

@@ -11,7 +11,7 @@ import pytest
 
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.fmu.masters.simulate import simulate
-from double_pendulum.fmu.runner import FmuRunError
+from double_pendulum.fmu.running.runner import FmuRunError
 from double_pendulum.model.inputs import INPUT_NAMES
 from double_pendulum.model.outputs import MODEL_OUTPUT_NAMES, OUTPUT_NAMES, PORT_NAMES
 from double_pendulum.model.parameters import ParameterError, PendulumParameters

@@ -152,7 +152,7 @@ def _load_fmu(path: str, rebuild: bool):
     open the FMU with fmpy; unusable files become a CliError."""
     import zipfile
 
-    from .fmu.runner import FmuRunner
+    from .fmu.running.runner import FmuRunner
 
     fmu = Path(path)
     if rebuild or not fmu_set_is_current(fmu):

@@ -80,7 +80,7 @@ from .mechanisms import (
 
 
 class ComponentRunner:
-    """The FMU's co-simulation component in-process, with :class:`~double_pendulum.fmu.runner.FmuRunner`'s
+    """The FMU's co-simulation component in-process, with :class:`~double_pendulum.fmu.running.runner.FmuRunner`'s
     ``simulate`` signature (same numbers, no FMI layer)."""
 
     def simulate(self, start_values: Mapping[str, Any] | None = None, **kwargs: Any) -> np.ndarray:

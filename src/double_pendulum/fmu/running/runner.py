@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from ..model.outputs import OUTPUT_NAMES
-from .build.fmi2 import DEFAULT_FMU_PATH, build_fmu, fmu_is_current
+from ...model.outputs import OUTPUT_NAMES
+from ..build.fmi2 import DEFAULT_FMU_PATH, build_fmu, fmu_is_current
 
 
 class FmuRunError(RuntimeError):
