@@ -18,8 +18,8 @@ from double_pendulum.fmu.build.container import write_container
 from double_pendulum.fmu.build.fmi2 import build_fmu
 from double_pendulum.fmu.build.ssp import write_ssp
 from double_pendulum.fmu.build.systems import build_systems
-from double_pendulum.fmu.hosts import simulate_container, simulate_ssp_with_libcosim
 from double_pendulum.fmu.masters.coupling import FmuSlave, run_coupled, split_values
+from double_pendulum.fmu.running.hosts import simulate_container, simulate_ssp_with_libcosim
 
 START = {"phi1_0": 1.2, "phi2_0": 0.8}
 STOP = 0.2

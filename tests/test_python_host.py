@@ -63,7 +63,7 @@ SCRIPT = textwrap.dedent("""
                                                           if n.startswith(linux)) for p in fmus}
 
     # the coupled system on libcosim and as the container FMU, in this same process
-    from double_pendulum.fmu.hosts import simulate_container, simulate_ssp_with_libcosim
+    from double_pendulum.fmu.running.hosts import simulate_container, simulate_ssp_with_libcosim
     ssp = simulate_ssp_with_libcosim(folder / "PendulumOnSuspension.ssp", stop_time=0.05, macro_step=1e-3)
     container = simulate_container(folder / "PendulumOnSuspension.fmu", stop_time=0.05, macro_step=1e-3)
     out["ssp_phi1"], out["container_phi1"] = float(ssp["phi1"][-1]), float(container["phi1"][-1])

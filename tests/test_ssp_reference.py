@@ -45,7 +45,7 @@ def test_the_ssp_holds_the_states_of_its_default_experiment(reference):
 
 
 def test_libcosim_reproduces_the_ssps_reference(built_ssp, reference):
-    from double_pendulum.fmu.hosts import simulate_ssp_with_libcosim
+    from double_pendulum.fmu.running.hosts import simulate_ssp_with_libcosim
 
     rows = simulate_ssp_with_libcosim(built_ssp, stop_time=HORIZON, macro_step=MACRO_STEP,
                                       pendulum_outputs=SHORT[:4], suspension_outputs=SHORT[4:])

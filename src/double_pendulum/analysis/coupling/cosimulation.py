@@ -84,7 +84,7 @@ def _in_process(values: Mapping[str, Any], stop_time: float, h: float, scheme: s
 def _on_engine(values: Mapping[str, Any], stop_time: float, h: float, engine: str, fmus: Sequence[Path]) -> np.ndarray:
     from ...fmu.build.container import write_container
     from ...fmu.build.ssp import write_ssp
-    from ...fmu.hosts import simulate_container, simulate_ssp_with_libcosim
+    from ...fmu.running.hosts import simulate_container, simulate_ssp_with_libcosim
 
     with tempfile.TemporaryDirectory(prefix="dp_cosim_") as tmp:
         if engine == "libcosim":

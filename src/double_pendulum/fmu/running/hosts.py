@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from .masters.coupling import PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, CouplingError, check_row, column_names
+from ..masters.coupling import PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, CouplingError, check_row, column_names
 
 NANOSECONDS_PER_SECOND = 1_000_000_000
 
