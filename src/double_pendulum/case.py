@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from .fmu.running.runner import FmuRunError, FmuRunner
-from .fmu.start_values import value_text
+from .fmu.running.start_values import value_text
 from .model.outputs import OUTPUT_NAMES
 from .plots import animate_swings, swing
 from .plots.case import plot_case
