@@ -5,7 +5,7 @@ The FMI Cross-Check (modelica/fmi-cross-check, rules v4.1) asks an exporting too
 ``<Model>_ref.csv``, ``<Model>_ref.opt``, ``<Model>_in.csv`` where it has inputs and a ReadMe.
 :func:`write_tree` writes it for this platform (:data:`PLATFORM`) from freshly built case FMUs
 (:func:`double_pendulum.fmu.reference_runs.build_case_fmus`) and the committed reference files
-(``data/reference/fmu/``, :mod:`double_pendulum.fmu.reference_cases`).
+(``data/reference/fmu/``, :mod:`double_pendulum.fmu.crosscheck.reference_cases`).
 
 The checks, as the Cross-Check runs them:
 
@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import __version__
-from .reference_cases import CASES, ReferenceCase, fmu_file, input_names
+from .crosscheck.reference_cases import CASES, ReferenceCase, fmu_file, input_names
 
 TOOL = "double-pendulum-fmu"
 PLATFORM = "linux64"
@@ -104,7 +104,7 @@ The double-pendulum-fmu project; `double-pendulum cross-check DIR` writes this f
 
 def write_tree(root: str | Path, fmus: Mapping[str, Path], references: str | Path) -> list[Path]:
     """Write every case's folder under ``root``: the FMU from ``fmus`` (by
-    :func:`~double_pendulum.fmu.reference_cases.fmu_file`), the files from ``references`` (the committed
+    :func:`~double_pendulum.fmu.crosscheck.reference_cases.fmu_file`), the files from ``references`` (the committed
     ``data/reference/fmu``) and a ReadMe. The tool's folders are written anew; return the case folders."""
     references = Path(references)
     record = json.loads((references / "references.json").read_text(encoding="utf-8"))

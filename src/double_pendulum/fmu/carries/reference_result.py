@@ -9,7 +9,7 @@ with the component(s) the FMU runs (:func:`double_pendulum.fmu.carries.doc_plot.
 it couples them). An importer that simulates the FMU with its defaults and that output interval should get
 these numbers: fmpy does, to rounding under Co-Simulation and within the tolerance under Model Exchange
 (``tests/test_reference_result.py``). The cross-check tree's references
-(:mod:`double_pendulum.fmu.reference_cases`) are other cases, with inputs and tight tolerances.
+(:mod:`double_pendulum.fmu.crosscheck.reference_cases`) are other cases, with inputs and tight tolerances.
 """
 
 from __future__ import annotations

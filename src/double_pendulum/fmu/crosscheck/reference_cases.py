@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..component.suspension import INPUT_START
-from ..model.inputs import INPUT_NAMES
+from ...component.suspension import INPUT_START
+from ...model.inputs import INPUT_NAMES
 
 TIGHT = {"rtol": 1e-12, "atol": 1e-14}
 """The FMU's integrator settings of a reference run (for FMUs that do not have them baked in)."""
