@@ -26,7 +26,7 @@ from double_pendulum.data import data_path
 
 from double_pendulum.fmu.build import loader
 from double_pendulum.fmu.crosscheck.reference_cases import CASES, ReferenceCase, fmu_file, input_names
-from double_pendulum.fmu.reference_runs import (
+from double_pendulum.fmu.crosscheck.reference_runs import (
     RECORD,
     build_case_fmus,
     input_csv,

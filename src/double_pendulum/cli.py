@@ -250,7 +250,7 @@ def cmd_cross_check(args: argparse.Namespace) -> int:
     with --checker the FMI Compliance Checker). Exit status 1 if a check finds a problem."""
     from .data import data_path
     from .fmu.cross_check import case_of, import_with_fmpy, validate_tree, write_tree
-    from .fmu.reference_runs import build_case_fmus
+    from .fmu.crosscheck.reference_runs import build_case_fmus
 
     checker = None
     if args.checker is not None:

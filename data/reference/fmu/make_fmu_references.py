@@ -22,7 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from double_pendulum.fmu.reference_runs import build_case_fmus, write_references
+from double_pendulum.fmu.crosscheck.reference_runs import build_case_fmus, write_references
 
 HERE = Path(__file__).resolve().parent
 

@@ -4,7 +4,7 @@ The FMI Cross-Check (modelica/fmi-cross-check, rules v4.1) asks an exporting too
 ``fmus/<fmi_version>/<cs|me>/<platform>/<tool>/<version>/<Model>/`` holding ``<Model>.fmu``,
 ``<Model>_ref.csv``, ``<Model>_ref.opt``, ``<Model>_in.csv`` where it has inputs and a ReadMe.
 :func:`write_tree` writes it for this platform (:data:`PLATFORM`) from freshly built case FMUs
-(:func:`double_pendulum.fmu.reference_runs.build_case_fmus`) and the committed reference files
+(:func:`double_pendulum.fmu.crosscheck.reference_runs.build_case_fmus`) and the committed reference files
 (``data/reference/fmu/``, :mod:`double_pendulum.fmu.crosscheck.reference_cases`).
 
 The checks, as the Cross-Check runs them:

@@ -23,7 +23,7 @@ PendulumOnSuspension   2.0 cs             the container: the two FMUs coupled, f
 
 The reference of a case is its run in fmpy at tight tolerance (:data:`TIGHT`: the FMU's own
 integrator, or CVode under Model Exchange), made by ``data/reference/fmu/make_fmu_references.py``
-(:mod:`double_pendulum.fmu.reference_runs`) and committed; ``double-pendulum cross-check`` writes the
+(:mod:`double_pendulum.fmu.crosscheck.reference_runs`) and committed; ``double-pendulum cross-check`` writes the
 tree (:mod:`double_pendulum.fmu.cross_check`).
 """
 
@@ -206,6 +206,7 @@ def input_table(case: ReferenceCase) -> list[tuple[float, ...]] | None:
 
 
 def fmu_file(case: ReferenceCase) -> str:
-    """The case's FMU in a folder of built case FMUs (:func:`double_pendulum.fmu.reference_runs.build_case_fmus`):
-    ``<fmi_version>/<model>.fmu`` (an FMI 3 FMU serves both its interfaces)."""
+    """The case's FMU in a folder of built case FMUs
+    (:func:`double_pendulum.fmu.crosscheck.reference_runs.build_case_fmus`): ``<fmi_version>/<model>.fmu``
+    (an FMI 3 FMU serves both its interfaces)."""
     return f"{case.fmi_version}/{case.model}.fmu"

@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from .. import __version__
-from .crosscheck.reference_cases import (
+from ... import __version__
+from .reference_cases import (
     CASES,
     CONTAINER_VALUES,
     ME_REFERENCE_TOLERANCE,
@@ -32,7 +32,7 @@ from .crosscheck.reference_cases import (
     fmu_file,
     input_names,
 )
-from .crosscheck.reference_cases import input_table as case_input_table
+from .reference_cases import input_table as case_input_table
 
 RECORD = "references.json"
 
@@ -41,9 +41,9 @@ def build_case_fmus(folder: str | Path) -> dict[str, Path]:
     """Build every FMU the cases run into ``folder``, as
     :func:`~double_pendulum.fmu.crosscheck.reference_cases.fmu_file` names them (``2.0/DoublePendulum.fmu``,
     ``3.0/DoublePendulumChaotic.fmu``, ...); return them by that name."""
-    from .build.container import write_container
-    from .build.fmi2 import build_fmu
-    from .build.fmi3 import build_fmu3
+    from ..build.container import write_container
+    from ..build.fmi2 import build_fmu
+    from ..build.fmi3 import build_fmu3
 
     folder = Path(folder)
     built: dict[str, Path] = {}
