@@ -249,8 +249,8 @@ def cmd_cross_check(args: argparse.Namespace) -> int:
     """Write the FMI Cross-Check tree into ``args.dir`` and check it (fmpy; with --simulate fmpy as importer;
     with --checker the FMI Compliance Checker). Exit status 1 if a check finds a problem."""
     from .data import data_path
-    from .fmu.cross_check import case_of, import_with_fmpy, validate_tree, write_tree
     from .fmu.crosscheck.reference_runs import build_case_fmus
+    from .fmu.crosscheck.tree import case_of, import_with_fmpy, validate_tree, write_tree
 
     checker = None
     if args.checker is not None:

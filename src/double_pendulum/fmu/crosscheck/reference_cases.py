@@ -24,7 +24,7 @@ PendulumOnSuspension   2.0 cs             the container: the two FMUs coupled, f
 The reference of a case is its run in fmpy at tight tolerance (:data:`TIGHT`: the FMU's own
 integrator, or CVode under Model Exchange), made by ``data/reference/fmu/make_fmu_references.py``
 (:mod:`double_pendulum.fmu.crosscheck.reference_runs`) and committed; ``double-pendulum cross-check`` writes the
-tree (:mod:`double_pendulum.fmu.cross_check`).
+tree (:mod:`double_pendulum.fmu.crosscheck.tree`).
 """
 
 from __future__ import annotations

@@ -27,8 +27,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from .. import __version__
-from .crosscheck.reference_cases import CASES, ReferenceCase, fmu_file, input_names
+from ... import __version__
+from .reference_cases import CASES, ReferenceCase, fmu_file, input_names
 
 TOOL = "double-pendulum-fmu"
 PLATFORM = "linux64"
