@@ -280,7 +280,7 @@ def cmd_cross_check(args: argparse.Namespace) -> int:
 def _check_with_compliance_checker(checker: Path, folder: Path, case, root: Path) -> int:
     """Run the FMI Compliance Checker on one FMI 2.0 folder (its log and result go to
     ``DIR/compliance-checker/...``); print its summary; 1 if it reported an error."""
-    from .fmu.compliance_checker import run_checker
+    from .fmu.crosscheck.compliance_checker import run_checker
 
     if case.fmi_version != "2.0":
         return 0

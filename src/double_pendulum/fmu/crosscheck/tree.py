@@ -16,7 +16,7 @@ The checks, as the Cross-Check runs them:
 * :func:`import_with_fmpy`: fmpy as an importer, run from the options and inputs as
   ``python -m fmpy.cross_check --simulate`` runs it, its result judged by
   ``fmpy.cross_check.validate_result`` (at most 10 % of the samples outside the reference's band);
-* the FMI Compliance Checker with the input file: :mod:`double_pendulum.fmu.compliance_checker`.
+* the FMI Compliance Checker with the input file: :mod:`double_pendulum.fmu.crosscheck.compliance_checker`.
 """
 
 from __future__ import annotations

@@ -20,7 +20,7 @@ import subprocess
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from .crosscheck.reference_cases import ReferenceCase, input_names
+from .reference_cases import ReferenceCase, input_names
 
 CHECKER_VARIABLE = "DOUBLE_PENDULUM_FMU_CHECKER"
 CHECKER_NAME = "fmuCheck.linux64"
