@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from double_pendulum.fmu.runner import FmuRunner, ensure_fmu
+from double_pendulum.fmu.running.runner import FmuRunner, ensure_fmu
 
 
 def _median_spread(samples: list[float]) -> str:

@@ -21,9 +21,9 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from double_pendulum.fmu.build import build_fmu
-from double_pendulum.fmu.hosts import simulate_ssp_with_libcosim, simulate_with_libcosim
-from double_pendulum.fmu.ssp import write_ssp
+from double_pendulum.fmu.build.fmi2 import build_fmu
+from double_pendulum.fmu.build.ssp import write_ssp
+from double_pendulum.fmu.running.hosts import simulate_ssp_with_libcosim, simulate_with_libcosim
 from double_pendulum.model.inputs import INPUT_NAMES
 
 EMPTY_SLAVE = '''

@@ -12,7 +12,7 @@ Usage: ``python benchmarks/fmi3_interfaces.py [--repeats 3]``
    (M_s = 2 kg, k = 2e4 N/m, c = 20 N s/m) with phi1 = phi2 = 1 rad for 1 s: the FMI 3 FMU with
    ``suspension`` on, integrated as one system by CVode (ME; the FMU's own dop853 as CS for
    comparison), against DoublePendulum.fmu and Suspension.fmu (FMI 2) coupled by
-   ``double_pendulum.fmu.coupling.run_coupled`` (Jacobi as libcosim does it, and iterative with
+   ``double_pendulum.fmu.masters.coupling.run_coupled`` (Jacobi as libcosim does it, and iterative with
    rollback) at several macro steps. Error: the largest angle error on the 10 ms grid against the
    monolith's reference; cost: CPU time of the whole run; for each target error the cheapest run of
    each kind and the cost ratio split / monolithic ME.
@@ -34,9 +34,9 @@ import numpy as np
 from fmpy import extract, read_model_description, simulate_fmu
 
 from double_pendulum.analysis.solvers.reference import reference_solution
-from double_pendulum.fmu.build import build_fmu
-from double_pendulum.fmu.build_fmi3 import build_fmu3
-from double_pendulum.fmu.coupling import FmuSlave, run_coupled, split_values
+from double_pendulum.fmu.build.fmi2 import build_fmu
+from double_pendulum.fmu.build.fmi3 import build_fmu3
+from double_pendulum.fmu.masters.coupling import FmuSlave, run_coupled, split_values
 
 CHAOTIC = {"phi1_0": 2.0, "phi2_0": 2.0}
 ON_SUSPENSION = {"phi1_0": 1.0, "phi2_0": 1.0, "suspension": True}

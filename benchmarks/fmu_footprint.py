@@ -24,7 +24,7 @@ from pathlib import Path
 from fmpy import extract, read_model_description
 from fmu_performance import startup_time
 
-from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import loader
 
 HOST_SOURCE = Path(__file__).resolve().parents[1] / "tests" / "c_host" / "fmi2_host.c"
 

@@ -34,7 +34,7 @@ import numpy as np
 
 from double_pendulum.analysis.solvers.reference import STATE_OUTPUTS, reference_solution
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
-from double_pendulum.fmu.runner import FmuRunner, ensure_fmu
+from double_pendulum.fmu.running.runner import FmuRunner, ensure_fmu
 
 CHAOTIC = {"phi1_0": 2.0, "phi2_0": 2.0}
 STIFF = {"phi1_0": 1.0, "phi2_0": 1.0, "suspension": True, "M_s": 0.05, "k_x": 1e7, "k_y": 1e7,

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from fmpy import extract, read_model_description
 
-from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import loader
 
 HOSTS = Path(__file__).resolve().parents[1] / "tests" / "c_host"
 NAMES = ("phi1_0", "m1", "l1", "solver", "phi1", "pivot_ax", "air_drag", "fixed_step", "omega2_0")

@@ -29,7 +29,7 @@ from pathlib import Path
 from coupling_performance import build_empty_fmu, shaker
 
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
-from double_pendulum.fmu.build import build_fmu
+from double_pendulum.fmu.build.fmi2 import build_fmu
 from double_pendulum.model.inputs import INPUT_NAMES
 
 H = 1e-3

@@ -3,7 +3,7 @@
     python benchmarks/sweep_cost.py [--fmu build/DoublePendulum.fmu] [--reference OLD.fmu] [--cases 1000]
 
 Each case is a 0.1 s run (10 steps of 10 ms, start value phi1_0 drawn per case) through
-:class:`double_pendulum.fmu.runner.FmuRunner`, as :func:`double_pendulum.analysis.sweep.run_sweep`
+:class:`double_pendulum.fmu.running.runner.FmuRunner`, as :func:`double_pendulum.analysis.sweep.run_sweep`
 runs it in a worker. Measured, each in a fresh process: the FMU with its instance reused (reset
 between cases, the default), the same FMU with a new instance per case (``reuse_instance=False``, as
 every case paid before), and optionally a reference FMU (an older build) with a new instance per
@@ -23,7 +23,7 @@ from pathlib import Path
 WORKER = textwrap.dedent("""
     import json, statistics, sys, time
     from double_pendulum.analysis.sweep import random_cases
-    from double_pendulum.fmu.runner import FmuRunner
+    from double_pendulum.fmu.running.runner import FmuRunner
 
     fmu, reuse, n = sys.argv[1], sys.argv[2] == "1", int(sys.argv[3])
     def rss_kib():

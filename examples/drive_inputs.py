@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from fmpy import simulate_fmu  # noqa: E402
 
-from double_pendulum.fmu.runner import ensure_fmu  # noqa: E402
+from double_pendulum.fmu.running.runner import ensure_fmu  # noqa: E402
 
 INPUTS = ("pivot_x", "pivot_y", "pivot_vx", "pivot_vy", "pivot_ax", "pivot_ay", "tau1", "tau2")
 TORQUE_N_M = 0.002  # amplitude of the motor torque on the upper rod

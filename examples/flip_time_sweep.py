@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from double_pendulum.analysis.sweep import grid_cases, run_sweep  # noqa: E402
-from double_pendulum.fmu.runner import ensure_fmu  # noqa: E402
+from double_pendulum.fmu.running.runner import ensure_fmu  # noqa: E402
 
 
 def first_flip_s(result: np.ndarray) -> float:

@@ -30,7 +30,7 @@ from pathlib import Path
 from types import ModuleType
 
 RESOURCES = Path(__file__).resolve().parent.parent  # in a built FMU: this package's folder is in resources/
-BUNDLE_FILE = "bundle.json"  # written by the build (double_pendulum.fmu.build)
+BUNDLE_FILE = "bundle.json"  # written by the build (double_pendulum.fmu.build.staging)
 PRESET_FILE = "start_values.json"  # start values baked in by the build (double_pendulum.fmu.presets)
 PRIVATE_MARK = "_dp_fmu_"  # every private module name starts with it
 

@@ -28,7 +28,7 @@ from double_pendulum.analysis.excitation import report as rep
 from double_pendulum.analysis.excitation import study
 from double_pendulum.analysis.excitation.drive import TORQUE_OUTPUTS, run_cases, run_torque
 from double_pendulum.analysis.excitation.theory import held_floquet_exponent
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.plots import excitation as fig
 from double_pendulum.runs.results_io import write_json, write_results_csv, write_table_csv, write_text
 

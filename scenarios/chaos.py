@@ -28,7 +28,7 @@ from double_pendulum.analysis.chaos.in_short import in_short
 from double_pendulum.analysis.chaos.lyapunov import LyapunovResult, lyapunov_benettin, lyapunov_two_trajectory
 from double_pendulum.analysis.chaos.plan import FULL, QUICK, THOROUGH, H, Plan, precision
 from double_pendulum.analysis.sweep import default_workers, parallel_map, run_sweep, where_runs
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.model.parameters import AirDragParameters, BearingParameters, PendulumParameters
 from double_pendulum.model.vector_field import ModelConfig
 from double_pendulum.runs.progress import step

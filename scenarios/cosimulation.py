@@ -32,8 +32,8 @@ from double_pendulum.analysis.coupling import cosimulation as study
 from double_pendulum.analysis.coupling.report import report_text
 from double_pendulum.analysis.coupling.stability import critical_mass_ratio, limit_table
 from double_pendulum.analysis.sweep import parallel_map
-from double_pendulum.fmu.build import build_fmu
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.build.fmi2 import build_fmu
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.plots import coupling as plots
 from double_pendulum.runs.results_io import write_json, write_table_csv, write_text
 

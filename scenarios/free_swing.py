@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from double_pendulum import plots
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.runs.results_io import read_results_csv, write_json, write_results_csv
 
 DESCRIPTION = "frictionless swing from a regular (small-angle) and a chaotic (2 rad) start"

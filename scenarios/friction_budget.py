@@ -26,7 +26,7 @@ import numpy as np
 from double_pendulum import plots
 from double_pendulum.analysis.decay.fit import fit_model
 from double_pendulum.analysis.sweep import runner_map, timed_simulate, where_runs
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.runs.progress import step
 from double_pendulum.runs.results_io import write_json, write_results_csv
 

@@ -108,7 +108,7 @@ from double_pendulum.analysis.prediction.runs import fitted_starts, starts_summa
 from double_pendulum.analysis.prediction.runs import predictions as run_predictions
 from double_pendulum.analysis.suspension.identification import START_FIT_FRAMES
 from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, Reconstruction
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.runs.results_io import read_results_csv, write_json, write_results_csv, write_text
 

@@ -40,7 +40,7 @@ from double_pendulum.analysis.solvers.stability_cases import (
     worst_passing,
 )
 from double_pendulum.analysis.sweep import runner_map, where_runs
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.runs.progress import step
 from double_pendulum.runs.results_io import write_json, write_results_csv, write_table_csv, write_text
 

@@ -66,7 +66,7 @@ from double_pendulum.analysis.suspension.plan import FULL, NULL_MEANS, QUICK, TH
 from double_pendulum.analysis.suspension.report import report_text
 from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.analysis.track.measurement import load_track, reconstruct
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.runs.progress import step
 from double_pendulum.runs.results_io import write_json, write_results_csv, write_text
 

@@ -49,7 +49,7 @@ from double_pendulum.analysis.solvers.work_precision import (
     settings_for,
 )
 from double_pendulum.analysis.sweep import runner_map
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.runs.progress import step
 from double_pendulum.runs.results_io import write_json, write_table_csv, write_text
 from double_pendulum.solvers import METHODS

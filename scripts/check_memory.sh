@@ -23,7 +23,7 @@ started=$(now)
 # --- 1. ASan + UBSan: the torture hosts' tests, built sanitized -----------------------------------------
 # -n0: one process (the module runs on one xdist worker anyway, and starting workers costs more than it saves).
 part=$(now)
-if ! "$python" -c "from double_pendulum.fmu import loader; raise SystemExit(loader.c_compiler() is None)"; then
+if ! "$python" -c "from double_pendulum.fmu.build import loader; raise SystemExit(loader.c_compiler() is None)"; then
     echo "memory 1/2 (ASan/UBSan): SKIPPED: no C compiler (\$CC, cc, gcc or clang) to build the loader and hosts"
 else
     echo "memory 1/2 (ASan/UBSan): tests/test_guard.py with the loader and the torture hosts built sanitized ..."

@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 import sanitize
 
-from double_pendulum.fmu.build import build_all
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.build.systems import build_all
+from double_pendulum.fmu.running.runner import FmuRunner
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
@@ -30,7 +30,7 @@ def fmu_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="session")
 def fmu3_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """A freshly built FMI 3.0 DoublePendulum.fmu, Model Exchange and Co-Simulation (built once per session)."""
-    from double_pendulum.fmu.build_fmi3 import build_fmu3
+    from double_pendulum.fmu.build.fmi3 import build_fmu3
 
     return build_fmu3(tmp_path_factory.mktemp("fmu3") / "DoublePendulum.fmu")
 

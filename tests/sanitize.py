@@ -2,7 +2,7 @@
 
 With ``DOUBLE_PENDULUM_SANITIZE=1`` the test session (tests/conftest.py) builds the FMUs' loader with
 AddressSanitizer and UndefinedBehaviorSanitizer (through ``DOUBLE_PENDULUM_LOADER_CFLAGS``, read by
-:mod:`double_pendulum.fmu.loader`), tests/test_guard.py compiles its C torture hosts with the same flags
+:mod:`double_pendulum.fmu.build.loader`), tests/test_guard.py compiles its C torture hosts with the same flags
 and runs them with :func:`environment` added to their bare environment: any finding ends the host
 with a report on stderr and a non-zero exit, which fails the test with the report in its message.
 Without the variable nothing changes.
@@ -49,6 +49,6 @@ def environment() -> dict[str, str]:
 def configure() -> None:
     """In a sanitized session, have the loader built with LOADER_FLAGS (unless the variable is set already)."""
     if ENABLED:
-        from double_pendulum.fmu import loader
+        from double_pendulum.fmu.build import loader
 
         os.environ.setdefault(loader.EXTRA_CFLAGS_VARIABLE, shlex.join(LOADER_FLAGS))

@@ -11,7 +11,7 @@ from dataclasses import fields
 import pytest
 
 from double_pendulum.component.cosimulation import PARAMETER_GROUPS
-from double_pendulum.fmu.runner import FmuRunError
+from double_pendulum.fmu.running.runner import FmuRunError
 
 INVALID_VALUES = {
     "positive": [-1.0, 0.0, math.nan, math.inf, -math.inf],
@@ -197,7 +197,7 @@ def test_through_the_runner_errors_reach_the_caller_not_stderr(fmu_path, tmp_pat
     """FmuRunner collects the FMU's log and raises it; the FMU then leaves stderr alone (no alarm lines)."""
     script = textwrap.dedent(f"""
         import os
-        from double_pendulum.fmu.runner import FmuRunError, FmuRunner
+        from double_pendulum.fmu.running.runner import FmuRunError, FmuRunner
         with FmuRunner({str(fmu_path)!r}) as runner:
             try:
                 runner.simulate({{"solver": "rk4", "fixed_step": 0.5, "phi1_0": 3.0, "omega2_0": 30.0}}, stop_time=20.0)

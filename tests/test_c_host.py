@@ -1,6 +1,6 @@
 """The FMUs in a host that is not Python: a minimal C host (tests/c_host/fmi2_host.c), started with a
 bare environment, loads each FMU that ``double-pendulum build`` writes through its C loader
-(``fmu_src/loader/``, :mod:`double_pendulum.fmu.loader`), runs it as fmpy does and gets fmpy's numbers;
+(``fmu_src/loader/``, :mod:`double_pendulum.fmu.build.loader`), runs it as fmpy does and gets fmpy's numbers;
 without a usable Python the FMU refuses to instantiate and says why in one line. The FMI 3.0 FMU runs
 in tests/c_host/fmi3_host.c: Model Exchange integrated by the host (RK4, FMI 3 event handling, strict
 out-arguments) and Co-Simulation."""
@@ -16,8 +16,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from double_pendulum.fmu import loader
-from double_pendulum.fmu.build import build_all
+from double_pendulum.fmu.build import loader
+from double_pendulum.fmu.build.systems import build_all
 
 HOST_SOURCE = Path(__file__).parent / "c_host" / "fmi2_host.c"
 STEPS, STEP_SIZE = 1000, 1e-3

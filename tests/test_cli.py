@@ -134,7 +134,7 @@ def test_an_unknown_option_shows_the_usage_of_its_command(capsys):
 def test_corrupt_fmu_is_one_clear_line(tmp_path, capsys, monkeypatch):
     fmu = tmp_path / "broken.fmu"
     fmu.write_bytes(b"not a zip file")
-    monkeypatch.setattr("double_pendulum.fmu.build.fmu_is_current", lambda path: True)  # do not rebuild it
+    monkeypatch.setattr("double_pendulum.fmu.build.fmi2.fmu_is_current", lambda path: True)  # do not rebuild it
     assert main(["run", "free_swing", "--fmu", str(fmu), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "is not a usable FMU" in err and "BadZipFile" in err
@@ -250,7 +250,7 @@ def test_run_from_another_folder_keeps_every_fmu_in_the_out_folder(tmp_path, mon
     newer = tmp_path / "DoublePendulumFmi3.py"  # an FMI 3 adapter source changed since: the set is stale
     newer.write_text("")
     os.utime(newer, (fmu.stat().st_mtime + 60,) * 2)
-    monkeypatch.setattr("double_pendulum.fmu.build_fmi3.adapter_sources", lambda: [newer])
+    monkeypatch.setattr("double_pendulum.fmu.build.fmi3.adapter_sources", lambda: [newer])
     assert not fmu_set_is_current(fmu)
     monkeypatch.undo()
     (out / "fmu" / "PendulumOnSuspension.ssp").unlink()  # one missing: the next run builds the set again

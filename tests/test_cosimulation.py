@@ -12,7 +12,7 @@ from double_pendulum.analysis.coupling.cosimulation import fitted_order, stabili
 from double_pendulum.analysis.coupling.stability import critical_mass_ratio, oscillator_step, spectral_radius
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.component.suspension import SuspensionCoSimulation
-from double_pendulum.fmu.coupling import CouplingError, run_coupled, split_values
+from double_pendulum.fmu.masters.coupling import CouplingError, run_coupled, split_values
 
 
 def _split(values: dict, scheme: str, stop: float, h: float) -> np.ndarray:

@@ -14,9 +14,9 @@ import pytest
 
 from double_pendulum import __version__
 from double_pendulum.cli import main
-from double_pendulum.fmu.compliance_checker import find_checker, run_checker
-from double_pendulum.fmu.cross_check import PLATFORM, TOOL, case_of, import_with_fmpy, model_dir, validate_tree
-from double_pendulum.fmu.reference_cases import CASES, input_names
+from double_pendulum.fmu.crosscheck.compliance_checker import find_checker, run_checker
+from double_pendulum.fmu.crosscheck.reference_cases import CASES, input_names
+from double_pendulum.fmu.crosscheck.tree import PLATFORM, TOOL, case_of, import_with_fmpy, model_dir, validate_tree
 
 pytestmark = pytest.mark.filterwarnings("ignore:Please import:DeprecationWarning")  # fmpy's scipy.ndimage.filters
 CHECKER = find_checker()

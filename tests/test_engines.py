@@ -2,7 +2,7 @@
 
 Both engines step the two FMUs side by side with the inputs held over a macro step (Jacobi), so
 they converge to the monolith (DoublePendulum with ``suspension`` on) at first order in the macro
-step, like :func:`double_pendulum.fmu.coupling.run_jacobi`.
+step, like :func:`double_pendulum.fmu.masters.coupling.run_jacobi`.
 """
 
 from __future__ import annotations
@@ -14,11 +14,12 @@ import numpy as np
 import pytest
 
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
-from double_pendulum.fmu.build import build_fmu, build_systems
-from double_pendulum.fmu.container import write_container
-from double_pendulum.fmu.coupling import FmuSlave, run_coupled, split_values
-from double_pendulum.fmu.hosts import simulate_container, simulate_ssp_with_libcosim
-from double_pendulum.fmu.ssp import write_ssp
+from double_pendulum.fmu.build.container import write_container
+from double_pendulum.fmu.build.fmi2 import build_fmu
+from double_pendulum.fmu.build.ssp import write_ssp
+from double_pendulum.fmu.build.systems import build_systems
+from double_pendulum.fmu.masters.coupling import FmuSlave, run_coupled, split_values
+from double_pendulum.fmu.running.hosts import simulate_container, simulate_ssp_with_libcosim
 
 START = {"phi1_0": 1.2, "phi2_0": 0.8}
 STOP = 0.2
@@ -142,7 +143,7 @@ def test_container_parameters_can_be_changed_by_the_host(fmus, tmp_path):
 
 def test_an_unstable_split_system_ends_with_a_message_and_its_rows_on_both_engines(fmus, tmp_path):
     """A suspension lighter than the pendulum ((m1 + m2) / M_s = 2) blows up under Jacobi coupling."""
-    from double_pendulum.fmu.coupling import CouplingError
+    from double_pendulum.fmu.masters.coupling import CouplingError
 
     light = {"phi1_0": 0.2, "phi2_0": 0.0, "M_s": 0.3, "k_x": 3e3, "k_y": 3e3, "c_x": 0.0, "c_y": 0.0}
     runs = (

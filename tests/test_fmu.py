@@ -18,9 +18,9 @@ import pytest
 from conftest import DATA
 from scipy.special import ellipk
 
-from double_pendulum.fmu import loader
-from double_pendulum.fmu.runner import FmuRunError
-from double_pendulum.fmu.simulate import simulate
+from double_pendulum.fmu.build import loader
+from double_pendulum.fmu.masters.simulate import simulate
+from double_pendulum.fmu.running.runner import FmuRunError
 from double_pendulum.model.dynamics import linearised_normal_modes
 from double_pendulum.model.outputs import OUTPUT_NAMES
 from double_pendulum.model.parameters import PendulumParameters
@@ -259,7 +259,7 @@ def test_fmu_ships_hash_checked_bytecode(fmu_path):
 
 def test_fmu_bundles_only_the_runtime(fmu_path):
     """resources/ holds the adapter, pythonfmu and the runtime subpackages: no analysis, plots or CLI."""
-    from double_pendulum.fmu.build import RUNTIME_SUBPACKAGES
+    from double_pendulum.fmu.build.staging import RUNTIME_SUBPACKAGES
 
     with zipfile.ZipFile(fmu_path) as fmu:
         sources = [n for n in fmu.namelist() if n.startswith("resources/double_pendulum/") and n.endswith(".py")]
@@ -272,11 +272,11 @@ def test_fmu_bundles_only_the_runtime(fmu_path):
 def test_without_a_c_compiler_the_build_stops_with_one_line_and_leaves_no_fmu(tmp_path, monkeypatch):
     """The FMU's binary is compiled from source: without a compiler there is no FMU to write, and the CLI
     says why in one line (no traceback, nothing half-written)."""
-    from double_pendulum.fmu import build, loader
+    from double_pendulum.fmu.build import fmi2, loader
 
     monkeypatch.setenv("CC", "/nonexistent/cc")
     with pytest.raises(loader.LoaderUnavailable, match="no C compiler found"):
-        build.build_fmu(tmp_path / "DoublePendulum.fmu")
+        fmi2.build_fmu(tmp_path / "DoublePendulum.fmu")
     assert not list(tmp_path.iterdir())
     done = subprocess.run([sys.executable, "-m", "double_pendulum.cli", "build", "-o", str(tmp_path / "out")],
                           capture_output=True, text=True, env={**os.environ, "CC": "/nonexistent/cc"})
@@ -287,14 +287,14 @@ def test_without_a_c_compiler_the_build_stops_with_one_line_and_leaves_no_fmu(tm
 def test_a_newer_build_module_makes_the_fmu_stale(fmu_path, tmp_path, monkeypatch):
     """The FMU holds what the build's own modules write (documentation, icon, terminals): a change to one
     of them, not only to the bundled code, means the FMU must be built again."""
-    from double_pendulum.fmu import build
+    from double_pendulum.fmu.build import fmi2
 
-    assert build.fmu_is_current(fmu_path)
+    assert fmi2.fmu_is_current(fmu_path)
     newer = tmp_path / "documentation.py"
     newer.write_text("")
     os.utime(newer, (fmu_path.stat().st_mtime + 60,) * 2)
-    monkeypatch.setattr(build, "build_sources", lambda: [newer])
-    assert not build.fmu_is_current(fmu_path)
+    monkeypatch.setattr(fmi2, "build_sources", lambda: [newer])
+    assert not fmi2.fmu_is_current(fmu_path)
 
 
 def test_every_fmu_claims_only_the_platform_it_ran_on_and_no_sources_that_do_not_build_it(fmu_path):
@@ -317,7 +317,7 @@ def test_every_fmu_claims_only_the_platform_it_ran_on_and_no_sources_that_do_not
 def test_every_fmu_carries_the_licences_of_what_it_bundles(fmu_path):
     """documentation/licenses/: the project's MIT licence and those of pythonfmu (FMI 2) or pythonfmu3 (FMI 3),
     and for the container fmpy's (its container binary), each the text the distribution ships."""
-    from double_pendulum.fmu.presentation import distribution_licence
+    from double_pendulum.fmu.carries.presentation import distribution_licence
 
     project = (Path(__file__).resolve().parents[1] / "LICENSE").read_bytes()
     folder = fmu_path.parent

@@ -1,6 +1,6 @@
 """What a tool shows of each FMU the build writes: documentation/index.html with its result plot, the icon
 (model.png, terminalsAndIcons/icon.png) and terminalsAndIcons.xml, valid against FMI 3.0's schema and
-naming only the FMU's own variables (double_pendulum.fmu.presentation)."""
+naming only the FMU's own variables (double_pendulum.fmu.carries.presentation)."""
 
 from __future__ import annotations
 
@@ -14,9 +14,9 @@ import numpy as np
 import pytest
 from fmpy import read_model_description, simulate_fmu
 
-from double_pendulum.fmu import doc_plot, documentation, terminals
-from double_pendulum.fmu.docstring_html import docstring_html, inline_html
-from double_pendulum.fmu.tex_html import UnsupportedTeX, tex_to_html
+from double_pendulum.fmu.carries import doc_plot, documentation, terminals
+from double_pendulum.fmu.carries.docstring_html import docstring_html, inline_html
+from double_pendulum.fmu.carries.tex_html import UnsupportedTeX, tex_to_html
 
 FMUS = ("DoublePendulum.fmu", "Suspension.fmu", "PendulumOnSuspension.fmu", "fmi3/DoublePendulum.fmu")
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -158,7 +158,7 @@ def test_the_containers_plot_is_the_container_run(fmu_path):
 
 
 def test_a_build_with_baked_start_values_documents_and_plots_them(tmp_path):
-    from double_pendulum.fmu.build import build_fmu
+    from double_pendulum.fmu.build.fmi2 import build_fmu
 
     fmu = build_fmu(tmp_path / "Chaotic.fmu", "DoublePendulum", {"phi1_0": 2.0, "phi2_0": 2.0})
     with zipfile.ZipFile(fmu) as z:

@@ -21,7 +21,7 @@ import pytest
 import sanitize
 from foreign_fmu import RATE, START, build_foreign_fmu
 
-from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import loader
 
 HOSTS = Path(__file__).parent / "c_host"
 NO_LOG = ""  # expected fragment: the call logs nothing

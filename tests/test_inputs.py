@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
-from double_pendulum.fmu.runner import FmuRunError
-from double_pendulum.fmu.simulate import simulate
+from double_pendulum.fmu.masters.simulate import simulate
+from double_pendulum.fmu.running.runner import FmuRunError
 from double_pendulum.model.inputs import INPUT_NAMES
 from double_pendulum.model.outputs import MODEL_OUTPUT_NAMES, OUTPUT_NAMES, PORT_NAMES
 from double_pendulum.model.parameters import ParameterError, PendulumParameters
@@ -209,7 +209,7 @@ def test_model_structure_states_the_outputs_dependencies_on_the_inputs(fmu_path)
 
 def test_fmu_state_with_inputs_restores_through_the_fmu(runner):
     """fmi2GetFMUstate/fmi2SetFMUstate with inputs driving: the repeated steps are bit-identical."""
-    from double_pendulum.fmu.coupling import FmuSlave
+    from double_pendulum.fmu.masters.coupling import FmuSlave
 
     slave = FmuSlave(runner.unzipdir, runner.model_description, {"air_drag": True})
 

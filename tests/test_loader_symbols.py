@@ -11,7 +11,8 @@ from pathlib import Path
 
 import pytest
 
-from double_pendulum.fmu import elf_needs, loader
+from double_pendulum.fmu.build import loader
+from double_pendulum.fmu.carries import elf_needs
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "fmu.md"
 GLIBC_FLOOR = "GLIBC_2.17"  # CentOS 7, manylinux2014
@@ -65,7 +66,7 @@ def test_zigs_compiler_builds_a_loader_that_runs_like_the_system_compilers(fmu_p
     versions, the same C libraries, the same numbers."""
     from fmpy import simulate_fmu
 
-    from double_pendulum.fmu.build import build_fmu
+    from double_pendulum.fmu.build.fmi2 import build_fmu
 
     monkeypatch.setenv("CC", f"{sys.executable} -m ziglang cc")
     assert "ziglang" in " ".join(loader.c_compiler())

@@ -18,7 +18,7 @@ from conftest import quick_scenario
 from double_pendulum.analysis.losses import claims as loss_claims
 from double_pendulum.analysis.losses import comparison, fitting, identification, mechanisms
 from double_pendulum.analysis.track import measurement as ms
-from double_pendulum.fmu.simulate import simulate
+from double_pendulum.fmu.masters.simulate import simulate
 from double_pendulum.model.parameters import SEED_RIGID_LINKS
 
 TRUE = {"air_factor": 2.0, "tau_b": 1.0e-3}

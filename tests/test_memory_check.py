@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 import sanitize
 
-from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import loader
 
 SCRIPTS = Path(__file__).resolve().parents[1] / "scripts"
 

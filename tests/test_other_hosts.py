@@ -32,7 +32,7 @@ def _libcosim_result(fmu_path, start, tmp_path) -> dict[str, float]:
     """Run libcosim in its own process (isolated from the fmpy instances of this session)."""
     script = textwrap.dedent(f"""
         import json, os
-        from double_pendulum.fmu.hosts import simulate_with_libcosim
+        from double_pendulum.fmu.running.hosts import simulate_with_libcosim
         values = simulate_with_libcosim({str(fmu_path)!r}, {start!r}, {OUTPUTS!r}, stop_time=3.0, step_size=0.01)
         print(json.dumps(values), flush=True)
         os._exit(0)  # skip teardown, see docs/fmu.md (pythonfmu issue #228)

@@ -9,8 +9,8 @@ from pathlib import Path
 import pytest
 from fmpy import read_model_description, simulate_fmu
 
-from double_pendulum.fmu.build import build_fmu
-from double_pendulum.fmu.build_fmi3 import build_fmu3
+from double_pendulum.fmu.build.fmi2 import build_fmu
+from double_pendulum.fmu.build.fmi3 import build_fmu3
 from double_pendulum.fmu.presets import PRESET_FILE
 from double_pendulum.model.parameters import ParameterError
 

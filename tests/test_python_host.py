@@ -43,7 +43,7 @@ SCRIPT = textwrap.dedent("""
     out["libpythons"] = sorted({line.split()[-1] for line in maps.splitlines() if "libpython3" in line})
 
     # a build after the run: ours, and a user's own slave with pythonfmu's builder
-    from double_pendulum.fmu.build import build_all
+    from double_pendulum.fmu.build.systems import build_all
     folder = Path(sys.argv[2])
     built = build_all(folder / "DoublePendulum.fmu")
     user = folder / "user_slave.py"
@@ -63,7 +63,7 @@ SCRIPT = textwrap.dedent("""
                                                           if n.startswith(linux)) for p in fmus}
 
     # the coupled system on libcosim and as the container FMU, in this same process
-    from double_pendulum.fmu.hosts import simulate_container, simulate_ssp_with_libcosim
+    from double_pendulum.fmu.running.hosts import simulate_container, simulate_ssp_with_libcosim
     ssp = simulate_ssp_with_libcosim(folder / "PendulumOnSuspension.ssp", stop_time=0.05, macro_step=1e-3)
     container = simulate_container(folder / "PendulumOnSuspension.fmu", stop_time=0.05, macro_step=1e-3)
     out["ssp_phi1"], out["container_phi1"] = float(ssp["phi1"][-1]), float(container["phi1"][-1])

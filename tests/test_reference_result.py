@@ -11,7 +11,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 import pytest
 
-from double_pendulum.fmu.reference_result import FOLDER, MANIFEST, MOST_ROWS, interval
+from double_pendulum.fmu.carries.reference_result import FOLDER, MANIFEST, MOST_ROWS, interval
 
 LS = "{http://fmi-standard.org/fmi-ls-manifest}"
 CASES = {  # FMU, model, interface, |difference| bound relative to each output's range (or size, if larger)

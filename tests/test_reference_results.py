@@ -1,4 +1,4 @@
-"""The committed reference results (data/reference/fmu/, double_pendulum.fmu.reference_cases): freshly built
+"""The committed reference results (data/reference/fmu/, double_pendulum.fmu.crosscheck.reference_cases): freshly built
 FMUs reproduce them in fmpy and in the project's C hosts (tests/c_host, no Python in them), and the
 committed inputs and options are what the case definitions write.
 
@@ -24,9 +24,9 @@ import numpy as np
 import pytest
 from double_pendulum.data import data_path
 
-from double_pendulum.fmu import loader
-from double_pendulum.fmu.reference_cases import CASES, ReferenceCase, fmu_file, input_names
-from double_pendulum.fmu.reference_runs import (
+from double_pendulum.fmu.build import loader
+from double_pendulum.fmu.crosscheck.reference_cases import CASES, ReferenceCase, fmu_file, input_names
+from double_pendulum.fmu.crosscheck.reference_runs import (
     RECORD,
     build_case_fmus,
     input_csv,

@@ -22,7 +22,7 @@ from independent_lagrangian import IndependentPendulum
 from scipy.integrate import solve_ivp
 from scipy.linalg import eigh
 
-from double_pendulum.fmu.simulate import simulate
+from double_pendulum.fmu.masters.simulate import simulate
 from double_pendulum.model.dynamics import fixed_pivot_vector_field, linearised_normal_modes
 from double_pendulum.model.links import link_coefficients, plate_lengths
 from double_pendulum.model.parameters import (

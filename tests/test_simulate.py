@@ -14,8 +14,8 @@ from fmpy import read_model_description, simulate_fmu
 from double_pendulum import case as case_module
 from double_pendulum.case import FILES, START_STATE, start_state, start_state_words
 from double_pendulum.cli import main
-from double_pendulum.fmu.runner import FmuRunner
-from double_pendulum.fmu.start_values import StartValueError, closest_name, parse_start_values
+from double_pendulum.fmu.running.runner import FmuRunner
+from double_pendulum.fmu.running.start_values import StartValueError, closest_name, parse_start_values
 from double_pendulum.model.outputs import OUTPUT_NAMES
 from double_pendulum.model.parameters import InitialState
 from double_pendulum.runs.results_io import read_results_csv

@@ -12,8 +12,8 @@ import pytest
 
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.component.suspension import SuspensionCoSimulation
-from double_pendulum.fmu.coupling import run_coupled, split_values
-from double_pendulum.fmu.reference_result import FOLDER, LIBCOSIM_INITIAL_EXCHANGES, MANIFEST, SSP_STATES
+from double_pendulum.fmu.carries.reference_result import FOLDER, LIBCOSIM_INITIAL_EXCHANGES, MANIFEST, SSP_STATES
+from double_pendulum.fmu.masters.coupling import run_coupled, split_values
 
 MACRO_STEP = 1e-3  # the built SSP's
 HORIZON = 2.0  # [s] compared: libcosim takes about 1 s of CPU a simulated second here
@@ -45,7 +45,7 @@ def test_the_ssp_holds_the_states_of_its_default_experiment(reference):
 
 
 def test_libcosim_reproduces_the_ssps_reference(built_ssp, reference):
-    from double_pendulum.fmu.hosts import simulate_ssp_with_libcosim
+    from double_pendulum.fmu.running.hosts import simulate_ssp_with_libcosim
 
     rows = simulate_ssp_with_libcosim(built_ssp, stop_time=HORIZON, macro_step=MACRO_STEP,
                                       pendulum_outputs=SHORT[:4], suspension_outputs=SHORT[4:])

@@ -26,7 +26,7 @@ from pathlib import Path
 import pytest
 from test_guard import compile_host, host_command
 
-from double_pendulum.fmu import loader
+from double_pendulum.fmu.build import loader
 
 pytestmark = [
     pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the C loader and these C hosts are for Linux"),

@@ -12,9 +12,9 @@ import pytest
 
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
 from double_pendulum.component.suspension import SuspensionCoSimulation
-from double_pendulum.fmu.build import build_fmu
-from double_pendulum.fmu.coupling import FmuSlave, run_jacobi
-from double_pendulum.fmu.runner import FmuRunError, FmuRunner
+from double_pendulum.fmu.build.fmi2 import build_fmu
+from double_pendulum.fmu.masters.coupling import FmuSlave, run_jacobi
+from double_pendulum.fmu.running.runner import FmuRunError, FmuRunner
 from double_pendulum.model.parameters import ParameterError, PendulumParameters, SuspensionLoad
 from double_pendulum.model.suspension import OUTPUT_NAMES, PORT_NAMES
 

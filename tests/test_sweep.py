@@ -16,7 +16,7 @@ from double_pendulum.analysis.sweep import (
     run_sweep,
     worker_pool,
 )
-from double_pendulum.fmu.runner import FmuRunError
+from double_pendulum.fmu.running.runner import FmuRunError
 from double_pendulum.runs.workers import WORKERS_ENV, default_workers
 
 OPTIONS = {"stop_time": 0.5, "output_interval": 0.05}
@@ -148,7 +148,7 @@ def test_default_workers_are_capped_by_the_environment_variable_when_it_is_a_pos
 def test_the_reused_instance_gives_the_numbers_of_a_new_instance_for_every_case(fmu_path):
     """FmuRunner keeps one instance and resets it between runs (fmi2Reset): every case, also one after a
     failed case and one with inputs, bit for bit what a new instance per case gives."""
-    from double_pendulum.fmu.runner import FmuRunner
+    from double_pendulum.fmu.running.runner import FmuRunner
 
     cases = [*_cases(), {"l1": -1.0}, {"phi1_0": 2.5, "air_drag": True}]
     signal = np.array([(0.0, 0.3), (0.5, 0.3)], dtype=[("time", float), ("tau1", float)])
@@ -173,7 +173,7 @@ def test_the_reused_instance_gives_the_numbers_of_a_new_instance_for_every_case(
 MEMORY_SCRIPT = """
 import sys
 from double_pendulum.analysis.sweep import random_cases
-from double_pendulum.fmu.runner import FmuRunner
+from double_pendulum.fmu.running.runner import FmuRunner
 
 def rss_kib():
     with open("/proc/self/statm") as statm:

@@ -2,7 +2,7 @@
 figure, an animation and a summary.
 
 :func:`run_case` calls :func:`fmpy.simulate_fmu` on the FMU with the user's start values (through
-:class:`~double_pendulum.fmu.runner.FmuRunner`, a new instance, as a plain ``simulate_fmu`` call makes: the
+:class:`~double_pendulum.fmu.running.runner.FmuRunner`, a new instance, as a plain ``simulate_fmu`` call makes: the
 numbers are fmpy's, bit for bit, ``summary.json`` says which call gives them) and writes into the output folder:
 
 * ``simulation.csv``: time and every output, units in the column names;
@@ -34,8 +34,8 @@ from typing import Any
 
 import numpy as np
 
-from .fmu.runner import FmuRunError, FmuRunner
-from .fmu.start_values import value_text
+from .fmu.running.runner import FmuRunError, FmuRunner
+from .fmu.running.start_values import value_text
 from .model.outputs import OUTPUT_NAMES
 from .model.parameters import InitialState
 from .plots import animate_swings, swing

@@ -1,6 +1,6 @@
 """Generate the committed reference results of the FMUs in ``data/reference/fmu/``.
 
-For every reference case (``double_pendulum.fmu.reference_cases``: the FMI 2.0 and FMI 3.0 FMUs, Co-Simulation
+For every reference case (``double_pendulum.fmu.crosscheck.reference_cases``: the FMI 2.0 and FMI 3.0 FMUs, Co-Simulation
 and Model Exchange, the container) this builds the FMUs afresh, runs each case in fmpy at tight tolerance
 (the FMU's own integrator at rtol 1e-12, atol 1e-14; under Model Exchange fmpy's CVode at 1e-12) and writes
 
@@ -22,7 +22,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from double_pendulum.fmu.reference_runs import build_case_fmus, write_references
+from double_pendulum.fmu.crosscheck.reference_runs import build_case_fmus, write_references
 
 HERE = Path(__file__).resolve().parent
 

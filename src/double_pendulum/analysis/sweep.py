@@ -1,9 +1,9 @@
 """Many FMU runs at once: parameter sweeps on all local cores or on a Dask cluster.
 
 :func:`run_sweep` runs the FMU once per *case* (a mapping of start values, as for
-:meth:`double_pendulum.fmu.runner.FmuRunner.simulate`) and returns the results in the order of the
+:meth:`double_pendulum.fmu.running.runner.FmuRunner.simulate`) and returns the results in the order of the
 cases. The cases are split into contiguous chunks; each worker process extracts the FMU once
-(one :class:`~double_pendulum.fmu.runner.FmuRunner` per process, kept for later chunks) and runs its
+(one :class:`~double_pendulum.fmu.running.runner.FmuRunner` per process, kept for later chunks) and runs its
 chunks one case after another.
 
 * Locally (default) the chunks go to a :class:`concurrent.futures.ProcessPoolExecutor` with one
@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from ..fmu.runner import FmuRunError, FmuRunner
+from ..fmu.running.runner import FmuRunError, FmuRunner
 from ..runs.interrupts import acknowledge, sigint_blocked, worker_ignores_sigint
 from ..runs.progress import progress_bar as _progress_bar
 from ..runs.workers import default_workers
@@ -375,7 +375,7 @@ def run_sweep(
     Each result is fmpy's structured array (``time`` and ``outputs``), or ``reduce(result)`` if
     given (computed on the worker, so only the reduced value travels back; it must be a
     module-level function). Parallelism as in :func:`parallel_map`; a failing case raises
-    :class:`~double_pendulum.fmu.runner.FmuRunError` naming the case.
+    :class:`~double_pendulum.fmu.running.runner.FmuRunError` naming the case.
     """
     options: dict[str, Any] = {"stop_time": stop_time, "output_interval": output_interval}
     if outputs is not None:

@@ -8,8 +8,9 @@ import os
 import sys
 from pathlib import Path
 
-from ..fmu.build import DEFAULT_FMU_PATH, build_all
-from ..fmu.loader import LoaderUnavailable
+from ..fmu.build.fmi2 import DEFAULT_FMU_PATH
+from ..fmu.build.loader import LoaderUnavailable
+from ..fmu.build.systems import build_all
 from .common import CliError, private_tempdir, writable_folder
 
 
@@ -30,8 +31,8 @@ def cmd_cross_check(args: argparse.Namespace) -> int:
     """Write the FMI Cross-Check tree into ``args.dir`` and check it (fmpy; with --simulate fmpy as importer;
     with --checker the FMI Compliance Checker). Exit status 1 if a check finds a problem."""
     from ..data import data_path
-    from ..fmu.cross_check import case_of, import_with_fmpy, validate_tree, write_tree
-    from ..fmu.reference_runs import build_case_fmus
+    from ..fmu.crosscheck.reference_runs import build_case_fmus
+    from ..fmu.crosscheck.tree import case_of, import_with_fmpy, validate_tree, write_tree
 
     checker = None
     if args.checker is not None:
@@ -61,7 +62,7 @@ def cmd_cross_check(args: argparse.Namespace) -> int:
 def _check_with_compliance_checker(checker: Path, folder: Path, case, root: Path) -> int:
     """Run the FMI Compliance Checker on one FMI 2.0 folder (its log and result go to
     ``DIR/compliance-checker/...``); print its summary; 1 if it reported an error."""
-    from ..fmu.compliance_checker import run_checker
+    from ..fmu.crosscheck.compliance_checker import run_checker
 
     if case.fmi_version != "2.0":
         return 0

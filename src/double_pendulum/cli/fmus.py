@@ -6,8 +6,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..component.variables import INTERFACES
-from ..fmu.build import DEFAULT_FMU_PATH, build_all
-from ..fmu.loader import LoaderUnavailable
+from ..fmu.build.fmi2 import DEFAULT_FMU_PATH
+from ..fmu.build.loader import LoaderUnavailable
+from ..fmu.build.systems import build_all
 from .common import CliError
 
 
@@ -41,13 +42,13 @@ def fmu_set(fmu: Path) -> list[Path]:
 def fmu_set_is_current(fmu: Path) -> bool:
     """Whether ``fmu`` is newer than its sources and, for an FMU named as ``build`` names it, the rest of
     :func:`fmu_set` is there and current too (an FMU of another name is checked alone)."""
-    from ..fmu.build import fmu_is_current
+    from ..fmu.build.fmi2 import fmu_is_current
 
     if not fmu_is_current(fmu):
         return False
     if fmu.name != DEFAULT_FMU_PATH.name:
         return True
-    from ..fmu.build_fmi3 import adapter_sources as fmi3_sources
+    from ..fmu.build.fmi3 import adapter_sources as fmi3_sources
 
     built = fmu.stat().st_mtime
     others = fmu_set(fmu)[1:]
@@ -63,7 +64,7 @@ def load_fmu(path: str, rebuild: bool):
     open the FMU with fmpy; unusable files become a CliError."""
     import zipfile
 
-    from ..fmu.runner import FmuRunner
+    from ..fmu.running.runner import FmuRunner
 
     fmu = Path(path)
     if rebuild or not fmu_set_is_current(fmu):

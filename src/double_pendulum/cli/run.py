@@ -14,7 +14,7 @@ import time
 from pathlib import Path
 
 from .. import __version__
-from ..fmu.build import DEFAULT_FMU_PATH
+from ..fmu.build.fmi2 import DEFAULT_FMU_PATH
 from ..runs.interrupts import acknowledge, interrupted
 from ..runs.lines import failed_line, header_line, wrote_line
 from .catalogue import check_scenarios, scenario_description, scenario_listing

@@ -15,7 +15,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from fmpy import read_model_description
 
     from ..case import Case, run_case, start_state_words
-    from ..fmu.start_values import StartValueError, parse_start_values
+    from ..fmu.running.start_values import StartValueError, parse_start_values
 
     if args.me and args.fmi != "3":
         raise CliError("--me needs --fmi 3: the FMI 2.0 FMU is co-simulation only")

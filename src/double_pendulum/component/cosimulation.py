@@ -1,7 +1,7 @@
 """The co-simulation component: parameters by name, initialisation, doStep, outputs.
 
 This is what the FMU runs (``fmu_src/DoublePendulum.py`` only maps FMI calls onto it) and what
-:func:`double_pendulum.fmu.simulate.simulate` runs in-process, so both give identical numbers.
+:func:`double_pendulum.fmu.masters.simulate.simulate` runs in-process, so both give identical numbers.
 
 Life cycle (FMI 2.0 co-simulation):
 

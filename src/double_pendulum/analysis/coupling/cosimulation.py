@@ -2,7 +2,7 @@
 
 Each *case* is a start (regular, chaotic) and a suspension (default; light and stiff). The
 reference is the monolith (DoublePendulum with ``suspension`` on, in-process, the FMU's own
-numbers). The split system runs with the schemes of :mod:`double_pendulum.fmu.coupling`
+numbers). The split system runs with the schemes of :mod:`double_pendulum.fmu.masters.coupling`
 in-process (``jacobi``, ``extrapolation``, ``iterative``) and on the two engines (``libcosim``:
 the SSP file; ``container``: fmpy's container FMU), for a range of macro steps. Per run: the
 errors at the stop time of the angles [rad], the pivot position [m] and the total energy [J], the
@@ -24,7 +24,7 @@ import numpy as np
 
 from ...component.cosimulation import DoublePendulumCoSimulation
 from ...component.suspension import SuspensionCoSimulation
-from ...fmu.coupling import CouplingError, coupling_energy, run_coupled, split_values
+from ...fmu.masters.coupling import CouplingError, coupling_energy, run_coupled, split_values
 from .stability import critical_mass_ratio, spectral_radius
 
 STARTS: dict[str, dict[str, float]] = {
@@ -82,9 +82,9 @@ def _in_process(values: Mapping[str, Any], stop_time: float, h: float, scheme: s
 
 
 def _on_engine(values: Mapping[str, Any], stop_time: float, h: float, engine: str, fmus: Sequence[Path]) -> np.ndarray:
-    from ...fmu.container import write_container
-    from ...fmu.hosts import simulate_container, simulate_ssp_with_libcosim
-    from ...fmu.ssp import write_ssp
+    from ...fmu.build.container import write_container
+    from ...fmu.build.ssp import write_ssp
+    from ...fmu.running.hosts import simulate_container, simulate_ssp_with_libcosim
 
     with tempfile.TemporaryDirectory(prefix="dp_cosim_") as tmp:
         if engine == "libcosim":
@@ -212,7 +212,7 @@ def step_map_spectral_radius(rows: np.ndarray, scheme: str) -> float:
     :func:`~double_pendulum.analysis.coupling.stability.amplification_matrix`: the suspension's
     displacement and velocity and the pendulum's pivot force, (y_n, v_n, F_n) for ``jacobi_sequential`` and
     (y_n, v_n, F_n, F_{n-1}) for ``jacobi`` (columns ``y``, ``vy``, ``F_pivot_y`` of
-    :func:`~double_pendulum.fmu.coupling.run_coupled`; the constant b takes the static load). Returns the
+    :func:`~double_pendulum.fmu.masters.coupling.run_coupled`; the constant b takes the static load). Returns the
     largest |eigenvalue| of G, the growth factor per macro step of the fastest mode; ``inf`` if the run
     ended before it had twice as many steps as unknowns.
     """
@@ -232,7 +232,7 @@ def stability_run(item: tuple[float, float, float, int, str]) -> dict[str, Any]:
     pendulum hangs straight at rest and the suspension's static load is :data:`MAP_LOAD_STEP` off its
     weight, so the run is the vertical loop of the derivation, set moving by a step of the load. Stable if
     the spectral radius of the step map fitted to the run (:func:`step_map_spectral_radius`) is at most
-    1 + :data:`STABILITY_TOLERANCE`; a run that blew up (:class:`~double_pendulum.fmu.coupling.CouplingError`)
+    1 + :data:`STABILITY_TOLERANCE`; a run that blew up (:class:`~double_pendulum.fmu.masters.coupling.CouplingError`)
     is fitted on the rows it kept.
     """
     from ...model.parameters import PendulumParameters

@@ -4,7 +4,7 @@ Model of the loop: the pendulum hanging (nearly) straight down moves vertically 
 one rigid mass m = m1 + m2, so its force on the pivot is F = -m (g + a_p) with a_p the pivot
 acceleration it is given. The suspension mass M_s on spring k and damper c (omega^2 = k / M_s,
 zeta = c / (2 sqrt(k M_s))) feels f = F + m g (the dynamic part). In the Jacobi master
-(:func:`double_pendulum.fmu.coupling.run_jacobi`, libcosim) the exchange at
+(:func:`double_pendulum.fmu.masters.coupling.run_jacobi`, libcosim) the exchange at
 t_n gives the suspension f_n (the pendulum's output of t_n) and the pendulum A_n (the suspension's
 output of t_n), both held over [t_n, t_n + h]. The outputs of t_n were computed with the inputs
 of the step before, so

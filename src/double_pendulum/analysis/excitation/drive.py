@@ -8,9 +8,9 @@ r"""Driving the pendulum through the FMU's inputs: input signals, runs and what 
 
 Every signal carries all eight inputs (the unused ones 0), sampled on the communication grid, so
 fmpy sets exactly these values at each communication point. :func:`simulate_signal` runs one case
-through the FMU with fmpy (an :class:`~double_pendulum.fmu.runner.FmuRunner`, or a path: one runner
+through the FMU with fmpy (an :class:`~double_pendulum.fmu.running.runner.FmuRunner`, or a path: one runner
 per process, for :func:`~double_pendulum.analysis.sweep.parallel_map` workers) or, without an FMU,
-in-process with the same component (:func:`double_pendulum.fmu.simulate.simulate`, same numbers).
+in-process with the same component (:func:`double_pendulum.fmu.masters.simulate.simulate`, same numbers).
 """
 
 from __future__ import annotations
@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
-from ...fmu.simulate import simulate
+from ...fmu.masters.simulate import simulate
+from ...fmu.running.runner import FmuRunner
 from ...model.inputs import INPUT_NAMES
 from ..sweep import parallel_map, process_runner
 

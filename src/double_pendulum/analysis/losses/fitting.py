@@ -36,7 +36,7 @@ matrix tells which parameters the energy separates. The profile likelihood (:fun
 re-fits the other parameters at fixed values of one and gives :math:`\Delta\chi^2/F` (1 at one standard error if the
 problem is linear in u).
 
-Simulations run in-process (:func:`double_pendulum.fmu.simulate.simulate`, the FMU's own component;
+Simulations run in-process (:func:`double_pendulum.fmu.masters.simulate.simulate`, the FMU's own component;
 :class:`ComponentRunner`); the scenario re-runs the best model through the FMU for its headline
 numbers. All regularised friction laws use :data:`.mechanisms.OMEGA_REG` = 0.01 rad/s (the loss of the
 regularisation below it is < 1e-4 of the drag torque's work over a swing of ~5 rad/s peak rate).
@@ -57,7 +57,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.simulate import simulate
+from ...fmu.masters.simulate import simulate
 from ...model.parameters import SEED_RIGID_LINKS
 from ...runs.result_cache import cached
 from ..decay.fit import fit_model
@@ -80,7 +80,7 @@ from .mechanisms import (
 
 
 class ComponentRunner:
-    """The FMU's co-simulation component in-process, with :class:`~double_pendulum.fmu.runner.FmuRunner`'s
+    """The FMU's co-simulation component in-process, with :class:`~double_pendulum.fmu.running.runner.FmuRunner`'s
     ``simulate`` signature (same numbers, no FMI layer)."""
 
     def simulate(self, start_values: Mapping[str, Any] | None = None, **kwargs: Any) -> np.ndarray:

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from ...model.parameters import SEED_RIGID_LINKS, PendulumParameters
 from ..chaos import flips, lyapunov, lyapunov_study
 from ..chaos.ensemble import batch_energy, initial_states, pendulum_field

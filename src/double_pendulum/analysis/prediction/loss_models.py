@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from ..losses import claims, comparison, fitting, identification, mechanisms
 from ..track.measurement import FRAME_INTERVAL, Reconstruction
 from ..track.start_state import StartStateFit

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from ...runs.result_cache import cached
 from ..losses.fitting import ModelFit
 from ..track.measurement import FRAME_INTERVAL, Reconstruction

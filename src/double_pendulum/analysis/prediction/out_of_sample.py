@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from ..losses.holdout import HALVES, HoldoutFit, other, out_of_sample
 from ..losses.identification import thorough_half_fits
 from ..losses.mechanisms import model_title

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from ..suspension.identification import START_FIT_FRAMES
 from ..track.measurement import Reconstruction
 from ..track.start_state import STATE_NAMES, StartStateFit

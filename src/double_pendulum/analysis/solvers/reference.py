@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from ...component.cosimulation import DoublePendulumCoSimulation
-from ...fmu.simulate import simulate
+from ...fmu.masters.simulate import simulate
 from ...runs.result_cache import cache_root, key_hash, sources_hash
 
 STATE_OUTPUTS = ("phi1", "phi2", "omega1", "omega2")

@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunError, FmuRunner
+from ...fmu.running.runner import FmuRunError, FmuRunner
 from ...model.parameters import PendulumParameters
 from ...runs.results_io import report_opening
 

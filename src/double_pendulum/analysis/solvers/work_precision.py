@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunError, FmuRunner
+from ...fmu.running.runner import FmuRunError, FmuRunner
 from ...runs.results_io import report_opening
 from ...solvers import make_method
 from .reference import STATE_OUTPUTS, Reference, reference_solution

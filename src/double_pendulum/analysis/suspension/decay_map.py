@@ -41,7 +41,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from ..sweep import run_sweep
 from ..track.measurement import FRAME_INTERVAL
 from .identification import (

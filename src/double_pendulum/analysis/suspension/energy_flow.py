@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from .identification import FitFrames, simulate_frames_from
 
 ENERGY_FLOW_INTERVAL = 0.005

@@ -54,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from ...model.parameters import SuspensionParameters
 from ..decay.fit import FitResult, calibrate_error_model, fit_model, record_correlation_factor
 from ..track.measurement import FRAME_INTERVAL, Reconstruction, load_track, reconstruct

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 
 FORCE_SAMPLE_RATE = 200.0
 """Sampling rate [1/s] of the fixed-pivot force for its spectrum (Nyquist 628 rad/s)."""

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import least_squares
 
-from ...fmu.runner import FmuRunner
+from ...fmu.running.runner import FmuRunner
 from .measurement import FRAME_INTERVAL, Reconstruction
 
 POSITION_OUTPUTS: tuple[str, ...] = ("x1", "y1", "x2", "y2")

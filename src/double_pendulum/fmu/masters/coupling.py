@@ -88,7 +88,7 @@ def split_values(values: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, A
     pendulum's weight: it hangs at rest without moving the mass); everything else but the
     ``suspension`` switch goes to ``DoublePendulum``, whose own suspension stays off.
     """
-    from ..model.parameters import PendulumParameters
+    from ...model.parameters import PendulumParameters
 
     p = PendulumParameters(**{n: values[n] for n in ("m1", "m2", "g") if n in values})
     pendulum = {n: v for n, v in values.items() if n not in SUSPENSION_PARAMETERS and n != "suspension"}

@@ -23,8 +23,8 @@ PendulumOnSuspension   2.0 cs             the container: the two FMUs coupled, f
 
 The reference of a case is its run in fmpy at tight tolerance (:data:`TIGHT`: the FMU's own
 integrator, or CVode under Model Exchange), made by ``data/reference/fmu/make_fmu_references.py``
-(:mod:`double_pendulum.fmu.reference_runs`) and committed; ``double-pendulum cross-check`` writes the
-tree (:mod:`double_pendulum.fmu.cross_check`).
+(:mod:`double_pendulum.fmu.crosscheck.reference_runs`) and committed; ``double-pendulum cross-check`` writes the
+tree (:mod:`double_pendulum.fmu.crosscheck.tree`).
 """
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ..component.suspension import INPUT_START
-from ..model.inputs import INPUT_NAMES
+from ...component.suspension import INPUT_START
+from ...model.inputs import INPUT_NAMES
 
 TIGHT = {"rtol": 1e-12, "atol": 1e-14}
 """The FMU's integrator settings of a reference run (for FMUs that do not have them baked in)."""
@@ -46,7 +46,7 @@ FRICTION = {"phi1_0": 1.5, "phi2_0": 0.5, "air_drag": True, "rod_drag": True, "b
             "bearing_drag": True, "tau_b1": 1e-3, "tau_b2": 1e-3, "m_rod1": 0.07, "m_rod2": 0.07,
             "L_rod1": 0.35, "L_rod2": 0.25, **TIGHT}
 CONTAINER_VALUES = {"phi1_0": 1.5, "phi2_0": 1.5, **TIGHT}
-"""The container's scene (monolith names, split by :func:`double_pendulum.fmu.coupling.split_values`)."""
+"""The container's scene (monolith names, split by :func:`double_pendulum.fmu.masters.coupling.split_values`)."""
 PIVOT_AMPLITUDE, PIVOT_FREQUENCY = 0.02, 1.5  # [m], [Hz] of the driven case's horizontal pivot motion
 
 
@@ -205,15 +205,8 @@ def input_table(case: ReferenceCase) -> list[tuple[float, ...]] | None:
     return rows
 
 
-def case_named(fmi_version: str, fmi_type: str, model: str) -> ReferenceCase:
-    """The case of one folder of the tree."""
-    for case in CASES:
-        if (case.fmi_version, case.fmi_type, case.model) == (fmi_version, fmi_type, model):
-            return case
-    raise KeyError(f"no reference case {fmi_version}/{fmi_type}/{model}")
-
-
 def fmu_file(case: ReferenceCase) -> str:
-    """The case's FMU in a folder of built case FMUs (:func:`double_pendulum.fmu.reference_runs.build_case_fmus`):
-    ``<fmi_version>/<model>.fmu`` (an FMI 3 FMU serves both its interfaces)."""
+    """The case's FMU in a folder of built case FMUs
+    (:func:`double_pendulum.fmu.crosscheck.reference_runs.build_case_fmus`): ``<fmi_version>/<model>.fmu``
+    (an FMI 3 FMU serves both its interfaces)."""
     return f"{case.fmi_version}/{case.model}.fmu"

@@ -6,7 +6,7 @@ let an FMU group variables into terminals for a graphical tool. Every FMU of the
 (the same ``fmiVersion="3.0"`` file for FMI 2 and FMI 3), made from the variables it has:
 
 ``pivot`` (DoublePendulum) and ``mount`` (Suspension), ``plug``, kind :data:`MOUNT_KIND`
-    the coupling of :mod:`double_pendulum.fmu.coupling`: the pivot's motion in and the pivot force out
+    the coupling of :mod:`double_pendulum.fmu.masters.coupling`: the pivot's motion in and the pivot force out
     (DoublePendulum), the mass's motion out and the load in (Suspension). Member names are the
     Suspension's variable names (``x, y, vx, vy, ax, ay, F_x, F_y``), so a tool that matches members by
     name connects ``DoublePendulum.pivot`` to ``Suspension.mount`` as the container does.
@@ -15,7 +15,7 @@ let an FMU group variables into terminals for a graphical tool. Every FMU of the
 ``angles`` (DoublePendulum, the container), ``bus``
     the rod angles and rates a controller reads.
 
-Each terminal has a picture (:func:`double_pendulum.fmu.icons.terminal_icon`) on the icon's edge:
+Each terminal has a picture (:func:`double_pendulum.fmu.carries.icons.terminal_icon`) on the icon's edge:
 pivot and mount at the top, torques on the left, angles on the right. Terminals naming variables the
 FMU lacks are left out (the container has no inputs and only the angles).
 """
@@ -26,7 +26,7 @@ from collections.abc import Iterable, Sequence
 from typing import NamedTuple
 from xml.etree import ElementTree as ET
 
-from .coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS
+from ..masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS
 
 FILE = "terminalsAndIcons/terminalsAndIcons.xml"
 FMI_VERSION = "3.0"  # the FMI version whose definition the file follows, also in an FMI 2.0 FMU

@@ -23,7 +23,7 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
-from ..component.variables import INTERFACES
+from ...component.variables import INTERFACES
 
 PRIVATE_MARK = "_dp_fmu_"
 BUILDER_ADAPTERS = "adapters"  # the adapters' folder as the builder writes it into resources/
@@ -36,7 +36,7 @@ ADAPTERS = {
 }
 ADAPTER_MODULES = {2: {name: name for name in INTERFACES}, 3: {"DoublePendulum": "DoublePendulumFmi3"}}
 
-PACKAGE_INIT = '''"""The adapters of this bundle (written by the build: double_pendulum.fmu.bundle).
+PACKAGE_INIT = '''"""The adapters of this bundle (written by the build: double_pendulum.fmu.build.bundle).
 
 All are imported with the package: FMUs of one bundle (DoublePendulum, Suspension) share it, and
 the folder it was first imported from may be gone by the time another FMU of the bundle, or
@@ -46,7 +46,7 @@ another extraction of the same FMU, is instantiated (fmpy extracts an FMU anew f
 from . import {modules}  # noqa: F401
 '''
 
-ENTRY_FMI2 = '''"""Entry module of {model}.fmu, which its binary imports (written by double_pendulum.fmu.bundle)."""
+ENTRY_FMI2 = '''"""Entry module of {model}.fmu, imported by its binary (written by double_pendulum.fmu.build.bundle)."""
 
 from {package}.{adapter} import {model}
 from {package}.fmi_bridge import Bridge
@@ -54,7 +54,7 @@ from {package}.fmi_bridge import Bridge
 fmi_bridge = Bridge({model}, fmi_version=2)
 '''
 
-ENTRY_FMI3 = '''"""Entry module of {model}.fmu, which its binary imports (written by double_pendulum.fmu.bundle)."""
+ENTRY_FMI3 = '''"""Entry module of {model}.fmu, imported by its binary (written by double_pendulum.fmu.build.bundle)."""
 
 from {package} import {adapter} as _adapter
 from {package}.fmi_bridge import Bridge
@@ -137,10 +137,5 @@ def identity_record(model_identifier: str, token: str, identity: str) -> bytes:
     another FMU's resources folder (fmu_src/loader/guard.c), and what it imports: the adapters' package
     (``resources/<package>/``) and the entry module (``resources/<entry>.py``)."""
     package, entry = package_name(identity), entry_name(identity, model_identifier)
-    return (f"# The FMU these resources belong to (written by double_pendulum.fmu.bundle).\n"
+    return (f"# The FMU these resources belong to (written by double_pendulum.fmu.build.bundle).\n"
             f"model={model_identifier}\ntoken={token}\npackage={package}\nentry={entry}\n").encode()
-
-
-def entry_module(files: dict[str, bytes]) -> str:
-    """The entry module named in an FMU's ``resources/slavemodule.txt``."""
-    return files["resources/slavemodule.txt"].decode().strip()

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from .coupling import PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, CouplingError, check_row, column_names
+from ..masters.coupling import PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, CouplingError, check_row, column_names
 
 NANOSECONDS_PER_SECOND = 1_000_000_000
 
@@ -65,14 +65,14 @@ def simulate_ssp_with_libcosim(
     suspension_outputs: Sequence[str] = SUSPENSION_OUTPUTS,
     energy_scale: float = 1.0,
 ) -> np.ndarray:
-    """Run the SSP system (:mod:`double_pendulum.fmu.ssp`) in libcosim; return its rows at t = h, 2h, ...
+    """Run the SSP system (:mod:`double_pendulum.fmu.build.ssp`) in libcosim; return its rows at t = h, 2h, ...
 
     libcosim's fixed-step algorithm steps both FMUs side by side, reads their outputs and then
     sets the inputs (Jacobi, inputs held over the step; two more exchanges while initialising):
-    :func:`~double_pendulum.fmu.coupling.run_coupled` with ``scheme="jacobi"`` and
+    :func:`~double_pendulum.fmu.masters.coupling.run_coupled` with ``scheme="jacobi"`` and
     ``initial_exchanges=2`` gives the same numbers. The columns are those of
-    :func:`~double_pendulum.fmu.coupling.run_coupled`; a run that blows up ends in
-    :class:`~double_pendulum.fmu.coupling.CouplingError` with the rows so far.
+    :func:`~double_pendulum.fmu.masters.coupling.run_coupled`; a run that blows up ends in
+    :class:`~double_pendulum.fmu.masters.coupling.CouplingError` with the rows so far.
     """
     from libcosimpy.CosimExecution import CosimExecution
     from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
@@ -115,12 +115,12 @@ def simulate_container(
     suspension_outputs: Sequence[str] = SUSPENSION_OUTPUTS,
     energy_scale: float = 1.0,
 ) -> np.ndarray:
-    """Run the container FMU (:mod:`double_pendulum.fmu.container`) in fmpy; rows at t = 0, h, 2h, ...
+    """Run the container FMU (:mod:`double_pendulum.fmu.build.container`) in fmpy; rows at t = 0, h, 2h, ...
 
     The container is an ordinary FMI 2.0 co-simulation FMU to fmpy (``FMU2Slave``); it is stepped
     with ``doStep(n h, h)``, ``macro_step`` [s] the container's fixed step (or a multiple of it).
-    The columns are those of :func:`~double_pendulum.fmu.coupling.run_coupled`; a failed step or
-    a run that blows up ends in :class:`~double_pendulum.fmu.coupling.CouplingError` with the
+    The columns are those of :func:`~double_pendulum.fmu.masters.coupling.run_coupled`; a failed step or
+    a run that blows up ends in :class:`~double_pendulum.fmu.masters.coupling.CouplingError` with the
     rows so far.
     """
     import shutil

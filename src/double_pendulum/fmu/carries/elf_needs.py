@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import re
 import struct
-from pathlib import Path
 
 SHT_GNU_VERNEED = 0x6FFFFFFE
 # The oldest GCC whose libstdc++ has each GLIBCXX version (GCC's ABI policy, libstdc++ manual, "ABI").
@@ -75,8 +74,3 @@ def describe(data: bytes) -> str:
         gcc = GLIBCXX_GCC.get(glibcxx.partition("_")[2])
         parts.append(f"libstdc++ with {glibcxx}" + (f" (GCC {gcc} or newer)" if gcc else ""))
     return " and ".join(parts) or "nothing versioned"
-
-
-def describe_file(path: str | Path) -> str:
-    """:func:`describe` of the file at ``path``."""
-    return describe(Path(path).read_bytes())

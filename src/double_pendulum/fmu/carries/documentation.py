@@ -6,12 +6,12 @@ Nothing here is a second copy of the documentation: the page is assembled from
   variable table with units and start values) and the validity rules of the interface's parameters
   (:mod:`double_pendulum.component.variables`: the "valid values" column);
 * the model's module docstrings (the equations, :data:`MODEL_SOURCES`), rendered by
-  :mod:`double_pendulum.fmu.docstring_html`;
+  :mod:`double_pendulum.fmu.carries.docstring_html`;
 * the parameter groups' docstrings and switches (:data:`SWITCH_GROUPS`: the switches of a scene);
 * the FMU's binaries, read for what each needs of the target machine
-  (:mod:`double_pendulum.fmu.elf_needs`), the CPython recorded at build and the loader's docstring (how
-  the FMU finds its Python, :mod:`double_pendulum.fmu.loader`);
-* the result plot ``result.png`` of the FMU's default run (:mod:`double_pendulum.fmu.doc_plot`).
+  (:mod:`double_pendulum.fmu.carries.elf_needs`), the CPython recorded at build and the loader's docstring (how
+  the FMU finds its Python, :mod:`double_pendulum.fmu.build.loader`);
+* the result plot ``result.png`` of the FMU's default run (:mod:`double_pendulum.fmu.carries.doc_plot`).
 
 The page is plain HTML with its style inline and no script, so the simple HTML views of FMI tools show
 it as a browser does.
@@ -26,10 +26,11 @@ from collections.abc import Mapping, Sequence
 from dataclasses import fields
 from xml.etree import ElementTree as ET
 
-from .. import __version__
-from ..component.variables import INTERFACES
-from ..model.parameters import MAX_START_ANGLE, AirDragParameters, BearingParameters, SuspensionParameters
-from . import elf_needs, presets
+from ... import __version__
+from ...component.variables import INTERFACES
+from ...model.parameters import MAX_START_ANGLE, AirDragParameters, BearingParameters, SuspensionParameters
+from .. import presets
+from . import elf_needs
 from .docstring_html import docstring_html, inline_html, summary
 
 MODEL_SOURCES: dict[str, tuple[str, ...]] = {
@@ -37,7 +38,7 @@ MODEL_SOURCES: dict[str, tuple[str, ...]] = {
     "DoublePendulumFmi3": ("model.dynamics", "model.links", "model.kinematics", "model.forces", "model.inputs",
                            "component.model_exchange"),
     "Suspension": ("model.suspension", "component.suspension"),
-    "PendulumOnSuspension": ("fmu.container",),
+    "PendulumOnSuspension": ("fmu.build.container",),
 }
 """The modules (under ``double_pendulum``) whose docstrings are the page's "The model" section."""
 SWITCH_GROUPS = {"DoublePendulum": (AirDragParameters, BearingParameters, SuspensionParameters)}
@@ -65,7 +66,7 @@ footer { margin-top: 3em; font-size: 0.8em; color: #57606a; }
 
 
 def _module_doc(name: str) -> str:
-    return importlib.import_module(f"{__package__.rpartition('.')[0]}.{name}").__doc__ or ""
+    return importlib.import_module(f"{__package__.partition('.')[0]}.{name}").__doc__ or ""
 
 
 def model_section(sources: Sequence[str]) -> str:
@@ -183,7 +184,7 @@ def machine_section(files: Mapping[str, bytes], model: str) -> str:
                     f"<pre>{html.escape(chr(10).join(lines))}</pre>")
     intro = ("<p>The container's own binary (fmpy's <code>container_fmu</code>) needs no Python; its two FMUs, "
              "under <code>resources/</code>, do:</p>" if model == "PendulumOnSuspension" else "")
-    loader_doc = _module_doc("fmu.loader")
+    loader_doc = _module_doc("fmu.build.loader")
     head = "<thead><tr><th>binary</th><th>what it is</th><th>needs of the system</th></tr></thead>"
     return (f"{intro}\n<table>\n{head}\n<tbody>\n"
             + "\n".join(rows) + f"\n</tbody>\n</table>\n{recorded}\n"

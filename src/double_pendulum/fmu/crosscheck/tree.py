@@ -4,8 +4,8 @@ The FMI Cross-Check (modelica/fmi-cross-check, rules v4.1) asks an exporting too
 ``fmus/<fmi_version>/<cs|me>/<platform>/<tool>/<version>/<Model>/`` holding ``<Model>.fmu``,
 ``<Model>_ref.csv``, ``<Model>_ref.opt``, ``<Model>_in.csv`` where it has inputs and a ReadMe.
 :func:`write_tree` writes it for this platform (:data:`PLATFORM`) from freshly built case FMUs
-(:func:`double_pendulum.fmu.reference_runs.build_case_fmus`) and the committed reference files
-(``data/reference/fmu/``, :mod:`double_pendulum.fmu.reference_cases`).
+(:func:`double_pendulum.fmu.crosscheck.reference_runs.build_case_fmus`) and the committed reference files
+(``data/reference/fmu/``, :mod:`double_pendulum.fmu.crosscheck.reference_cases`).
 
 The checks, as the Cross-Check runs them:
 
@@ -16,7 +16,7 @@ The checks, as the Cross-Check runs them:
 * :func:`import_with_fmpy`: fmpy as an importer, run from the options and inputs as
   ``python -m fmpy.cross_check --simulate`` runs it, its result judged by
   ``fmpy.cross_check.validate_result`` (at most 10 % of the samples outside the reference's band);
-* the FMI Compliance Checker with the input file: :mod:`double_pendulum.fmu.compliance_checker`.
+* the FMI Compliance Checker with the input file: :mod:`double_pendulum.fmu.crosscheck.compliance_checker`.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from .. import __version__
+from ... import __version__
 from .reference_cases import CASES, ReferenceCase, fmu_file, input_names
 
 TOOL = "double-pendulum-fmu"
@@ -104,7 +104,7 @@ The double-pendulum-fmu project; `double-pendulum cross-check DIR` writes this f
 
 def write_tree(root: str | Path, fmus: Mapping[str, Path], references: str | Path) -> list[Path]:
     """Write every case's folder under ``root``: the FMU from ``fmus`` (by
-    :func:`~double_pendulum.fmu.reference_cases.fmu_file`), the files from ``references`` (the committed
+    :func:`~double_pendulum.fmu.crosscheck.reference_cases.fmu_file`), the files from ``references`` (the committed
     ``data/reference/fmu``) and a ReadMe. The tool's folders are written anew; return the case folders."""
     references = Path(references)
     record = json.loads((references / "references.json").read_text(encoding="utf-8"))

@@ -2,19 +2,19 @@
 
 :func:`presentation_files` gives the files, by their path in the FMU:
 
-* ``documentation/index.html`` and ``documentation/result.png`` (:mod:`double_pendulum.fmu.documentation`,
-  :mod:`double_pendulum.fmu.doc_plot`);
+* ``documentation/index.html`` and ``documentation/result.png`` (:mod:`double_pendulum.fmu.carries.documentation`,
+  :mod:`double_pendulum.fmu.carries.doc_plot`);
 * the icon: ``model.png`` (FMI 2.0) and ``terminalsAndIcons/icon.png`` (FMI 3.0, and FMI 2.0.4's
-  back-port), :mod:`double_pendulum.fmu.icons`;
+  back-port), :mod:`double_pendulum.fmu.carries.icons`;
 * ``terminalsAndIcons/terminalsAndIcons.xml`` with the terminals of the FMU's variables and their
-  pictures (:mod:`double_pendulum.fmu.terminals`);
+  pictures (:mod:`double_pendulum.fmu.carries.terminals`);
 * ``documentation/licenses/<distribution>.txt``: the licence of everything the FMU bundles
   (:func:`licence_files`);
 * ``extra/org.fmi-standard.fmi-ls-ref/``: the reference result of the default experiment, in Reference-FMUs'
-  layout (:mod:`double_pendulum.fmu.reference_result`).
+  layout (:mod:`double_pendulum.fmu.carries.reference_result`).
 
-The build adds them in :func:`double_pendulum.fmu.build.rewrite_fmu` (DoublePendulum, Suspension, the
-FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.container.write_container` (the container).
+The build adds them in :func:`double_pendulum.fmu.build.staging.rewrite_fmu` (DoublePendulum, Suspension, the
+FMI 3 DoublePendulum) and :func:`double_pendulum.fmu.build.container.write_container` (the container).
 """
 
 from __future__ import annotations

@@ -1,10 +1,10 @@
 """The reference cases' FMUs, their reference runs in fmpy and their files (_ref.csv, _in.csv, _ref.opt).
 
-:func:`build_case_fmus` builds every FMU the cases run (:mod:`double_pendulum.fmu.reference_cases`):
+:func:`build_case_fmus` builds every FMU the cases run (:mod:`double_pendulum.fmu.crosscheck.reference_cases`):
 the FMUs as ``double-pendulum build`` writes them, the ones with a scene baked in, the container.
 :func:`reference_run` is a case's run in fmpy at tight tolerance (the FMU's integrator at
-:data:`~double_pendulum.fmu.reference_cases.TIGHT`, or CVode at
-:data:`~double_pendulum.fmu.reference_cases.ME_REFERENCE_TOLERANCE`); :func:`write_case_files` writes
+:data:`~double_pendulum.fmu.crosscheck.reference_cases.TIGHT`, or CVode at
+:data:`~double_pendulum.fmu.crosscheck.reference_cases.ME_REFERENCE_TOLERANCE`); :func:`write_case_files` writes
 it in the FMI Cross-Check's formats (rules v4.1, appendix B: a header of quoted names, time first,
 numbers as C literals, no units). ``data/reference/fmu/make_fmu_references.py`` writes the committed set
 and its record ``references.json`` (:func:`provenance`).
@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import __version__
+from ... import __version__
 from .reference_cases import (
     CASES,
     CONTAINER_VALUES,
@@ -38,11 +38,12 @@ RECORD = "references.json"
 
 
 def build_case_fmus(folder: str | Path) -> dict[str, Path]:
-    """Build every FMU the cases run into ``folder``, as :func:`~double_pendulum.fmu.reference_cases.fmu_file`
-    names them (``2.0/DoublePendulum.fmu``, ``3.0/DoublePendulumChaotic.fmu``, ...); return them by that name."""
-    from .build import build_fmu
-    from .build_fmi3 import build_fmu3
-    from .container import write_container
+    """Build every FMU the cases run into ``folder``, as
+    :func:`~double_pendulum.fmu.crosscheck.reference_cases.fmu_file` names them (``2.0/DoublePendulum.fmu``,
+    ``3.0/DoublePendulumChaotic.fmu``, ...); return them by that name."""
+    from ..build.container import write_container
+    from ..build.fmi2 import build_fmu
+    from ..build.fmi3 import build_fmu3
 
     folder = Path(folder)
     built: dict[str, Path] = {}

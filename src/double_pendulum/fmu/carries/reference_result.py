@@ -5,11 +5,11 @@
 
 The result is the FMU's default experiment (its ``DefaultExperiment`` start and stop, the start values the FMU
 carries, baked presets included, the default inputs), every :func:`interval` [s], computed at build in-process
-with the component(s) the FMU runs (:func:`double_pendulum.fmu.doc_plot.run`; the container's two components as
+with the component(s) the FMU runs (:func:`double_pendulum.fmu.carries.doc_plot.run`; the container's two components as
 it couples them). An importer that simulates the FMU with its defaults and that output interval should get
 these numbers: fmpy does, to rounding under Co-Simulation and within the tolerance under Model Exchange
-(``tests/test_reference_result.py``). The cross-check tree's references (:mod:`.reference_cases`) are other
-cases, with inputs and tight tolerances.
+(``tests/test_reference_result.py``). The cross-check tree's references
+(:mod:`double_pendulum.fmu.crosscheck.reference_cases`) are other cases, with inputs and tight tolerances.
 """
 
 from __future__ import annotations
@@ -91,8 +91,8 @@ def ssp_reference_files(values: Mapping[str, Any], stop_time: float, macro_step:
     all outputs are passed; two extra exchanges while initialising), macro step ``macro_step`` [s], to
     ``stop_time`` [s], :data:`SSP_STATES` every :func:`interval`. Computed at build in-process with the two
     components; ``run_coupled`` reproduces libcosim to rounding (``tests/test_engines.py``)."""
-    from .coupling import run_coupled, split_values
-    from .presets import COMPONENTS
+    from ..masters.coupling import run_coupled, split_values
+    from ..presets import COMPONENTS
 
     every = interval(0.0, stop_time, macro_step, macro_step)
     pendulum_values, suspension_values = split_values(values)

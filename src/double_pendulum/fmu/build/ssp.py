@@ -4,9 +4,9 @@ An SSP file (System Structure and Parameterization, the FMI family's standard fo
 FMUs) is a zip holding ``SystemStructure.ssd`` and the FMUs it references, here
 ``resources/DoublePendulum.fmu`` and ``resources/Suspension.fmu``. The SSD lists the two
 components with their connectors, the eight connections of
-:mod:`double_pendulum.fmu.coupling` and, per component, an inline parameter set
+:mod:`double_pendulum.fmu.masters.coupling` and, per component, an inline parameter set
 (``ssd:ParameterBindings/ssd:ParameterValues/ssv:ParameterSet``) with the values of
-:func:`~double_pendulum.fmu.coupling.split_values`: the pendulum's start values with its own
+:func:`~double_pendulum.fmu.masters.coupling.split_values`: the pendulum's start values with its own
 suspension off, the suspension's ``M_s, k, c`` and ``F_static_y = -(m1 + m2) g``.
 
 libcosim (libcosimpy ``CosimExecution.from_ssp_file``) reads exactly this subset of SSP 1.0:
@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from .coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, split_values
+from ..masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, split_values
 
 SYSTEM_NAME = "PendulumOnSuspension"
 PENDULUM, SUSPENSION = "DoublePendulum", "Suspension"
@@ -124,7 +124,7 @@ def write_ssp(
     """Write the ``.ssp`` at ``dest`` holding both FMUs; ``values``: the monolith's start values (defaults if None).
 
     ``reference=True`` (the build's SSP) adds the reference result of its default experiment,
-    ``extra/org.fmi-standard.fmi-ls-ref/`` as in the FMUs (:func:`~double_pendulum.fmu.reference_result.
+    ``extra/org.fmi-standard.fmi-ls-ref/`` as in the FMUs (:func:`~double_pendulum.fmu.carries.reference_result.
     ssp_reference_files`: the states as libcosim steps them; about 1.5 s of CPU for the 10 s).
     """
     dest = Path(dest)
@@ -137,7 +137,7 @@ def write_ssp(
         archive.write(pendulum_fmu, f"resources/{PENDULUM}.fmu")
         archive.write(suspension_fmu, f"resources/{SUSPENSION}.fmu")
         if reference:
-            from .reference_result import ssp_reference_files
+            from ..carries.reference_result import ssp_reference_files
 
             for name, data in ssp_reference_files(values or {}, stop_time, macro_step).items():
                 archive.writestr(name, data)

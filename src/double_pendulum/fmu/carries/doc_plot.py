@@ -4,7 +4,7 @@ Each FMU's ``documentation/result.png`` shows what the FMU computes from its own
 values baked into the build included) over its default experiment, as Reference-FMUs' documentation
 shows an fmusim run. It is computed in-process with the component the FMU runs (the same numbers as
 the FMU, ``tests/test_fmu.py``); the pendulum on its suspension with the coupling the container steps
-(:func:`double_pendulum.fmu.coupling.run_coupled`, ``jacobi_sequential``, its macro step). The
+(:func:`double_pendulum.fmu.masters.coupling.run_coupled`, ``jacobi_sequential``, its macro step). The
 Suspension's defaults leave it at rest, so its plot applies a load step (:data:`SUSPENSION_STEP`).
 
 Plots are kept per process, keyed by everything they show (a build writes several FMUs of one
@@ -19,10 +19,10 @@ import json
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ..component.suspension import INPUT_START
-from ..component.variables import INTERFACES
-from . import presets
-from .simulate import communication_points
+from ...component.suspension import INPUT_START
+from ...component.variables import INTERFACES
+from .. import presets
+from ..masters.simulate import communication_points
 
 SUSPENSION_STEP = {"F_x": 1.0, "F_y": INPUT_START["F_y"] - 1.0}
 """The Suspension plot's load [N]: 1 N horizontally and 1 N down on top of the static load, from t = 0."""
@@ -84,11 +84,11 @@ def _coupled(values: Mapping[str, Any], stop_time: float, interval: float, names
     (``DoublePendulum.phi1_0``, ``Suspension.x``); rows every ``interval`` [s], a multiple of ``macro_step``.
 
     The container steps both components over a macro step, then passes the connections, the force first
-    (``jacobi_sequential``, :func:`double_pendulum.fmu.coupling.sequential_exchange`), and a host reads its
+    (``jacobi_sequential``, :func:`double_pendulum.fmu.masters.coupling.sequential_exchange`), and a host reads its
     outputs after that: the outputs that follow their inputs at once (the pivot force, the suspension's
     acceleration) are recorded after the exchange too.
     """
-    from .coupling import sequential_exchange
+    from ..masters.coupling import sequential_exchange
 
     every = round(interval / macro_step)
     if every < 1 or abs(every * macro_step - interval) > 1e-9 * interval:

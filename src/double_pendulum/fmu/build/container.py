@@ -15,7 +15,7 @@ other, or on threads with ``parallelDoStep``): inputs held over the step, Jacobi
 
 The container exposes, as flat variables named ``<component>.<variable>``, parameters (the
 pendulum's initial state, the suspension's ``M_s, k, c, F_static_y``, and whatever else the
-monolith's start values split by :func:`~double_pendulum.fmu.coupling.split_values` set; their
+monolith's start values split by :func:`~double_pendulum.fmu.masters.coupling.split_values` set; their
 start values are those values) and the coupling and energy outputs of both components.
 
 fmpy 0.3.32 writes a connection's ``variableType`` as the FMI 2 type name ("Real") where the
@@ -34,8 +34,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, split_values
-from .presets import literal
+from ..masters.coupling import FORCE_CONNECTIONS, MOTION_CONNECTIONS, PENDULUM_OUTPUTS, SUSPENSION_OUTPUTS, split_values
+from ..presets import literal
 
 SYSTEM_NAME = "PendulumOnSuspension"
 PENDULUM, SUSPENSION = "DoublePendulum", "Suspension"
@@ -140,7 +140,7 @@ def write_container(
     ``compression`` is the zip method of the archive: ``zipfile.ZIP_STORED`` writes a container meant to be
     run once and removed about twice as fast (compressing the two bundled FMUs takes ~0.3 s).
     ``documented=True`` (the build's container) adds the documentation, icon and terminals
-    (:mod:`double_pendulum.fmu.presentation`; its result plot runs the coupled scene for 2 s in-process).
+    (:mod:`double_pendulum.fmu.carries.presentation`; its result plot runs the coupled scene for 2 s in-process).
     """
     from fmpy.container_fmu import write_configuration
     from fmpy.model_description import write_model_description
@@ -178,7 +178,7 @@ def write_container(
 
 def _add_presentation(root: Path) -> None:
     """Write the container's documentation, icon and terminals into the folder ``root`` it is zipped from."""
-    from .presentation import CONTAINER, presentation_files
+    from ..carries.presentation import CONTAINER, presentation_files
 
     files = {path.relative_to(root).as_posix(): path.read_bytes() for path in root.rglob("*")
              if path.is_file() and (path.name in ("modelDescription.xml", "python.cfg", "bundle.json")

@@ -10,7 +10,7 @@ docstrings (the switches of a scene). This turns one docstring into HTML:
 * inline ``:math:`...```, ``:mod:``, ``:func:``, ``:class:``, ``:meth:``, ``:data:`` (as code, ``~``
   keeps the last name), ````code````, ``**strong**`` and ``*emphasis*``.
 
-Formulas go through :func:`double_pendulum.fmu.tex_html.tex_to_html`.
+Formulas go through :func:`double_pendulum.fmu.carries.tex_html.tex_to_html`.
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ icon.png``) as a square PNG with a transparent background, :data:`ICON_PIXELS` w
 * ``PendulumOnSuspension``: the pendulum hanging from that block.
 
 ``terminal_icon(kind)`` is the picture of a terminal (``terminalsAndIcons/<kind>.png``,
-:mod:`double_pendulum.fmu.terminals`): ``mount`` (the pivot: a grey square with a hinge),
+:mod:`double_pendulum.fmu.carries.terminals`): ``mount`` (the pivot: a grey square with a hinge),
 ``torque`` (a curved arrow) and ``sensor`` (an output triangle). Drawn once per process.
 """
 

@@ -1,7 +1,7 @@
 """The TeX of the model's docstrings as plain HTML: letters, sub- and superscripts, accents, symbols.
 
 The FMU's ``documentation/index.html`` shows the equations of the model's docstrings
-(:mod:`double_pendulum.fmu.docstring_html`). FMI tools show an FMU's documentation in whatever HTML
+(:mod:`double_pendulum.fmu.carries.docstring_html`). FMI tools show an FMU's documentation in whatever HTML
 view they have (often no MathML, no JavaScript, no network), so the formulas become text: Latin
 letters in italics, Greek letters and symbols as Unicode, ``_``/``^`` as ``<sub>``/``<sup>``, dots
 as combining marks (U+0307, U+0308, U+0302), vectors in bold, ``\\tfrac12`` as ½.

@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from ..component.cosimulation import DoublePendulumCoSimulation
-from ..model.outputs import OUTPUT_NAMES
+from ...component.cosimulation import DoublePendulumCoSimulation
+from ...model.outputs import OUTPUT_NAMES
 
 
 def communication_points(

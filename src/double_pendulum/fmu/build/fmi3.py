@@ -3,7 +3,7 @@
 The adapter ``fmu_src/DoublePendulumFmi3.py`` maps the FMI 3 calls onto the same component as the
 FMI 2 FMU (Co-Simulation) and onto the runtime's vector field (Model Exchange,
 ``double_pendulum.component.model_exchange``); the runtime is bundled as for FMI 2
-(:mod:`double_pendulum.fmu.build`), with pythonfmu3's Python part imported under a private name.
+(:mod:`double_pendulum.fmu.build.staging`), with pythonfmu3's Python part imported under a private name.
 The build then
 
 * adds ``UnitDefinitions`` for the units the adapter gives its Float64 variables;
@@ -24,18 +24,19 @@ from pathlib import Path
 from typing import Any
 from xml.etree import ElementTree as ET
 
-from ..component.model_exchange import STATES
-from ..component.variables import INTERFACES, MODEL_IDENTIFIER
-from . import bundle, presets
-from .build import (
-    _copy_runtime,
+from ...component.model_exchange import STATES
+from ...component.variables import INTERFACES, MODEL_IDENTIFIER
+from .. import presets
+from . import bundle
+from .staging import adapter_sources as _adapter_sources
+from .staging import (
     builder_imports_forgotten,
     check_platform_binary,
     copy_adapters,
+    copy_runtime,
     rewrite_fmu,
     unit_definitions,
 )
-from .build import adapter_sources as _adapter_sources
 
 DEFAULT_FMU3_PATH = Path("build") / "fmi3" / f"{MODEL_IDENTIFIER}.fmu"
 
@@ -87,9 +88,9 @@ def complete_model_description_fmi3(xml_text: bytes) -> bytes:
 def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH, start_values: Mapping[str, Any] | None = None) -> Path:
     """Build the FMI 3.0 ``DoublePendulum`` FMU at ``dest`` (a ``.fmu`` path or a folder); return its path.
 
-    ``start_values`` (parameters by name) are baked in as the FMU's defaults (:mod:`.presets`). Written to
-    a temporary folder first and moved into place at the end, so a failed build never leaves a broken FMU
-    behind.
+    ``start_values`` (parameters by name) are baked in as the FMU's defaults
+    (:mod:`double_pendulum.fmu.presets`). Written to a temporary folder first and moved into place at the end,
+    so a failed build never leaves a broken FMU behind.
     """
     from pythonfmu3.builder import FmuBuilder
 
@@ -104,7 +105,7 @@ def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH, start_values: Mapping[str, 
             built = Path(FmuBuilder.build_FMU(
                 bundle.builder_script(tmp_dir / "script", MODEL_IDENTIFIER, 3),
                 dest=tmp_dir / "out",
-                project_files=[_copy_runtime(tmp_dir), copy_adapters(tmp_dir, 3)],
+                project_files=[copy_runtime(tmp_dir), copy_adapters(tmp_dir, 3)],
                 canGetAndSetFMUState=True,
                 canSerializeFMUState=True,
                 canHandleVariableCommunicationStepSize=True,

@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from ..model.outputs import OUTPUT_NAMES
-from .build import DEFAULT_FMU_PATH, build_fmu, fmu_is_current
+from ...model.outputs import OUTPUT_NAMES
+from ..build.fmi2 import DEFAULT_FMU_PATH, build_fmu, fmu_is_current
 
 
 class FmuRunError(RuntimeError):
@@ -237,11 +237,3 @@ def keep_fmpy_logger_alive() -> None:
 def _summarise(messages: list[str]) -> str:
     """Join the FMU's error messages, keeping the last line of each (the exception itself)."""
     return "; ".join(m.strip().split("\n")[-1] for m in messages) or "no message logged"
-
-
-def simulate_fmu_file(
-    fmu_path: str | Path, start_values: Mapping[str, Any] | None = None, **options: Any
-) -> np.ndarray:
-    """One-shot convenience: extract, simulate, clean up."""
-    with FmuRunner(fmu_path) as runner:
-        return runner.simulate(start_values, **options)
