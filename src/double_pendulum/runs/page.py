@@ -8,7 +8,8 @@ and links to its report, its CSV files, its ``summary.json`` and its other figur
 runs that this run did not touch are listed at the end, with links.
 
 The page is self-contained: plain HTML with its style sheet inline, every link and image a relative path into
-the output folder, no script, nothing from the network. It is written atomically (:mod:`.results_io`). The
+the output folder, nothing from the network; its one script is the animations' player (:mod:`.player`,
+inline). It is written atomically (:mod:`.results_io`). The
 scenarios' registry (:mod:`double_pendulum.scenarios`) declares what it shows of each with the classes here, so
 this module imports nothing slow at its top.
 """
@@ -24,6 +25,8 @@ from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 from typing import Any
+
+from .player import PLAYER_SCRIPT, PLAYER_STYLE, Animation, animation_html
 
 PAGE = "index.html"
 
@@ -50,6 +53,7 @@ class ScenarioPage:
     description: str
     headlines: Sequence[Headline] = ()
     figures: Sequence[tuple[str, str]] = ()
+    animations: Sequence[Animation] = ()  # the players shown under their GIFs (:mod:`.player`)
 
 
 @dataclass(frozen=True)
@@ -241,6 +245,7 @@ def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
             parts.append(f'<figure><a href="{html.escape(src)}"><img src="{html.escape(src)}" '
                          f'alt="{html.escape(caption)}"></a><figcaption>{html.escape(caption)} '
                          f"({html.escape(name)})</figcaption></figure>")
+            parts.extend(animation_html(folder, a) for a in page.animations if a.gif == name)
     parts.append(_files(folder, shown))
     return "\n".join(parts) + "</section>"
 
@@ -283,8 +288,9 @@ def page_html(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> str:
         body.append(f'<section id="earlier"><h2>From earlier runs in this folder</h2><ul>{items}</ul></section>')
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-            f"<title>Double pendulum: results of a {html.escape(run.mode)} run</title><style>{STYLE}</style>"
-            "</head><body>\n" + "\n".join([*head, *body]) + "\n</body></html>\n")
+            f"<title>Double pendulum: results of a {html.escape(run.mode)} run</title>"
+            f"<style>{STYLE}{PLAYER_STYLE}</style>"
+            f"{PLAYER_SCRIPT}</head><body>\n" + "\n".join([*head, *body]) + "\n</body></html>\n")
 
 
 def write_index(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> Path:
