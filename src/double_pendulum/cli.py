@@ -569,6 +569,7 @@ def build_parser() -> argparse.ArgumentParser:
     p_vars = sub.add_parser("variables", help="print the FMU's variables (Markdown table)",
                             description="Print the FMU's variables as a Markdown table.")
     p_vars.set_defaults(func=cmd_variables)
+    __import__("double_pendulum.app.server", fromlist=["add_app_command"]).add_app_command(sub)  # issue 37
     return parser
 
 
