@@ -10,6 +10,7 @@ names (:data:`SCENARIOS`), their costs for ``run all`` (:data:`EXPECTED_CPU_S`, 
 """
 
 from double_pendulum.runs.page import Headline, ScenarioPage
+from double_pendulum.runs.player import Animation, Drawn
 
 SCENARIOS: tuple[str, ...] = (
     "cosimulation",
@@ -232,7 +233,22 @@ CONCLUSIONS: dict[str, str] = {
 figure of :data:`HEADLINES` as the table shows it; the first five of the scenarios that ran, in :data:`READING_ORDER`
 (:class:`~double_pendulum.runs.page.ScenarioPage`'s ``conclusion``). No figure is written here."""
 
+ANIMATIONS: dict[str, tuple[Animation, ...]] = {
+    "measured_vs_sim": (Animation(
+        "measured_vs_sim.gif", "measured (camera) and simulated (FMU) pendulum", time="t_since_t0",
+        time_label="t - t0", drawn=(
+            Drawn("camera", "k", "paths.csv", "_measured", links=False),
+            Drawn("FMU", "C0", "paths.csv", "_simulated", pivot=("pivot_x_simulated", "pivot_y_simulated")))),),
+    "free_swing": (Animation(
+        "twin_starts.gif", "frictionless: two chaotic starts a hair apart",
+        drawn=(Drawn("first start", "C0", "chaotic.csv"), Drawn("second start", "C3", "chaotic_nudged.csv"))),),
+}
+"""The players the run's page shows under these GIFs, drawn from the CSV files the GIFs are drawn from
+(:class:`~double_pendulum.runs.player.Animation`), with play, pause, step, speed and a time slider."""
+
 
 def page(name: str, description: str) -> ScenarioPage:
     """What the run's page shows of scenario ``name`` (``description``: its one line)."""
     return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()), CONCLUSIONS.get(name, ""))
+
+    return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()), ANIMATIONS.get(name, ()))

@@ -151,6 +151,28 @@ class Browser:
             raise BrowserError(f"{expression}: {result['exceptionDetails']}")
         return result["result"].get("value")
 
+    def wait_for(self, expression: str, timeout: float = WAIT_S, interval: float = 0.1) -> Any:
+        """The first truthy value of ``expression``, asked every ``interval`` seconds (BrowserError after
+        ``timeout``: a guard against a hang, no measure of speed)."""
+        deadline = time.monotonic() + timeout
+        while not (value := self.evaluate(expression)):
+            if time.monotonic() > deadline:
+                raise BrowserError(f"{expression} stayed false for {timeout:g} s")
+            time.sleep(interval)
+        return value
+
+    def click(self, selector: str) -> None:
+        """Click the element ``selector`` (a CSS selector) finds, once it is there."""
+        self.wait_for(f"document.querySelector({json.dumps(selector)}) !== null")
+        self.evaluate(f"document.querySelector({json.dumps(selector)}).click()")
+
+    def type_into(self, selector: str, text: str) -> None:
+        """Replace the text of the input field ``selector`` by ``text``, typed as a user types it."""
+        self.wait_for(f"document.querySelector({json.dumps(selector)}) !== null")
+        found = f"document.querySelector({json.dumps(selector)})"
+        self.evaluate(f"(() => {{ const e = {found}; e.focus(); e.select(); }})()")
+        self.send("Input.insertText", text=text)
+
     def drain(self) -> list[dict]:
         """Every event received so far."""
         while True:

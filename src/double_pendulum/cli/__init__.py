@@ -23,6 +23,7 @@ import os
 import sys
 
 from .. import __version__
+from ..app.server import add_app_command
 from ..runs.interrupts import handling_interrupts
 from .build import add_build_parser, add_cross_check_parser
 from .common import PROG, CliError
@@ -31,7 +32,7 @@ from .run import add_run_parser
 from .simulate import add_simulate_parser
 
 COMMANDS = (add_build_parser, add_run_parser, add_cross_check_parser, add_simulate_parser, add_list_parser,
-            add_variables_parser)
+            add_variables_parser, add_app_command)
 """Each command's part of the parser, in the order ``--help`` lists the commands."""
 
 

@@ -9,7 +9,8 @@ and links to its report, its CSV files, its ``summary.json`` and its other figur
 runs that this run did not touch are listed at the end, with links.
 
 The page is self-contained: plain HTML with its style sheet inline, every link and image a relative path into
-the output folder, no script, nothing from the network. It is written atomically (:mod:`.results_io`). The
+the output folder, nothing from the network; its one script is the animations' player (:mod:`.player`,
+inline). It is written atomically (:mod:`.results_io`). The
 scenarios' registry (:mod:`double_pendulum.scenarios`) declares what it shows of each with the classes here, so
 this module imports nothing slow at its top.
 """
@@ -25,6 +26,8 @@ from dataclasses import dataclass, field
 from datetime import datetime
 from pathlib import Path
 from typing import Any
+
+from .player import PLAYER_SCRIPT, PLAYER_STYLE, Animation, animation_html
 
 PAGE = "index.html"
 
@@ -58,6 +61,7 @@ class ScenarioPage:
     conclusion: str = ""
     """One sentence of the run's conclusions at the top of the page, with ``{0}``, ``{1}``, ... where the headline
     figures of that index go, formatted as in the table (:func:`conclusion`); "" for none."""
+    animations: Sequence[Animation] = ()  # the players shown under their GIFs (:mod:`.player`)
 
 
 @dataclass(frozen=True)
@@ -304,6 +308,7 @@ def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
             parts.append(f'<figure><a href="{html.escape(src)}"><img src="{html.escape(src)}" '
                          f'alt="{html.escape(caption)}"></a><figcaption>{html.escape(caption)} '
                          f"({html.escape(name)})</figcaption></figure>")
+            parts.extend(animation_html(folder, a) for a in page.animations if a.gif == name)
     parts.append(_files(folder, shown))
     return "\n".join([*parts, BACK]) + "</section>"
 
@@ -384,8 +389,9 @@ def page_html(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> str:
     body.append('<a class="to-top" href="#top">&uarr; top</a>')
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-            f"<title>Double pendulum: results of a {html.escape(run.mode)} run</title><style>{STYLE}</style>"
-            "</head><body>\n" + "\n".join([*head, *body]) + "\n</body></html>\n")
+            f"<title>Double pendulum: results of a {html.escape(run.mode)} run</title>"
+            f"<style>{STYLE}{PLAYER_STYLE}</style>"
+            f"{PLAYER_SCRIPT}</head><body>\n" + "\n".join([*head, *body]) + "\n</body></html>\n")
 
 
 def write_index(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> Path:

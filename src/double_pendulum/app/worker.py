@@ -1,0 +1,185 @@
+"""The app's runs, each in a process of its own: started, watched and cancelled by the request that owns it.
+
+A run is :func:`fmpy.simulate_fmu` on ``DoublePendulum.fmu`` through
+:class:`~double_pendulum.fmu.running.runner.FmuRunner` (a new FMU instance a run, as a bare ``simulate_fmu`` call makes,
+with the FMU's log collected so a failed run reports the FMU's own message). A process a run keeps two browser
+tabs' runs apart (each has its FMU instance, its fmpy logger and its interpreter state) and makes a run
+cancellable at any point: the process is terminated. The processes come from a fork server that has imported
+fmpy, NumPy and the package once, so a run starts in milliseconds.
+
+The kinds of run (:data:`KINDS`): ``case`` (the form's case), ``twins`` (the case and the same with ``phi1_0``
+moved by :data:`~double_pendulum.scenarios.free_swing.NUDGE_RAD`, as ``free_swing`` runs its twin starts) and
+``measured`` (the seed's start at t0 with the losses fitted to the measured energy decay, against the camera's
+track, as ``measured_vs_sim`` predicts it: :mod:`double_pendulum.analysis.prediction`; the first such run fits
+the losses, later ones read the fit from the cache).
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import threading
+import uuid
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+KINDS = ("case", "twins", "measured")
+PRELOAD = ["numpy", "fmpy", "double_pendulum.app.worker", "double_pendulum.fmu.running.runner"]
+
+
+def _columns(result: Any) -> dict[str, list[float]]:
+    return {name: result[name].tolist() for name in result.dtype.names}
+
+
+def run_case(fmu: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float,
+             progress: Any = None) -> dict[str, Any]:
+    """One run of the FMU: its columns (every output), or the FMU's message and the rows before it. ``progress``
+    (a shared double) follows the run's time [s]."""
+    from ..fmu.running.runner import FmuRunError, FmuRunner
+
+    def step_finished(time: float, recorder: Any) -> bool:
+        if progress is not None:
+            progress.value = time
+        return True
+
+    with FmuRunner(fmu, reuse_instance=False) as runner:
+        try:
+            result = runner.simulate(start_values, stop_time=stop_time, output_interval=output_interval,
+                                     step_finished=step_finished)
+        except FmuRunError as error:
+            partial = error.partial_result
+            return {"columns": _columns(partial) if partial is not None and len(partial) else None,
+                    "message": str(error).split(" -- FMU says: ")[-1], "units": runner.units}
+        return {"columns": _columns(result), "message": None, "units": runner.units}
+
+
+def run_twins(fmu: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float,
+              progress: Any = None) -> dict[str, Any]:
+    """The case and its twin, ``phi1_0`` a hair larger (``free_swing``'s nudge)."""
+    from double_pendulum.scenarios.free_swing import NUDGE_RAD
+
+    first = run_case(fmu, start_values, stop_time, output_interval, progress)
+    if first["message"]:
+        return first
+    nudged = {**start_values, "phi1_0": float(start_values.get("phi1_0", 0.0)) + NUDGE_RAD}
+    second = run_case(fmu, nudged, stop_time, output_interval, progress)
+    return {**first, "twin": second["columns"], "message": second["message"], "nudge_rad": NUDGE_RAD}
+
+
+def run_measured(fmu: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float,
+                 progress: Any = None) -> dict[str, Any]:
+    """The seed's start with the fitted losses against the camera's track (``measured_vs_sim``'s run
+    ``seed_start_identified``), over at most ``stop_time`` [s] of the record: the paths table of
+    :func:`~double_pendulum.analysis.prediction.paths.paths_table` and the losses' values."""
+    from double_pendulum.scenarios.measured_vs_sim import SEED_T0
+
+    from ..analysis.losses.identification import seed_reconstruction
+    from ..analysis.prediction.comparison import identified_losses, nearest_frame, predict, reconstructed_state
+    from ..analysis.prediction.paths import paths_table
+    from ..analysis.track.measurement import FRAME_INTERVAL
+    from ..fmu.running.runner import FmuRunner
+
+    rec = seed_reconstruction()
+    losses = identified_losses(rec)
+    i0 = nearest_frame(rec, SEED_T0)
+    frames = min(int(round(stop_time / FRAME_INTERVAL)) + 1, len(rec.t) - i0)
+    with FmuRunner(fmu, reuse_instance=False) as runner:
+        prediction = predict(runner, "seed_start_identified", losses.values, reconstructed_state(rec, i0), rec, i0,
+                             frames)
+    table = paths_table(rec, i0, frames, prediction)
+    if progress is not None:
+        progress.value = stop_time
+    return {"columns": _columns(table), "message": None, "losses": losses.losses, "t0": float(rec.t[i0])}
+
+
+RUNS = {"case": run_case, "twins": run_twins, "measured": run_measured}
+
+
+def _child(kind: str, fmu: str, start_values: dict[str, Any], stop_time: float, output_interval: float,
+           progress: Any, sender: Any) -> None:
+    try:
+        answer = RUNS[kind](fmu, start_values, stop_time, output_interval, progress)
+    except Exception as error:  # the run's own failure, shown in the app
+        answer = {"columns": None, "message": f"{type(error).__name__}: {error}"}
+    sender.send(answer)
+    sender.close()
+
+
+@dataclass
+class Job:
+    """A run in its process: its ``progress`` [s of run time], the pipe its answer comes through."""
+
+    kind: str
+    stop_time: float
+    process: Any
+    progress: Any
+    receiver: Any
+    answer: dict[str, Any] | None = None
+
+    def poll(self) -> dict[str, Any] | None:
+        """The run's answer once it has come (None while it runs)."""
+        if self.answer is None and self.receiver.poll():
+            self.answer = self.receiver.recv()
+            self.process.join()
+        elif self.answer is None and not self.process.is_alive() and not self.receiver.poll():
+            self.answer = {"columns": None, "message": f"the run's process ended without an answer "
+                                                         f"(exit code {self.process.exitcode})"}
+        return self.answer
+
+    def cancel(self) -> None:
+        """Stop the run now (its process is terminated)."""
+        if self.process.is_alive():
+            self.process.terminate()
+        self.process.join()
+        self.answer = self.answer or {"columns": None, "message": "cancelled"}
+
+
+@dataclass
+class Runs:
+    """The runs of one app, by an id each browser tab keeps in its own store (no tab sees another's run)."""
+
+    fmu: Path
+    context: Any = None
+    jobs: dict[str, Job] = field(default_factory=dict)
+    lock: Any = field(default_factory=threading.Lock)  # the server answers requests on threads of its own
+
+    def __post_init__(self) -> None:
+        if self.context is None:
+            self.context = multiprocessing.get_context("forkserver")
+            self.context.set_forkserver_preload(PRELOAD)
+
+    def start(self, kind: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float) -> str:
+        """Start a run of ``kind`` (:data:`KINDS`); its id."""
+        receiver, sender = self.context.Pipe(duplex=False)
+        progress = self.context.Value("d", 0.0, lock=False)
+        process = self.context.Process(target=_child, args=(kind, str(self.fmu), dict(start_values), stop_time,
+                                                           output_interval, progress, sender), daemon=True)
+        process.start()
+        sender.close()
+        run_id = uuid.uuid4().hex
+        with self.lock:
+            self.jobs[run_id] = Job(kind, stop_time, process, progress, receiver)
+        return run_id
+
+    def poll(self, run_id: str) -> tuple[float, dict[str, Any] | None] | None:
+        """How far the run is (0 to 1) and its answer once it has come (then it is forgotten here); None for a run
+        not known (its answer went to an earlier request, or the app was restarted)."""
+        with self.lock:
+            job = self.jobs.get(run_id)
+            if job is None:
+                return None
+            answer = job.poll()
+            if answer is not None:
+                del self.jobs[run_id]
+            return min(1.0, job.progress.value / max(job.stop_time, 1e-12)), answer
+
+    def cancel(self, run_id: str) -> None:
+        with self.lock:
+            job = self.jobs.pop(run_id, None)
+        if job is not None:
+            job.cancel()
+
+    def close(self) -> None:
+        for run_id in list(self.jobs):
+            self.cancel(run_id)
