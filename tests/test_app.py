@@ -117,7 +117,7 @@ def test_the_page_s_player_steps_and_scrubs_to_another_frame(fmu_path, tmp_path)
     (folder / "summary.json").write_text("{}")
     animation = Animation("twin_starts.gif", "a test swing", (Drawn("one start", "C0", "chaotic.csv"),))
     (folder / "twin_starts.gif").write_bytes(b"GIF89a")
-    page = ScenarioPage("free_swing", "a test", (), (("twin_starts.gif", "a GIF"),), (animation,))
+    page = ScenarioPage("free_swing", "a test", (), (("twin_starts.gif", "a GIF"),), animations=(animation,))
     run = RunInfo(datetime.datetime(2026, 12, 5, tzinfo=datetime.UTC), "0", "quick", 1.0, 1.0, "test",
                   ("free_swing",))
     index = tmp_path / "index.html"
