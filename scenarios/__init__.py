@@ -221,8 +221,9 @@ CONCLUSIONS: dict[str, str] = {
              "Lyapunov exponent, {0}, and hand releases within 5 mm of each other spread beyond 1 cm after {2}.",
     "energy_decay": "The measured energy decays as E = a exp(b t) with b = {0} (statistical error); the choice of "
                     "weights, window or energy shifts b by up to {1}.",
-    "loss_identification": "{0} loss models fit the measured energy about equally well, so the record does not tell "
-                           "which losses cause the decay: air drag's share of the loss is {1} among them.",
+    "loss_identification": "Loss models that fit the measured energy about equally well: {0}, air drag's share of the "
+                           "loss {1} among them; where there is more than one, the record does not tell which losses "
+                           "cause the decay.",
     "base_excitation": "Shaking the pivot at 50 rad/s holds the single pendulum upright from an amplitude of {0} "
                        "(Kapitza), and the simulated resonance peaks are within {2} of the damped linear theory.",
     "cosimulation": "Split into two FMUs, plain exchange converges with order {0} in the macro step, the iterative "
@@ -249,6 +250,5 @@ ANIMATIONS: dict[str, tuple[Animation, ...]] = {
 
 def page(name: str, description: str) -> ScenarioPage:
     """What the run's page shows of scenario ``name`` (``description``: its one line)."""
-    return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()), CONCLUSIONS.get(name, ""))
-
-    return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()), ANIMATIONS.get(name, ()))
+    return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()),
+                        conclusion=CONCLUSIONS.get(name, ""), animations=ANIMATIONS.get(name, ()))

@@ -12,7 +12,7 @@ from urllib.parse import unquote, urlparse
 
 import pytest
 from browser import Browser, find_chromium
-from double_pendulum.scenarios import FIGURES, HEADLINES, READING_ORDER, SCENARIOS
+from double_pendulum.scenarios import ANIMATIONS, CONCLUSIONS, FIGURES, HEADLINES, READING_ORDER, SCENARIOS
 
 from double_pendulum.runs.page import (
     Headline,
@@ -154,6 +154,9 @@ def test_the_page_shows_each_scenario_with_the_figures_its_summary_holds(quick_r
             assert html.escape(headline_text(line, summary)) in section, (name, line.label)
         assert 'class="short"' in section, f"{name}: no plain summary"
         assert f'href="{name}/summary.json"' in section
+        assert section.count('class="dp-player"') == len(ANIMATIONS.get(name, ())), f"{name}: not every player"
+    conclusions = page.split('<section id="conclusions">', 1)[1].split("</section>", 1)[0]
+    assert conclusions.count("<li>") == min(5, len(CONCLUSIONS)), "a sentence for each of the first five that ran"
 
 
 def test_the_page_is_self_contained(quick_results, page):
