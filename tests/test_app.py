@@ -105,6 +105,41 @@ def test_a_run_the_fmu_cannot_complete_answers_the_fmu_s_own_message(fmu_path):
     assert _answer_text(answer) == f"the FMU stopped the run: {answer['message']}"
 
 
+def _wait_for_answer(runs, run_id: str, timeout: float = 120.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        state = runs.poll(run_id)
+        if state is not None and state[1] is not None:
+            return state[1]
+        time.sleep(0.05)
+    raise AssertionError(f"run {run_id} gave no answer in {timeout} s")
+
+
+def test_two_runs_at_once_each_get_their_own_answer_and_a_cancelled_one_leaves_no_process(fmu_path):
+    """Two tabs' runs in flight together come back with their own start's result; a long run cancelled ends its
+    process at once and is forgotten (a poll of it answers None)."""
+    from double_pendulum.app.worker import Runs
+
+    runs = Runs(fmu_path)
+    try:
+        long = runs.start("case", {"phi1_0": 2.0, "solver": "dop853", "rtol": 1e-12}, 3600.0, 0.01)
+        first = runs.start("case", {"phi1_0": 0.1, "phi2_0": 0.1}, 2.0, 0.01)
+        second = runs.start("case", {"phi1_0": -0.1, "phi2_0": -0.1}, 2.0, 0.01)
+        process = runs.jobs[long].process
+        deadline = time.monotonic() + 60
+        while runs.jobs[long].progress.value == 0.0 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert process.is_alive() and runs.poll(long)[1] is None, "the hour-long run should be running"
+        runs.cancel(long)
+        assert not process.is_alive() and runs.poll(long) is None
+        a, b = _wait_for_answer(runs, first), _wait_for_answer(runs, second)
+        assert a["message"] is None and b["message"] is None
+        assert a["columns"]["phi1"][0] == pytest.approx(0.1) and b["columns"]["phi1"][0] == pytest.approx(-0.1)
+        assert a["columns"]["phi1"][-1] == pytest.approx(-b["columns"]["phi1"][-1], rel=1e-9)  # mirror images
+    finally:
+        runs.close()
+
+
 @needs_browser
 def test_the_page_s_player_steps_and_scrubs_to_another_frame(fmu_path, tmp_path):
     from double_pendulum.fmu.running.runner import FmuRunner
