@@ -140,6 +140,26 @@ def test_two_runs_at_once_each_get_their_own_answer_and_a_cancelled_one_leaves_n
         runs.close()
 
 
+def test_a_run_whose_process_dies_answers_so_and_does_not_raise(fmu_path):
+    """A run's process killed from outside (out of memory, a signal) is reported as ended without an answer."""
+    from double_pendulum.app.worker import Runs
+
+    runs = Runs(fmu_path)
+    try:
+        run_id = runs.start("case", {"phi1_0": 2.0, "solver": "dop853", "rtol": 1e-12}, 3600.0, 0.01)
+        process = runs.jobs[run_id].process
+        deadline = time.monotonic() + 60
+        while runs.jobs[run_id].progress.value == 0.0 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        process.kill()
+        process.join()
+        answer = _wait_for_answer(runs, run_id)
+        assert answer["columns"] is None and answer["message"] == (
+            f"the run's process ended without an answer (exit code {-signal.SIGKILL})")
+    finally:
+        runs.close()
+
+
 @needs_browser
 def test_the_page_s_player_steps_and_scrubs_to_another_frame(fmu_path, tmp_path):
     from double_pendulum.fmu.running.runner import FmuRunner

@@ -14,7 +14,7 @@ from dash import dcc, html
 from .form import LOSSES, OWN_PENDULUM, PENDULUMS, SOLVERS, START, STOP_TIME, SUSPENSION, TOLERANCE, Field
 from .form import default_values as defaults
 
-POLL_MS = 200
+POLL_MS = 100
 """How often [ms] a tab asks after its running run."""
 LOSS_NAMES = {"air_drag": "air drag on the bobs", "bearing_friction": "rolling friction in the bearings",
               "bearing_drag": "load-independent drag torque in the bearings"}

@@ -120,7 +120,12 @@ class Job:
     def poll(self) -> dict[str, Any] | None:
         """The run's answer once it has come (None while it runs)."""
         if self.answer is None and self.receiver.poll():
-            self.answer = self.receiver.recv()
+            try:
+                self.answer = self.receiver.recv()
+            except EOFError:  # the process ended (or died) before it sent its answer
+                self.process.join()
+                self.answer = {"columns": None, "message": f"the run's process ended without an answer "
+                                                             f"(exit code {self.process.exitcode})"}
             self.process.join()
         elif self.answer is None and not self.process.is_alive() and not self.receiver.poll():
             self.answer = {"columns": None, "message": f"the run's process ended without an answer "
