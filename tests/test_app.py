@@ -127,7 +127,7 @@ def test_two_runs_at_once_each_get_their_own_answer_and_a_cancelled_one_leaves_n
         second = runs.start("case", {"phi1_0": -0.1, "phi2_0": -0.1}, 2.0, 0.01)
         process = runs.jobs[long].process
         deadline = time.monotonic() + 60
-        while runs.jobs[long].progress.value == 0.0 and time.monotonic() < deadline:
+        while runs.poll(long)[0] == 0.0 and time.monotonic() < deadline:
             time.sleep(0.05)
         assert process.is_alive() and runs.poll(long)[1] is None, "the hour-long run should be running"
         runs.cancel(long)
@@ -149,7 +149,7 @@ def test_a_run_whose_process_dies_answers_so_and_does_not_raise(fmu_path):
         run_id = runs.start("case", {"phi1_0": 2.0, "solver": "dop853", "rtol": 1e-12}, 3600.0, 0.01)
         process = runs.jobs[run_id].process
         deadline = time.monotonic() + 60
-        while runs.jobs[run_id].progress.value == 0.0 and time.monotonic() < deadline:
+        while runs.poll(run_id)[0] == 0.0 and time.monotonic() < deadline:
             time.sleep(0.05)
         process.kill()
         process.join()

@@ -9,6 +9,7 @@ without them the command says so in one line.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from pathlib import Path
 from typing import Any
@@ -60,13 +61,19 @@ def cmd_app(args: argparse.Namespace) -> int:
     fmu = ensure_fmu(Path(args.fmu) if args.fmu else DEFAULT_FMU_PATH).resolve()
     app, runs = create_app(fmu)
     print(f"double-pendulum app: open http://{HOST}:{args.port}/ in a browser (Ctrl-C ends it)", flush=True)
+    previous = signal.signal(signal.SIGTERM, _interrupt)  # `kill` ends it as Ctrl-C does: runs and files cleaned
     try:
         app.run(host=HOST, port=args.port, debug=False)
     except KeyboardInterrupt:
         print("double-pendulum app: ended", file=sys.stderr)
     finally:
         runs.close()
+        signal.signal(signal.SIGTERM, previous)
     return 0
+
+
+def _interrupt(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
 
 
 def main(argv: list[str] | None = None) -> int:

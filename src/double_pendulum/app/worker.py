@@ -4,7 +4,9 @@ A run is :func:`fmpy.simulate_fmu` on ``DoublePendulum.fmu`` through
 :class:`~double_pendulum.fmu.running.runner.FmuRunner` (a new FMU instance a run, as a bare ``simulate_fmu`` call makes,
 with the FMU's log collected so a failed run reports the FMU's own message). A process a run keeps two browser
 tabs' runs apart (each has its FMU instance, its fmpy logger and its interpreter state) and makes a run
-cancellable at any point: the process is terminated. The processes come from a fork server that has imported
+cancellable at any point: the process is terminated. The FMU is extracted once, by :class:`Runs`, which removes it
+when closed, and a run's progress comes through its pipe: a run's process owns no file and no shared memory, so one
+terminated or killed leaves nothing behind. The processes come from a fork server that has imported
 fmpy, NumPy and the package once, so a run starts in milliseconds.
 
 The kinds of run (:data:`KINDS`): ``case`` (the form's case), ``twins`` (the case and the same with ``phi1_0``
@@ -16,12 +18,15 @@ the losses, later ones read the fit from the cache).
 
 from __future__ import annotations
 
+import math
 import multiprocessing
+import shutil
 import threading
 import uuid
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from time import monotonic
 from typing import Any
 
 KINDS = ("case", "twins", "measured")
@@ -96,41 +101,73 @@ def run_measured(fmu: str, start_values: Mapping[str, Any], stop_time: float, ou
 RUNS = {"case": run_case, "twins": run_twins, "measured": run_measured}
 
 
+class _Progress:
+    """A run's time [s] (``value``, as the runs set it), sent to the app through the run's pipe at most every
+    :data:`PROGRESS_EVERY_S` of wall time. A pipe, not shared memory: a run's process owns nothing that outlives it
+    (multiprocessing's shared values can need a temporary folder that only a normal exit of the app removes)."""
+
+    def __init__(self, sender: Any) -> None:
+        self.sender, self._value, self._sent_at = sender, 0.0, -math.inf
+
+    @property
+    def value(self) -> float:
+        return self._value
+
+    @value.setter
+    def value(self, time: float) -> None:
+        self._value = time
+        now = monotonic()
+        if now - self._sent_at >= PROGRESS_EVERY_S:
+            self.sender.send(("progress", time))
+            self._sent_at = now
+
+
+PROGRESS_EVERY_S = 0.05
+
+
 def _child(kind: str, fmu: str, start_values: dict[str, Any], stop_time: float, output_interval: float,
-           progress: Any, sender: Any) -> None:
+           sender: Any) -> None:
     try:
-        answer = RUNS[kind](fmu, start_values, stop_time, output_interval, progress)
+        answer = RUNS[kind](fmu, start_values, stop_time, output_interval, _Progress(sender))
     except Exception as error:  # the run's own failure, shown in the app
         answer = {"columns": None, "message": f"{type(error).__name__}: {error}"}
-    sender.send(answer)
+    sender.send(("answer", answer))
     sender.close()
 
 
 @dataclass
 class Job:
-    """A run in its process: its ``progress`` [s of run time], the pipe its answer comes through."""
+    """A run in its process: the pipe its progress and its answer come through, its ``progress`` [s of run
+    time] as last heard."""
 
     kind: str
     stop_time: float
     process: Any
-    progress: Any
     receiver: Any
+    progress: float = 0.0
     answer: dict[str, Any] | None = None
 
     def poll(self) -> dict[str, Any] | None:
-        """The run's answer once it has come (None while it runs)."""
-        if self.answer is None and self.receiver.poll():
+        """The run's answer once it has come (None while it runs); reads the progress sent so far."""
+        while self.answer is None and self.receiver.poll():
             try:
-                self.answer = self.receiver.recv()
+                what, payload = self.receiver.recv()
             except EOFError:  # the process ended (or died) before it sent its answer
                 self.process.join()
-                self.answer = {"columns": None, "message": f"the run's process ended without an answer "
-                                                             f"(exit code {self.process.exitcode})"}
-            self.process.join()
-        elif self.answer is None and not self.process.is_alive() and not self.receiver.poll():
-            self.answer = {"columns": None, "message": f"the run's process ended without an answer "
-                                                         f"(exit code {self.process.exitcode})"}
+                self.answer = self._ended()
+                break
+            if what == "progress":
+                self.progress = payload
+            else:
+                self.answer = payload
+                self.process.join()
+        if self.answer is None and not self.process.is_alive() and not self.receiver.poll():
+            self.answer = self._ended()
         return self.answer
+
+    def _ended(self) -> dict[str, Any]:
+        return {"columns": None, "message": f"the run's process ended without an answer "
+                                            f"(exit code {self.process.exitcode})"}
 
     def cancel(self) -> None:
         """Stop the run now (its process is terminated)."""
@@ -148,23 +185,26 @@ class Runs:
     context: Any = None
     jobs: dict[str, Job] = field(default_factory=dict)
     lock: Any = field(default_factory=threading.Lock)  # the server answers requests on threads of its own
+    unzipdir: str = ""  # the FMU extracted for every run (removed by close)
 
     def __post_init__(self) -> None:
+        from fmpy import extract
+
         if self.context is None:
             self.context = multiprocessing.get_context("forkserver")
             self.context.set_forkserver_preload(PRELOAD)
+        self.unzipdir = extract(str(self.fmu))
 
     def start(self, kind: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float) -> str:
         """Start a run of ``kind`` (:data:`KINDS`); its id."""
         receiver, sender = self.context.Pipe(duplex=False)
-        progress = self.context.Value("d", 0.0, lock=False)
-        process = self.context.Process(target=_child, args=(kind, str(self.fmu), dict(start_values), stop_time,
-                                                           output_interval, progress, sender), daemon=True)
+        process = self.context.Process(target=_child, args=(kind, self.unzipdir, dict(start_values), stop_time,
+                                                           output_interval, sender), daemon=True)
         process.start()
         sender.close()
         run_id = uuid.uuid4().hex
         with self.lock:
-            self.jobs[run_id] = Job(kind, stop_time, process, progress, receiver)
+            self.jobs[run_id] = Job(kind, stop_time, process, receiver)
         return run_id
 
     def poll(self, run_id: str) -> tuple[float, dict[str, Any] | None] | None:
@@ -177,7 +217,7 @@ class Runs:
             answer = job.poll()
             if answer is not None:
                 del self.jobs[run_id]
-            return min(1.0, job.progress.value / max(job.stop_time, 1e-12)), answer
+            return min(1.0, job.progress / max(job.stop_time, 1e-12)), answer
 
     def cancel(self, run_id: str) -> None:
         with self.lock:
@@ -186,5 +226,7 @@ class Runs:
             job.cancel()
 
     def close(self) -> None:
+        """Cancel the runs still going, then remove the extracted FMU."""
         for run_id in list(self.jobs):
             self.cancel(run_id)
+        shutil.rmtree(self.unzipdir, ignore_errors=True)

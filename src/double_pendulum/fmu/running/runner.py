@@ -41,14 +41,19 @@ def ensure_fmu(path: str | Path = DEFAULT_FMU_PATH, *, rebuild: bool = False) ->
 
 
 class FmuRunner:
-    """Simulate one FMU file repeatedly with fmpy (extracted once; an FMI 2 co-simulation instance reused)."""
+    """Simulate one FMU file repeatedly with fmpy (extracted once; an FMI 2 co-simulation instance reused).
+
+    ``fmu_path`` is an FMU file, extracted here and removed again by :meth:`close`, or the folder of an FMU already
+    extracted (:func:`fmpy.extract`), which stays: its owner removes it (the app extracts once for all its runs'
+    processes, so a run's process killed at any point leaves nothing behind)."""
 
     def __init__(self, fmu_path: str | Path, *, reuse_instance: bool = True) -> None:
         from fmpy import extract, read_model_description
 
         self.fmu_path = Path(fmu_path)
         self.model_description = read_model_description(str(self.fmu_path))
-        self.unzipdir = extract(str(self.fmu_path))
+        self._owns_unzipdir = not self.fmu_path.is_dir()
+        self.unzipdir = extract(str(self.fmu_path)) if self._owns_unzipdir else str(self.fmu_path)
         self.units = {
             v.name: (v.unit or (v.declaredType.unit if v.declaredType else None) or "")
             for v in self.model_description.modelVariables
@@ -65,7 +70,8 @@ class FmuRunner:
             _SINKS.pop(id(self), None)
             with contextlib.suppress(Exception):
                 instance.freeInstance()
-        shutil.rmtree(self.unzipdir, ignore_errors=True)
+        if self._owns_unzipdir:
+            shutil.rmtree(self.unzipdir, ignore_errors=True)
 
     def __enter__(self) -> FmuRunner:
         return self
