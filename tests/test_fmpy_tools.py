@@ -146,7 +146,26 @@ def _gui_missing() -> str | None:
         return 'FMPy\'s GUI needs PySide6 and pyqtgraph (pip install "fmpy[gui,plot]"); not installed'
     if shutil.which("xvfb-run") is None:
         return "the GUI test needs Xvfb (Debian: apt-get install xvfb xauth); xvfb-run is not on PATH"
+    missing = _xcb_libraries_missing()
+    if missing:
+        return (f"Qt's xcb platform plugin cannot load without {', '.join(missing)} (Debian: apt-get install "
+                f"libxcb-cursor0 libxkbcommon-x11-0 ..., as .ci/run does)")
     return None
+
+
+def _xcb_libraries_missing() -> list[str]:
+    """The libraries Qt's xcb plugin needs that this machine lacks: those ``ldd`` does not find for the plugin, and
+    libxcb-cursor, which Qt 6.5 and later load only when the plugin starts."""
+    import ctypes.util
+
+    import PySide6
+
+    plugin = Path(PySide6.__file__).parent / "Qt" / "plugins" / "platforms" / "libqxcb.so"
+    missing = [] if ctypes.util.find_library("xcb-cursor") else ["libxcb-cursor.so.0"]
+    if plugin.is_file() and shutil.which("ldd"):
+        listed = subprocess.run(["ldd", str(plugin)], capture_output=True, text=True).stdout
+        missing += sorted({line.split()[0] for line in listed.splitlines() if "not found" in line})
+    return missing
 
 
 @pytest.mark.skipif(_gui_missing() is not None, reason=_gui_missing() or "")
