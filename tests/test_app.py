@@ -10,6 +10,7 @@ import signal
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -115,49 +116,51 @@ def _wait_for_answer(runs, run_id: str, timeout: float = 120.0):
     raise AssertionError(f"run {run_id} gave no answer in {timeout} s")
 
 
-def test_two_runs_at_once_each_get_their_own_answer_and_a_cancelled_one_leaves_no_process(fmu_path):
+@pytest.fixture
+def runs(fmu_path: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch):
+    """The app's runs, with this test's tmp_path as the temporary folder; closed, they must have left nothing in it
+    but multiprocessing's own folder (pymp-..., the fork server's socket, which only a normal exit of the process
+    removes and an xdist worker ends with os._exit: pytest_unconfigure)."""
+    from double_pendulum.app.worker import Runs
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    runs = Runs(fmu_path)
+    yield runs
+    runs.close()
+    assert sorted(p.name for p in tmp_path.iterdir() if not p.name.startswith("pymp-")) == []
+
+
+def test_two_runs_at_once_each_get_their_own_answer_and_a_cancelled_one_leaves_no_process(runs):
     """Two tabs' runs in flight together come back with their own start's result; a long run cancelled ends its
     process at once and is forgotten (a poll of it answers None)."""
-    from double_pendulum.app.worker import Runs
-
-    runs = Runs(fmu_path)
-    try:
-        long = runs.start("case", {"phi1_0": 2.0, "solver": "dop853", "rtol": 1e-12}, 3600.0, 0.01)
-        first = runs.start("case", {"phi1_0": 0.1, "phi2_0": 0.1}, 2.0, 0.01)
-        second = runs.start("case", {"phi1_0": -0.1, "phi2_0": -0.1}, 2.0, 0.01)
-        process = runs.jobs[long].process
-        deadline = time.monotonic() + 60
-        while runs.poll(long)[0] == 0.0 and time.monotonic() < deadline:
-            time.sleep(0.05)
-        assert process.is_alive() and runs.poll(long)[1] is None, "the hour-long run should be running"
-        runs.cancel(long)
-        assert not process.is_alive() and runs.poll(long) is None
-        a, b = _wait_for_answer(runs, first), _wait_for_answer(runs, second)
-        assert a["message"] is None and b["message"] is None
-        assert a["columns"]["phi1"][0] == pytest.approx(0.1) and b["columns"]["phi1"][0] == pytest.approx(-0.1)
-        assert a["columns"]["phi1"][-1] == pytest.approx(-b["columns"]["phi1"][-1], rel=1e-9)  # mirror images
-    finally:
-        runs.close()
+    long = runs.start("case", {"phi1_0": 2.0, "solver": "dop853", "rtol": 1e-12}, 3600.0, 0.01)
+    first = runs.start("case", {"phi1_0": 0.1, "phi2_0": 0.1}, 2.0, 0.01)
+    second = runs.start("case", {"phi1_0": -0.1, "phi2_0": -0.1}, 2.0, 0.01)
+    process = runs.jobs[long].process
+    deadline = time.monotonic() + 60
+    while runs.poll(long)[0] == 0.0 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert process.is_alive() and runs.poll(long)[1] is None, "the hour-long run should be running"
+    runs.cancel(long)
+    assert not process.is_alive() and runs.poll(long) is None
+    a, b = _wait_for_answer(runs, first), _wait_for_answer(runs, second)
+    assert a["message"] is None and b["message"] is None
+    assert a["columns"]["phi1"][0] == pytest.approx(0.1) and b["columns"]["phi1"][0] == pytest.approx(-0.1)
+    assert a["columns"]["phi1"][-1] == pytest.approx(-b["columns"]["phi1"][-1], rel=1e-9)  # mirror images
 
 
-def test_a_run_whose_process_dies_answers_so_and_does_not_raise(fmu_path):
+def test_a_run_whose_process_dies_answers_so_and_does_not_raise(runs):
     """A run's process killed from outside (out of memory, a signal) is reported as ended without an answer."""
-    from double_pendulum.app.worker import Runs
-
-    runs = Runs(fmu_path)
-    try:
-        run_id = runs.start("case", {"phi1_0": 2.0, "solver": "dop853", "rtol": 1e-12}, 3600.0, 0.01)
-        process = runs.jobs[run_id].process
-        deadline = time.monotonic() + 60
-        while runs.poll(run_id)[0] == 0.0 and time.monotonic() < deadline:
-            time.sleep(0.05)
-        process.kill()
-        process.join()
-        answer = _wait_for_answer(runs, run_id)
-        assert answer["columns"] is None and answer["message"] == (
-            f"the run's process ended without an answer (exit code {-signal.SIGKILL})")
-    finally:
-        runs.close()
+    run_id = runs.start("case", {"phi1_0": 2.0, "solver": "dop853", "rtol": 1e-12}, 3600.0, 0.01)
+    process = runs.jobs[run_id].process
+    deadline = time.monotonic() + 60
+    while runs.poll(run_id)[0] == 0.0 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.kill()
+    process.join()
+    answer = _wait_for_answer(runs, run_id)
+    assert answer["columns"] is None and answer["message"] == (
+        f"the run's process ended without an answer (exit code {-signal.SIGKILL})")
 
 
 @needs_browser
