@@ -17,7 +17,6 @@ import numpy as np
 import pytest
 
 from double_pendulum.fmu.build import loader
-from double_pendulum.fmu.build.systems import build_all
 
 HOST_SOURCE = Path(__file__).parent / "c_host" / "fmi2_host.c"
 STEPS, STEP_SIZE = 1000, 1e-3
@@ -65,11 +64,11 @@ def host(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest.fixture(scope="module")
-def fmus(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    """Every FMU ``double-pendulum build`` writes, by path in the build folder (``fmi3/DoublePendulum.fmu``)."""
-    folder = tmp_path_factory.mktemp("built")
-    return {str(path.relative_to(folder)): path for path in build_all(folder / "DoublePendulum.fmu")
-            if path.suffix == ".fmu"}
+def fmus(built_fmus: list[Path]) -> dict[str, Path]:
+    """Every FMU ``double-pendulum build`` writes (the session's build), by path in the build folder
+    (``fmi3/DoublePendulum.fmu``)."""
+    folder = built_fmus[0].parent
+    return {str(path.relative_to(folder)): path for path in built_fmus if path.suffix == ".fmu"}
 
 
 @pytest.fixture(scope="module")
