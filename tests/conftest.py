@@ -73,6 +73,35 @@ def fmu3_path(built_fmus: list[Path]) -> Path:
     return built_fmus[-1]
 
 
+@pytest.fixture(scope="session")
+def cross_check_tree(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int, str]:
+    """``double-pendulum cross-check DIR`` run once for the session (shared by the xdist workers:
+    :func:`session_shared`) into a folder that already holds another vendor's files and a stale folder of ours:
+    DIR, the exit status and what the command printed. Its FMUs, the reference cases' freshly built, are read by
+    tests/test_cross_check.py and tests/test_reference_results.py; no test writes into DIR."""
+    import io
+
+    from double_pendulum import __version__
+    from double_pendulum.cli import main
+    from double_pendulum.fmu.crosscheck.tree import PLATFORM, TOOL
+
+    def run(folder: Path) -> None:
+        root = folder / "tree"
+        other = root / "fmus" / "2.0" / "cs" / PLATFORM / "OtherTool" / "1.0" / "Model"
+        other.mkdir(parents=True)
+        (other / "keep.txt").write_text("another vendor's file")
+        (other / "notCompliantWithLatestRules").write_text("")  # what fmpy's validator then skips
+        (root / "fmus" / "2.0" / "cs" / PLATFORM / TOOL / __version__ / "Removed").mkdir(parents=True)
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            code = main(["cross-check", str(root)])
+        (folder / "command.json").write_text(json.dumps({"code": code, "out": out.getvalue()}))
+
+    folder = session_shared(tmp_path_factory, "cross_check", run)
+    command = json.loads((folder / "command.json").read_text())
+    return folder / "tree", command["code"], command["out"]
+
+
 @pytest.fixture(scope="session", autouse=True)
 def close_kept_runners() -> Iterator[None]:
     """At the end of each test process, close the FMU runners the sweeps keep per process (each holds an extracted
