@@ -180,6 +180,30 @@ def quick_scenario(results: Path, name: str) -> tuple[Path, dict]:
     return folder, json.loads((folder / "summary.json").read_text())
 
 
+# --- the order the xdist workers take the modules in -----------------------------------------------------------
+#
+# Each module runs on one worker (--dist loadscope), handed out in collection order (--no-loadscope-reorder), a
+# module to whichever worker is free: the longest first, so that no long module is left for the end while the
+# other worker idles. LONGEST_FIRST are the modules of the most seconds (tests and module fixtures, measured on
+# 2 workers, issue 36); the one second does not need the session's FMUs, so its worker works while the first
+# builds them (conftest's built_fmus; the quick run needs them too). The rest follow by their number of tests,
+# as pytest-xdist orders them itself, within a module the tests keep their order.
+LONGEST_FIRST = (
+    "test_host_hygiene", "test_loss_noise", "test_reports", "test_guard", "test_loss_identification",
+    "test_python_host", "test_c_host", "test_cli", "test_cross_check", "test_state_matrix", "test_summary_types",
+    "test_reference_results", "test_app", "test_page", "test_scenario_pool", "test_fmpy_tools", "test_bad_input",
+    "test_chaos", "test_energy_budget",
+)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
+    counts: dict[Path, int] = {}
+    for item in items:
+        counts[item.path] = counts.get(item.path, 0) + 1
+    items.sort(key=lambda item: (rank.get(item.path.stem, len(rank)), -counts[item.path], str(item.path)))
+
+
 # --- $TMPDIR: the suite leaves it as it found it -------------------------------------------------------------
 #
 # The controlling process gives the whole session (its workers inherit the environment) a $TMPDIR of its own, a
