@@ -7,7 +7,7 @@ import json
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -20,19 +20,86 @@ REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
 
 
+def session_shared(tmp_path_factory: pytest.TempPathFactory, name: str, make: Callable[[Path], object]) -> Path:
+    """Folder ``name`` of the whole session, made and filled once by ``make(folder)``.
+
+    With pytest-xdist the workers share it (the xdist documentation's recipe): the first worker that needs it
+    fills it under a file lock in the session's common temporary folder (the parent of each worker's own), the
+    others wait for the lock and read it. A ``make`` that raises leaves no marker, so the next worker tries again.
+    """
+    import fcntl
+
+    base = tmp_path_factory.getbasetemp()
+    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base  # one folder per session
+    folder, done = shared / name, shared / f"{name}.done"
+    with open(shared / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not done.is_file():
+            shutil.rmtree(folder, ignore_errors=True)  # what a failed make left
+            make(folder)
+            done.write_text("")
+    return folder
+
+
+BUILT_FMUS = ("DoublePendulum.fmu", "Suspension.fmu", "PendulumOnSuspension.ssp", "PendulumOnSuspension.fmu",
+              "fmi3/DoublePendulum.fmu")
+"""What :func:`~double_pendulum.fmu.build.systems.build_all` writes, relative to its folder, in its order."""
+
+
 @pytest.fixture(scope="session")
-def fmu_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
+def built_fmus(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+    """Every FMU ``double-pendulum build`` writes (:data:`BUILT_FMUS`), freshly built once for the whole session
+    (shared by the xdist workers: :func:`session_shared`). Tests read them; none writes into their folder."""
+    def build(folder: Path) -> None:
+        folder.mkdir()
+        built = build_all(folder / "DoublePendulum.fmu")
+        assert [str(p.relative_to(folder)) for p in built] == list(BUILT_FMUS), built
+
+    folder = session_shared(tmp_path_factory, "fmu", build)
+    return [folder / name for name in BUILT_FMUS]
+
+
+@pytest.fixture(scope="session")
+def fmu_path(built_fmus: list[Path]) -> Path:
     """A freshly built DoublePendulum.fmu, with the other FMUs and the coupled system next to it, as ``run``
     wants them (built once per session)."""
-    return build_all(tmp_path_factory.mktemp("fmu") / "DoublePendulum.fmu")[0]
+    return built_fmus[0]
 
 
 @pytest.fixture(scope="session")
-def fmu3_path(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """A freshly built FMI 3.0 DoublePendulum.fmu, Model Exchange and Co-Simulation (built once per session)."""
-    from double_pendulum.fmu.build.fmi3 import build_fmu3
+def fmu3_path(built_fmus: list[Path]) -> Path:
+    """A freshly built FMI 3.0 DoublePendulum.fmu, Model Exchange and Co-Simulation (built once per session, by
+    ``build_all`` into ``fmi3/`` beside the FMI 2.0 one, as ``double-pendulum build`` puts it)."""
+    return built_fmus[-1]
 
-    return build_fmu3(tmp_path_factory.mktemp("fmu3") / "DoublePendulum.fmu")
+
+@pytest.fixture(scope="session")
+def cross_check_tree(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int, str]:
+    """``double-pendulum cross-check DIR`` run once for the session (shared by the xdist workers:
+    :func:`session_shared`) into a folder that already holds another vendor's files and a stale folder of ours:
+    DIR, the exit status and what the command printed. Its FMUs, the reference cases' freshly built, are read by
+    tests/test_cross_check.py and tests/test_reference_results.py; no test writes into DIR."""
+    import io
+
+    from double_pendulum import __version__
+    from double_pendulum.cli import main
+    from double_pendulum.fmu.crosscheck.tree import PLATFORM, TOOL
+
+    def run(folder: Path) -> None:
+        root = folder / "tree"
+        other = root / "fmus" / "2.0" / "cs" / PLATFORM / "OtherTool" / "1.0" / "Model"
+        other.mkdir(parents=True)
+        (other / "keep.txt").write_text("another vendor's file")
+        (other / "notCompliantWithLatestRules").write_text("")  # what fmpy's validator then skips
+        (root / "fmus" / "2.0" / "cs" / PLATFORM / TOOL / __version__ / "Removed").mkdir(parents=True)
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            code = main(["cross-check", str(root)])
+        (folder / "command.json").write_text(json.dumps({"code": code, "out": out.getvalue()}))
+
+    folder = session_shared(tmp_path_factory, "cross_check", run)
+    command = json.loads((folder / "command.json").read_text())
+    return folder / "tree", command["code"], command["out"]
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -73,25 +140,18 @@ def quick_results(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory) -> P
     pytest-xdist the workers share one run: the first worker that needs it runs it under a file lock
     in the session's common temporary folder, the others wait and read it.
     """
-    import fcntl
-
     from double_pendulum.cli import main
 
-    base = tmp_path_factory.getbasetemp()
-    shared = base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base  # one folder per session
-    out, done = shared / "quick_results", shared / "quick_results.done"
-    with open(shared / "quick_results.lock", "w") as lock:
-        fcntl.flock(lock, fcntl.LOCK_EX)
-        if not done.is_file():
-            shutil.rmtree(out, ignore_errors=True)
-            tmpdir = shared / "quick_results.tmp"  # the run's $TMPDIR: what it leaves there is recorded
-            shutil.rmtree(tmpdir, ignore_errors=True)
-            tmpdir.mkdir()
-            with temporary_folder(tmpdir):
-                assert main(["run", "all", "--quick", "--fmu", str(fmu_path), "--out", str(out)]) == 0
-            (shared / "quick_results.leftovers").write_text("".join(f"{p.name}\n" for p in tmpdir.iterdir()))
-            done.write_text("")
-    return out
+    def run(out: Path) -> None:
+        shared = out.parent
+        tmpdir = shared / "quick_results.tmp"  # the run's $TMPDIR: what it leaves there is recorded
+        shutil.rmtree(tmpdir, ignore_errors=True)
+        tmpdir.mkdir()
+        with temporary_folder(tmpdir):
+            assert main(["run", "all", "--quick", "--fmu", str(fmu_path), "--out", str(out)]) == 0
+        (shared / "quick_results.leftovers").write_text("".join(f"{p.name}\n" for p in tmpdir.iterdir()))
+
+    return session_shared(tmp_path_factory, "quick_results", run)
 
 
 @contextlib.contextmanager
@@ -118,6 +178,30 @@ def quick_scenario(results: Path, name: str) -> tuple[Path, dict]:
     """The folder of scenario ``name`` in :func:`quick_results` and its summary."""
     folder = results / name
     return folder, json.loads((folder / "summary.json").read_text())
+
+
+# --- the order the xdist workers take the modules in -----------------------------------------------------------
+#
+# Each module runs on one worker (--dist loadscope), handed out in collection order (--no-loadscope-reorder), a
+# module to whichever worker is free: the longest first, so that no long module is left for the end while the
+# other worker idles. LONGEST_FIRST are the modules of the most seconds (tests and module fixtures, measured on
+# 2 workers, issue 36); the one second does not need the session's FMUs, so its worker works while the first
+# builds them (conftest's built_fmus; the quick run needs them too). The rest follow by their number of tests,
+# as pytest-xdist orders them itself, within a module the tests keep their order.
+LONGEST_FIRST = (
+    "test_host_hygiene", "test_loss_noise", "test_reports", "test_guard", "test_loss_identification",
+    "test_python_host", "test_c_host", "test_cli", "test_cross_check", "test_state_matrix", "test_summary_types",
+    "test_reference_results", "test_app", "test_page", "test_scenario_pool", "test_fmpy_tools", "test_bad_input",
+    "test_chaos", "test_energy_budget",
+)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    rank = {name: k for k, name in enumerate(LONGEST_FIRST)}
+    counts: dict[Path, int] = {}
+    for item in items:
+        counts[item.path] = counts.get(item.path, 0) + 1
+    items.sort(key=lambda item: (rank.get(item.path.stem, len(rank)), -counts[item.path], str(item.path)))
 
 
 # --- $TMPDIR: the suite leaves it as it found it -------------------------------------------------------------

@@ -26,22 +26,10 @@ needs_checker = pytest.mark.skipif(CHECKER is None, reason="the FMI Compliance C
 
 
 @pytest.fixture(scope="module")
-def tree(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int, str]:
-    """The tree as the command writes it (into a folder that already holds another vendor's files)."""
-    import contextlib
-    import io
-
-    root = tmp_path_factory.mktemp("xc")
-    other = root / "fmus" / "2.0" / "cs" / PLATFORM / "OtherTool" / "1.0" / "Model"
-    other.mkdir(parents=True)
-    (other / "keep.txt").write_text("another vendor's file")
-    (other / "notCompliantWithLatestRules").write_text("")  # what fmpy's validator then skips
-    stale = root / "fmus" / "2.0" / "cs" / PLATFORM / TOOL / __version__ / "Removed"
-    stale.mkdir(parents=True)
-    out = io.StringIO()
-    with contextlib.redirect_stdout(out):
-        code = main(["cross-check", str(root)])
-    return root, code, out.getvalue()
+def tree(cross_check_tree: tuple[Path, int, str]) -> tuple[Path, int, str]:
+    """The tree as the command writes it (into a folder that already holds another vendor's files): the session's
+    run of the command (conftest.py's ``cross_check_tree``, whose FMUs tests/test_reference_results.py runs too)."""
+    return cross_check_tree
 
 
 def test_the_command_writes_every_case_and_fmpys_validator_finds_no_problem(tree):

@@ -563,15 +563,18 @@ not_sanitized = pytest.mark.skipif(sanitize.ENABLED, reason="AddressSanitizer ke
 
 @pytest.mark.slow
 @not_sanitized
-def test_ten_thousand_instantiate_free_cycles_cost_no_memory_after_warm_up(hosts, extracted, tmp_path):
-    """10,000 instantiate/initialise/step/free cycles (the soak mode): resident memory grows by less than
-    0.2 KiB a cycle over the 8,000 after a warm-up of 2,000 (measured: 0 KiB; from cycle 500 on 0.04)."""
+def test_six_thousand_instantiate_free_cycles_cost_no_memory_after_warm_up(hosts, extracted, tmp_path):
+    """6,000 instantiate/initialise/step/free cycles (the soak mode): resident memory grows by less than
+    0.2 KiB a cycle over the 4,200 after a warm-up of 1,800 (the host reads it every 300 cycles; measured over
+    cycles 2,000-10,000: 0 KiB, from cycle 500 on 0.04). 6,000 where there were 10,000 (one of the suite's
+    longest tests): a leak at the limit still grows 840 KiB, 210 pages, over the 4,200; the defect the guard
+    removed leaked 70 KiB a cycle."""
     folder, description = extracted["fmi2"]
-    done = run(host_command(hosts[2], folder, description, 2, "soak", "10000"), tmp_path)
+    done = run(host_command(hosts[2], folder, description, 2, "soak", "6000"), tmp_path)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr
     rss = rss_figures(done.stdout)
-    slope = (rss[10000] - rss[2000]) / 8000
-    print(f"C host soak: {slope:.3f} KiB per cycle over cycles 2000-10000 ({rss[2000]} -> {rss[10000]} KiB)")
+    slope = (rss[6000] - rss[1800]) / 4200
+    print(f"C host soak: {slope:.3f} KiB per cycle over cycles 1800-6000 ({rss[1800]} -> {rss[6000]} KiB)")
     assert slope < 0.2, rss
 
 

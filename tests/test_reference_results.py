@@ -1,6 +1,7 @@
 """The committed reference results (data/reference/fmu/, double_pendulum.fmu.crosscheck.reference_cases): freshly built
-FMUs reproduce them in fmpy and in the project's C hosts (tests/c_host, no Python in them), and the
-committed inputs and options are what the case definitions write.
+FMUs (those of the session's ``double-pendulum cross-check`` tree, tests/conftest.py) reproduce them in fmpy and in
+the project's C hosts (tests/c_host, no Python in them), and the committed inputs and options are what the case
+definitions write.
 
 Stated tolerances, per output column, relative to the column's largest magnitude (at least 1):
 fmpy and the C hosts under Co-Simulation run the same FMU code on the same communication grid,
@@ -28,12 +29,12 @@ from double_pendulum.fmu.build import loader
 from double_pendulum.fmu.crosscheck.reference_cases import CASES, ReferenceCase, fmu_file, input_names
 from double_pendulum.fmu.crosscheck.reference_runs import (
     RECORD,
-    build_case_fmus,
     input_csv,
     opt_text,
     read_reference,
     reference_run,
 )
+from double_pendulum.fmu.crosscheck.tree import model_dir
 
 pytestmark = pytest.mark.filterwarnings("ignore:Please import:DeprecationWarning")  # fmpy's scipy.ndimage.filters
 REFERENCES = Path(str(data_path("reference/fmu")))
@@ -49,8 +50,12 @@ def case_id(case: ReferenceCase) -> str:
 
 
 @pytest.fixture(scope="module")
-def fmus(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    return build_case_fmus(tmp_path_factory.mktemp("cases"))
+def fmus(cross_check_tree: tuple[Path, int, str]) -> dict[str, Path]:
+    """The cases' FMUs (by :func:`fmu_file`), freshly built by the session's ``double-pendulum cross-check`` run
+    (conftest.py's ``cross_check_tree``: ``build_case_fmus``, one build for both modules), as its tree holds them."""
+    root, code, out = cross_check_tree
+    assert code == 0, out
+    return {fmu_file(case): model_dir(root, case) / f"{case.model}.fmu" for case in CASES}
 
 
 def deviation(result, reference, names) -> float:
