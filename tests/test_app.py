@@ -42,29 +42,35 @@ def test_the_form_refuses_a_value_out_of_range_or_not_a_number_with_the_reason()
 
 
 @pytest.fixture(scope="module")
-def app_url(fmu_path: Path):
+def app_url(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory):
+    """The app served by ``python -m double_pendulum.app.server`` on a free port: its address. What the server
+    prints goes to a file (a pipe nobody reads while the tests run would fill and stop the server)."""
     if NO_DASH:
         pytest.skip("Dash is not installed (pip install -e \".[app]\")")
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         port = s.getsockname()[1]
-    server = subprocess.Popen([sys.executable, "-m", "double_pendulum.app.server", "--port", str(port), "--fmu",
-                               str(fmu_path)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    printed = tmp_path_factory.mktemp("app") / "printed.txt"
+    with printed.open("w") as out:
+        server = subprocess.Popen([sys.executable, "-m", "double_pendulum.app.server", "--port", str(port), "--fmu",
+                                   str(fmu_path)], stdout=out, stderr=subprocess.STDOUT, text=True)
     try:
-        line = server.stdout.readline()
-        assert f"http://127.0.0.1:{port}/" in line, line
         deadline = time.monotonic() + 60
         while True:  # the address is printed before the server listens
             try:
                 socket.create_connection(("127.0.0.1", port), timeout=1).close()
                 break
             except OSError:
-                assert time.monotonic() < deadline and server.poll() is None, "the app did not start"
+                assert time.monotonic() < deadline and server.poll() is None, "the app did not start: " + (
+                    printed.read_text())
                 time.sleep(0.2)
+        assert f"open http://127.0.0.1:{port}/ in a browser" in printed.read_text().splitlines()[0]
         yield f"http://127.0.0.1:{port}/"
     finally:
         server.send_signal(signal.SIGINT)  # as Ctrl-C: the app ends its runs and its fork server cleans up
         server.wait(timeout=60)
+    text = printed.read_text()
+    assert text.rstrip().endswith("double-pendulum app: ended") and '"GET ' not in text and '"POST ' not in text, text
 
 
 @needs_browser
@@ -147,6 +153,15 @@ def test_two_runs_at_once_each_get_their_own_answer_and_a_cancelled_one_leaves_n
     assert a["message"] is None and b["message"] is None
     assert a["columns"]["phi1"][0] == pytest.approx(0.1) and b["columns"]["phi1"][0] == pytest.approx(-0.1)
     assert a["columns"]["phi1"][-1] == pytest.approx(-b["columns"]["phi1"][-1], rel=1e-9)  # mirror images
+
+
+def test_an_answer_is_given_as_often_as_asked_until_the_tab_collects_it(runs):
+    """A tab's timer asks again before the reply to its last request is in, and the browser keeps only the latest
+    reply (Dash drops a callback's overtaken requests): the answer must not be spent by a reply that is dropped."""
+    run_id = runs.start("case", {"phi1_0": 0.1}, 0.5, 0.01)
+    answer = _wait_for_answer(runs, run_id)
+    assert answer["message"] is None and runs.poll(run_id) == (1.0, answer)
+    assert runs.collect(run_id) is answer and runs.poll(run_id) is None and runs.collect(run_id) is None
 
 
 def test_a_run_whose_process_dies_answers_so_and_does_not_raise(runs):

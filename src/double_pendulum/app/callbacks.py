@@ -2,8 +2,9 @@
 
 One callback owns a tab's run (:func:`register`): a click on a run button checks the form (:func:`~.form.check_form`)
 and either writes each refusal under its field or starts the run (:class:`~.worker.Runs`) and keeps its id in the
-tab's ``job`` store; the tab's timer then asks after it until its answer comes (the FMU's message when the FMU
-stopped it), and ``cancel`` ends it. A second callback draws the answer; a third gives it as CSV.
+tab's ``job`` store; the tab's timer then asks after it until its answer is in, and ``cancel`` ends it. A second
+callback collects the answer (the FMU's message when the FMU stopped the run), a third draws it, a fourth gives it
+as CSV.
 """
 
 from __future__ import annotations
@@ -45,7 +46,7 @@ def register(app: Dash, runs: Runs) -> None:
     names = [f.name for f in NUMBER_FIELDS] + ["solver"]
 
     @app.callback(
-        Output("job", "data"), Output("result", "data"), Output("poll", "disabled"), Output("status", "children"),
+        Output("job", "data"), Output("ready", "data"), Output("poll", "disabled"), Output("status", "children"),
         *errors,
         Input("run", "n_clicks"), Input("run-twins", "n_clicks"), Input("run-measured", "n_clicks"),
         Input("cancel", "n_clicks"), Input("poll", "n_intervals"),
@@ -76,8 +77,10 @@ def register(app: Dash, runs: Runs) -> None:
             if answer is None:
                 return no_update, no_update, False, f"running: {100 * done:.0f} % of {job['stop_time']:g} s", \
                     *unchanged
-            result = {**job, **answer}
-            return None, result if answer.get("columns") else no_update, True, _answer_text(answer), *unchanged
+            # The timer stops and ``collect`` fetches the answer in a request of its own: a reply the browser drops
+            # because the timer's next request overtook it (Dash keeps only a callback's latest) is a small one,
+            # and the next tick says the same.
+            return no_update, job["id"], True, "the run is done: reading its answer", *unchanged
         if job:
             return no_update, no_update, False, "a run is still going: cancel it first", *unchanged
         checked = check_form(_form(list(values), pendulum, switches, suspension, solver))
@@ -89,6 +92,19 @@ def register(app: Dash, runs: Runs) -> None:
         job = {"id": run_id, "kind": kind, "start_values": checked.start_values, "stop_time": checked.stop_time,
                "fmu": str(runs.fmu)}
         return job, no_update, False, f"running: 0 % of {checked.stop_time:g} s", *messages
+
+    @app.callback(
+        Output("result", "data"), Output("job", "data", allow_duplicate=True),
+        Output("status", "children", allow_duplicate=True),
+        Input("ready", "data"), State("job", "data"), prevent_initial_call=True,
+    )
+    def collect(ready: str | None, job: dict[str, Any] | None) -> tuple:
+        if not ready or not job or job["id"] != ready:
+            return no_update, no_update, no_update
+        answer = runs.collect(ready)
+        if answer is None:  # collected by an earlier request of this tab
+            return no_update, no_update, no_update
+        return {**job, **answer} if answer.get("columns") else no_update, None, _answer_text(answer)
 
     graphs = ("angles", "budget", "path", "compare", "compare2")
 

@@ -95,6 +95,6 @@ def page() -> html.Div:
         html.P("Every run is the FMU DoublePendulum.fmu through fmpy, as the scenarios run it.",
                style={"color": "#555"}),
         html.Div([form_panel(), results_panel()], style={"display": "flex", "gap": "1.5rem", "flexWrap": "wrap"}),
-        dcc.Store(id="job"), dcc.Store(id="result"),
+        dcc.Store(id="job"), dcc.Store(id="ready"), dcc.Store(id="result"),
         dcc.Interval(id="poll", interval=POLL_MS, disabled=True),
     ], style={"fontFamily": "system-ui, sans-serif", "margin": "1rem"})

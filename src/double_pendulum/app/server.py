@@ -9,6 +9,7 @@ without them the command says so in one line.
 from __future__ import annotations
 
 import argparse
+import logging
 import signal
 import sys
 from pathlib import Path
@@ -62,13 +63,17 @@ def cmd_app(args: argparse.Namespace) -> int:
     app, runs = create_app(fmu)
     print(f"double-pendulum app: open http://{HOST}:{args.port}/ in a browser (Ctrl-C ends it)", flush=True)
     previous = signal.signal(signal.SIGTERM, _interrupt)  # `kill` ends it as Ctrl-C does: runs and files cleaned
+    # The server's log of every request (a tab asks for its run's progress ten times a second) would bury the
+    # address above; its warnings and errors still show.
+    logging.getLogger("werkzeug").setLevel(logging.WARNING)
     try:
         app.run(host=HOST, port=args.port, debug=False)
     except KeyboardInterrupt:
-        print("double-pendulum app: ended", file=sys.stderr)
+        pass
     finally:
         runs.close()
         signal.signal(signal.SIGTERM, previous)
+    print("double-pendulum app: ended", file=sys.stderr)
     return 0
 
 

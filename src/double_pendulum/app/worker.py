@@ -123,6 +123,8 @@ class _Progress:
 
 
 PROGRESS_EVERY_S = 0.05
+KEEP_ANSWER_S = 600.0
+"""How long [s] a run's answer waits to be collected before a later start forgets it."""
 
 
 def _child(kind: str, fmu: str, start_values: dict[str, Any], stop_time: float, output_interval: float,
@@ -146,6 +148,7 @@ class Job:
     receiver: Any
     progress: float = 0.0
     answer: dict[str, Any] | None = None
+    answered_at: float = math.inf  # monotonic time [s] the answer came (or the run ended without one)
 
     def poll(self) -> dict[str, Any] | None:
         """The run's answer once it has come (None while it runs); reads the progress sent so far."""
@@ -163,6 +166,8 @@ class Job:
                 self.process.join()
         if self.answer is None and not self.process.is_alive() and not self.receiver.poll():
             self.answer = self._ended()
+        if self.answer is not None and self.answered_at == math.inf:
+            self.answered_at = monotonic()
         return self.answer
 
     def _ended(self) -> dict[str, Any]:
@@ -196,7 +201,8 @@ class Runs:
         self.unzipdir = extract(str(self.fmu))
 
     def start(self, kind: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float) -> str:
-        """Start a run of ``kind`` (:data:`KINDS`); its id."""
+        """Start a run of ``kind`` (:data:`KINDS`); its id. Answers not collected :data:`KEEP_ANSWER_S` after they
+        came (a tab closed before it read its run's) are forgotten now."""
         receiver, sender = self.context.Pipe(duplex=False)
         process = self.context.Process(target=_child, args=(kind, self.unzipdir, dict(start_values), stop_time,
                                                            output_interval, sender), daemon=True)
@@ -204,20 +210,31 @@ class Runs:
         sender.close()
         run_id = uuid.uuid4().hex
         with self.lock:
+            now = monotonic()
+            for old in [k for k, job in self.jobs.items() if now - job.answered_at > KEEP_ANSWER_S]:
+                del self.jobs[old]
             self.jobs[run_id] = Job(kind, stop_time, process, receiver)
         return run_id
 
     def poll(self, run_id: str) -> tuple[float, dict[str, Any] | None] | None:
-        """How far the run is (0 to 1) and its answer once it has come (then it is forgotten here); None for a run
-        not known (its answer went to an earlier request, or the app was restarted)."""
+        """How far the run is (0 to 1) and its answer once it has come, as often as asked (a browser may drop the
+        reply to one request when it sends the next); None for a run not known (collected, cancelled, or the app
+        was restarted)."""
         with self.lock:
             job = self.jobs.get(run_id)
             if job is None:
                 return None
             answer = job.poll()
-            if answer is not None:
-                del self.jobs[run_id]
-            return min(1.0, job.progress / max(job.stop_time, 1e-12)), answer
+            return (1.0 if answer is not None else min(1.0, job.progress / max(job.stop_time, 1e-12))), answer
+
+    def collect(self, run_id: str) -> dict[str, Any] | None:
+        """The run's answer, which is then forgotten here; None while it runs or for a run not known."""
+        with self.lock:
+            job = self.jobs.get(run_id)
+            if job is None or job.poll() is None:
+                return None
+            del self.jobs[run_id]
+            return job.answer
 
     def cancel(self, run_id: str) -> None:
         with self.lock:
