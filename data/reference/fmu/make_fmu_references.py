@@ -1,7 +1,7 @@
 """Generate the committed reference results of the FMUs in ``data/reference/fmu/``.
 
-For every reference case (``double_pendulum.fmu.crosscheck.reference_cases``: the FMI 2.0 and FMI 3.0 FMUs, Co-Simulation
-and Model Exchange, the container) this builds the FMUs afresh, runs each case in fmpy at tight tolerance
+For every reference case (``double_pendulum.fmu.crosscheck.reference_cases``: the FMI 2.0 and FMI 3.0 FMUs,
+Co-Simulation and Model Exchange, the container) this builds the FMUs afresh, runs each case in fmpy at tight tolerance
 (the FMU's own integrator at rtol 1e-12, atol 1e-14; under Model Exchange fmpy's CVode at 1e-12) and writes
 
     <fmi_version>/<fmi_type>/<Model>/<Model>_ref.csv   the reference result (time first, at most 10 outputs)
