@@ -23,13 +23,15 @@ import multiprocessing
 import shutil
 import threading
 import uuid
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from time import monotonic
 from typing import Any
 
 KINDS = ("case", "twins", "measured")
+Progress = Callable[[float], None]
+"""What a run tells its progress to: the run's time [s]."""
 PRELOAD = ["numpy", "fmpy", "double_pendulum.app.worker", "double_pendulum.fmu.running.runner"]
 
 
@@ -38,14 +40,14 @@ def _columns(result: Any) -> dict[str, list[float]]:
 
 
 def run_case(fmu: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float,
-             progress: Any = None) -> dict[str, Any]:
-    """One run of the FMU: its columns (every output), or the FMU's message and the rows before it. ``progress``
-    (a shared double) follows the run's time [s]."""
+             progress: Progress | None = None) -> dict[str, Any]:
+    """One run of the FMU (an FMU file or its extracted folder): its columns (every output), or the FMU's message
+    and the rows before it. ``progress`` is told the run's time [s] after each step."""
     from ..fmu.running.runner import FmuRunError, FmuRunner
 
     def step_finished(time: float, recorder: Any) -> bool:
         if progress is not None:
-            progress.value = time
+            progress(time)
         return True
 
     with FmuRunner(fmu, reuse_instance=False) as runner:
@@ -60,7 +62,7 @@ def run_case(fmu: str, start_values: Mapping[str, Any], stop_time: float, output
 
 
 def run_twins(fmu: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float,
-              progress: Any = None) -> dict[str, Any]:
+              progress: Progress | None = None) -> dict[str, Any]:
     """The case and its twin, ``phi1_0`` a hair larger (``free_swing``'s nudge)."""
     from double_pendulum.scenarios.free_swing import NUDGE_RAD
 
@@ -73,7 +75,7 @@ def run_twins(fmu: str, start_values: Mapping[str, Any], stop_time: float, outpu
 
 
 def run_measured(fmu: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float,
-                 progress: Any = None) -> dict[str, Any]:
+                 progress: Progress | None = None) -> dict[str, Any]:
     """The seed's start with the fitted losses against the camera's track (``measured_vs_sim``'s run
     ``seed_start_identified``), over at most ``stop_time`` [s] of the record: the paths table of
     :func:`~double_pendulum.analysis.prediction.paths.paths_table` and the losses' values."""
@@ -94,32 +96,27 @@ def run_measured(fmu: str, start_values: Mapping[str, Any], stop_time: float, ou
                              frames)
     table = paths_table(rec, i0, frames, prediction)
     if progress is not None:
-        progress.value = stop_time
+        progress(stop_time)
     return {"columns": _columns(table), "message": None, "losses": losses.losses, "t0": float(rec.t[i0])}
 
 
 RUNS = {"case": run_case, "twins": run_twins, "measured": run_measured}
 
 
-class _Progress:
-    """A run's time [s] (``value``, as the runs set it), sent to the app through the run's pipe at most every
-    :data:`PROGRESS_EVERY_S` of wall time. A pipe, not shared memory: a run's process owns nothing that outlives it
-    (multiprocessing's shared values can need a temporary folder that only a normal exit of the app removes)."""
+def _progress_through(sender: Any) -> Progress:
+    """A run's progress, sent to the app through the run's pipe at most every :data:`PROGRESS_EVERY_S` of wall
+    time. A pipe, not shared memory: a run's process owns nothing that outlives it (multiprocessing's shared values
+    can need a temporary folder that only a normal exit of the app removes)."""
+    sent_at = -math.inf
 
-    def __init__(self, sender: Any) -> None:
-        self.sender, self._value, self._sent_at = sender, 0.0, -math.inf
-
-    @property
-    def value(self) -> float:
-        return self._value
-
-    @value.setter
-    def value(self, time: float) -> None:
-        self._value = time
+    def report(time: float) -> None:
+        nonlocal sent_at
         now = monotonic()
-        if now - self._sent_at >= PROGRESS_EVERY_S:
-            self.sender.send(("progress", time))
-            self._sent_at = now
+        if now - sent_at >= PROGRESS_EVERY_S:
+            sender.send(("progress", time))
+            sent_at = now
+
+    return report
 
 
 PROGRESS_EVERY_S = 0.05
@@ -130,7 +127,7 @@ KEEP_ANSWER_S = 600.0
 def _child(kind: str, fmu: str, start_values: dict[str, Any], stop_time: float, output_interval: float,
            sender: Any) -> None:
     try:
-        answer = RUNS[kind](fmu, start_values, stop_time, output_interval, _Progress(sender))
+        answer = RUNS[kind](fmu, start_values, stop_time, output_interval, _progress_through(sender))
     except Exception as error:  # the run's own failure, shown in the app
         answer = {"columns": None, "message": f"{type(error).__name__}: {error}"}
     sender.send(("answer", answer))
