@@ -222,9 +222,18 @@ def pytest_configure(config: pytest.Config) -> None:
         return
     outer = tempfile.gettempdir()
     folder = Path(tempfile.mkdtemp(prefix="double-pendulum-tests-", dir=outer))
-    _SESSION_TMP.update(folder=folder, saved=os.environ.get("TMPDIR"), saved_root=os.environ.get(TEMPROOT))
+    cache = Path(tempfile.mkdtemp(prefix="double-pendulum-tests-cache-", dir=outer))
+    _SESSION_TMP.update(folder=folder, cache=cache, saved=os.environ.get("TMPDIR"),
+                        saved_root=os.environ.get(TEMPROOT), saved_cache=os.environ.get(CACHE))
     os.environ.setdefault(TEMPROOT, outer)
     os.environ["TMPDIR"], tempfile.tempdir = str(folder), None
+    os.environ[CACHE] = str(cache)
+
+
+CACHE = "DOUBLE_PENDULUM_CACHE"
+"""The scenarios' result cache (``runs.result_cache``, ``analysis.solvers.reference``): one empty folder for the
+session, shared by its workers and removed at its end, so that a run of the tests computes what a fresh clone
+computes, whatever a working copy's ``.cache/`` holds, and writes nothing there."""
 
 
 TEMPROOT = "PYTEST_DEBUG_TEMPROOT"
@@ -252,7 +261,9 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     if isinstance(folder, Path) and not hasattr(session.config, "workerinput"):
         left = session_leftovers(folder) if folder.is_dir() else []
         shutil.rmtree(folder, ignore_errors=True)
-        for name, saved in (("TMPDIR", _SESSION_TMP["saved"]), (TEMPROOT, _SESSION_TMP["saved_root"])):
+        shutil.rmtree(str(_SESSION_TMP["cache"]), ignore_errors=True)
+        for name, saved in (("TMPDIR", _SESSION_TMP["saved"]), (TEMPROOT, _SESSION_TMP["saved_root"]),
+                            (CACHE, _SESSION_TMP["saved_cache"])):
             if saved is None:
                 os.environ.pop(name, None)
             else:
