@@ -15,6 +15,7 @@ import sanitize
 
 from double_pendulum.fmu.build.systems import build_all
 from double_pendulum.fmu.running.runner import FmuRunner
+from double_pendulum.runs.result_cache import CACHE_ENV
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
@@ -224,16 +225,13 @@ def pytest_configure(config: pytest.Config) -> None:
     folder = Path(tempfile.mkdtemp(prefix="double-pendulum-tests-", dir=outer))
     cache = Path(tempfile.mkdtemp(prefix="double-pendulum-tests-cache-", dir=outer))
     _SESSION_TMP.update(folder=folder, cache=cache, saved=os.environ.get("TMPDIR"),
-                        saved_root=os.environ.get(TEMPROOT), saved_cache=os.environ.get(CACHE))
+                        saved_root=os.environ.get(TEMPROOT), saved_cache=os.environ.get(CACHE_ENV))
     os.environ.setdefault(TEMPROOT, outer)
     os.environ["TMPDIR"], tempfile.tempdir = str(folder), None
-    os.environ[CACHE] = str(cache)
-
-
-CACHE = "DOUBLE_PENDULUM_CACHE"
-"""The scenarios' result cache (``runs.result_cache``, ``analysis.solvers.reference``): one empty folder for the
-session, shared by its workers and removed at its end, so that a run of the tests computes what a fresh clone
-computes, whatever a working copy's ``.cache/`` holds, and writes nothing there."""
+    # The scenarios' result cache (runs.result_cache, read by analysis.solvers.reference too): one empty folder for
+    # the session, shared by its workers and removed at its end, so that a run of the tests computes what a fresh
+    # clone computes, whatever a working copy's .cache/ holds, and writes nothing there.
+    os.environ[CACHE_ENV] = str(cache)
 
 
 TEMPROOT = "PYTEST_DEBUG_TEMPROOT"
@@ -263,7 +261,7 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
         shutil.rmtree(folder, ignore_errors=True)
         shutil.rmtree(str(_SESSION_TMP["cache"]), ignore_errors=True)
         for name, saved in (("TMPDIR", _SESSION_TMP["saved"]), (TEMPROOT, _SESSION_TMP["saved_root"]),
-                            (CACHE, _SESSION_TMP["saved_cache"])):
+                            (CACHE_ENV, _SESSION_TMP["saved_cache"])):
             if saved is None:
                 os.environ.pop(name, None)
             else:
