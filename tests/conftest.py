@@ -13,7 +13,6 @@ from pathlib import Path
 import pytest
 import sanitize
 
-from double_pendulum.fmu.build.systems import build_all
 from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.runs.result_cache import CACHE_ENV
 
@@ -48,16 +47,33 @@ BUILT_FMUS = ("DoublePendulum.fmu", "Suspension.fmu", "PendulumOnSuspension.ssp"
 
 
 @pytest.fixture(scope="session")
-def built_fmus(tmp_path_factory: pytest.TempPathFactory) -> list[Path]:
+def built_fmus(built_by_the_command: tuple[Path, int, str]) -> list[Path]:
     """Every FMU ``double-pendulum build`` writes (:data:`BUILT_FMUS`), freshly built once for the whole session
-    (shared by the xdist workers: :func:`session_shared`). Tests read them; none writes into their folder."""
-    def build(folder: Path) -> None:
-        folder.mkdir()
-        built = build_all(folder / "DoublePendulum.fmu")
-        assert [str(p.relative_to(folder)) for p in built] == list(BUILT_FMUS), built
-
-    folder = session_shared(tmp_path_factory, "fmu", build)
+    by that command (:func:`built_by_the_command`). Tests read them; none writes into their folder."""
+    folder, code, _ = built_by_the_command
+    assert code == 0, built_by_the_command
     return [folder / name for name in BUILT_FMUS]
+
+
+@pytest.fixture(scope="session")
+def built_by_the_command(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, int, str]:
+    """``double-pendulum build -o FOLDER/DoublePendulum.fmu`` run once for the session (shared by the xdist workers:
+    :func:`session_shared`), FOLDER not there before: FOLDER, the exit status and what the command printed.
+    tests/test_cli.py checks the command by them; the other tests take the FMUs (:func:`built_fmus`)."""
+    import io
+
+    from double_pendulum.cli import main
+
+    def build(record: Path) -> None:
+        record.mkdir()
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            code = main(["build", "-o", str(record / "fmu" / "DoublePendulum.fmu")])
+        (record / "command.json").write_text(json.dumps({"code": code, "out": out.getvalue()}))
+
+    record = session_shared(tmp_path_factory, "build_command", build)
+    command = json.loads((record / "command.json").read_text())
+    return record / "fmu", command["code"], command["out"]
 
 
 @pytest.fixture(scope="session")

@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import quick_run_leftovers, quick_scenario
+from conftest import BUILT_FMUS, quick_run_leftovers, quick_scenario
 from double_pendulum.scenarios import SCENARIOS
 
 import double_pendulum
@@ -24,13 +24,20 @@ def test_list_names_the_scenarios(capsys):
     assert "free_swing" in capsys.readouterr().out
 
 
-def test_build_writes_the_fmu(tmp_path):
-    target = tmp_path / "out" / "X.fmu"
-    assert main(["build", "-o", str(target)]) == 0
+def test_build_writes_the_fmu(built_by_the_command):
+    """``double-pendulum build -o FOLDER/DoublePendulum.fmu`` into a folder not there before (the session's build,
+    tests/conftest.py) exits 0, says what it writes, and writes every FMU there, each one it names."""
+    folder, code, out = built_by_the_command
+    assert code == 0, out
+    target = folder / "DoublePendulum.fmu"
     assert target.is_file()
     assert (target.parent / "Suspension.fmu").is_file()  # every FMU, next to DoublePendulum
     assert (target.parent / "PendulumOnSuspension.ssp").is_file()  # and the coupled system
     assert (target.parent / "PendulumOnSuspension.fmu").is_file()
+    named = [Path(line.removeprefix("built ")) for line in out.splitlines() if line.startswith("built ")]
+    assert out.startswith(f"building the FMUs next to {target} ...")
+    assert [path.relative_to(folder).as_posix() for path in named] == list(BUILT_FMUS)
+    assert all(path.is_file() for path in named)
 
 
 def test_run_free_swing_writes_csv_plots_and_summary(fmu_path, tmp_path):
