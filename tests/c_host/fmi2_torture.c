@@ -12,8 +12,9 @@
  *   threads N ROUNDS  N threads at once instantiate, set a start value, run 20 steps, read phi1 and
  *                     free, ROUNDS times; then the same sequentially; print "threads-created K of M" and
  *                     "threads-identical 1" if every result equals the sequential one bit for bit
- *   soak N            N instantiate/initialise/step/free cycles; print "rss CYCLE KIB" every N/20 cycles
- *   reload N          N cycles of dlopen, instantiate, free, dlclose; "rss CYCLE KIB" as soak (and at 50)
+ *   soak N [EVERY]    N instantiate/initialise/step/free cycles; print "rss CYCLE KIB" every EVERY cycles
+ *                     (default N/20)
+ *   reload N [EVERY]  N cycles of dlopen, instantiate, free, dlclose; "rss CYCLE KIB" as soak (and at 50)
  *   matrix            every FMI function with valid arguments in every state a fixed call sequence reaches,
  *                     each on a fresh instance: "matrix STATE FUNCTION STATUS" and its log lines
  *   neighbour DIR2 IDENTIFIER2 GUID2
@@ -1230,8 +1231,13 @@ static long rss_kib(void) {
     return resident * (sysconf(_SC_PAGESIZE) / 1024);
 }
 
-static void run_soak(int cycles) {
-    int every = cycles >= 20 ? cycles / 20 : 1;
+/* Cycles between "rss" lines: `every` if given (> 0), else N/20. */
+static int rss_every(int cycles, int every) {
+    return every > 0 ? every : cycles >= 20 ? cycles / 20 : 1;
+}
+
+static void run_soak(int cycles, int every) {
+    every = rss_every(cycles, every);
     for (int k = 1; k <= cycles; k++) {
         fmi2Component c = initialised();
         if (!c) {
@@ -1247,9 +1253,9 @@ static void run_soak(int cycles) {
 }
 
 /* N cycles of dlopen, fmi2Instantiate, fmi2FreeInstance, dlclose of the FMU's binary at `path` (the host
- * holds no other handle on it); print "rss CYCLE KIB" every N/20 cycles (and at cycle 50). */
-static void run_reload(const char *path, int cycles) {
-    int every = cycles >= 20 ? cycles / 20 : 1;
+ * holds no other handle on it); print "rss CYCLE KIB" every `every` cycles (rss_every) and at cycle 50. */
+static void run_reload(const char *path, int cycles, int every) {
+    every = rss_every(cycles, every);
     for (int k = 1; k <= cycles; k++) {
         void *library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
         if (!library) {
@@ -1335,12 +1341,12 @@ int main(int argc, char **argv) {
     const char *mode = argv[k];
     if (strcmp(mode, "probes") == 0) run_probes(k + 1 < argc ? argv[k + 1] : NULL);
     else if (strcmp(mode, "threads") == 0 && k + 2 < argc) run_threads(atoi(argv[k + 1]), atoi(argv[k + 2]));
-    else if (strcmp(mode, "soak") == 0 && k + 1 < argc) run_soak(atoi(argv[k + 1]));
+    else if (strcmp(mode, "soak") == 0 && k + 1 < argc) run_soak(atoi(argv[k + 1]), k + 2 < argc ? atoi(argv[k + 2]) : 0);
     else if (strcmp(mode, "matrix") == 0) run_matrix();
     else if (strcmp(mode, "reload") == 0 && k + 1 < argc) {
         dlclose(library); /* the cycles' handles are the only ones */
         library = NULL;
-        run_reload(path, atoi(argv[k + 1]));
+        run_reload(path, atoi(argv[k + 1]), k + 2 < argc ? atoi(argv[k + 2]) : 0);
     }
     else if (strcmp(mode, "neighbour") == 0 && k + 3 < argc) {
         thread_case before = {.start = 1.3}, after = {.start = 1.3};
