@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from host_binaries import compiled_host
 
 from double_pendulum.fmu.build import loader
 
-HOST_SOURCE = Path(__file__).parent / "c_host" / "fmi2_host.c"
 STEPS, STEP_SIZE = 1000, 1e-3
 RUNS = 10  # C-host runs of each FMU
 
@@ -57,11 +57,8 @@ pytestmark = [
 
 @pytest.fixture(scope="module")
 def host(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The C host, compiled for this test session."""
-    path = tmp_path_factory.mktemp("c_host") / "fmi2_host"
-    command = [*loader.c_compiler(), "-O2", f"-I{loader.fmi_headers()}", "-o", str(path), str(HOST_SOURCE), "-ldl"]
-    subprocess.run(command, check=True, capture_output=True)
-    return path
+    """The C host (tests/c_host/fmi2_host.c), compiled once for the test session (host_binaries)."""
+    return compiled_host(tmp_path_factory, "fmi2_host")
 
 
 @pytest.fixture(scope="module")
@@ -213,7 +210,6 @@ def test_an_interpreter_with_nothing_installed_runs_the_fmu(host, extracted, tmp
 
 # ---------------------------------------------------------------------------------------------- FMI 3.0
 FMI3 = "fmi3/DoublePendulum.fmu"
-FMI3_HOST_SOURCE = Path(__file__).parent / "c_host" / "fmi3_host.c"
 # Model Exchange case: CASES' pendulum with constant torques (held the same way by the co-simulation's hold
 # and by continuous inputs; a constant pivot acceleration is not: the hold ramps the pivot velocity in each step)
 ME_INPUTS = {"tau1": 0.02, "tau2": -0.01}
@@ -221,12 +217,9 @@ ME_INPUTS = {"tau1": 0.02, "tau2": -0.01}
 
 @pytest.fixture(scope="module")
 def host3(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The FMI 3 C host (Model Exchange with Euler or RK4 and FMI 3 event handling, or Co-Simulation)."""
-    path = tmp_path_factory.mktemp("c_host3") / "fmi3_host"
-    command = [*loader.c_compiler(), "-O2", f"-I{loader.fmi_headers()}", "-o", str(path), str(FMI3_HOST_SOURCE),
-               "-ldl", "-lm"]
-    subprocess.run(command, check=True, capture_output=True)
-    return path
+    """The FMI 3 C host (tests/c_host/fmi3_host.c: Model Exchange with Euler or RK4 and FMI 3 event handling, or
+    Co-Simulation), compiled once for the test session (host_binaries)."""
+    return compiled_host(tmp_path_factory, "fmi3_host")
 
 
 def run_host3(host: Path, folder: Path, description, method: str, args: list[str], env: dict[str, str], cwd: Path):

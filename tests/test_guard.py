@@ -20,10 +20,10 @@ from pathlib import Path
 import pytest
 import sanitize
 from foreign_fmu import RATE, START, build_foreign_fmu
+from host_binaries import compiled_host
 
 from double_pendulum.fmu.build import loader
 
-HOSTS = Path(__file__).parent / "c_host"
 NO_LOG = ""  # expected fragment: the call logs nothing
 # Instantiate/free cycles of the soak, one run (the fixture soak) for both soak tests: fewer under the sanitizers
 # (about 2.5 ms a cycle there); the host reports resident memory every SOAK_EVERY cycles.
@@ -208,19 +208,11 @@ PROBE_LINES = {
 }
 
 
-def compile_host(name: str, folder: Path) -> Path:
-    path = folder / name
-    command = [*loader.c_compiler(), *sanitize.host_flags(), f"-I{loader.fmi_headers()}", "-o", str(path),
-               str(HOSTS / f"{name}.c"),
-               "-ldl", "-lpthread", "-lm"]
-    subprocess.run(command, check=True, capture_output=True)
-    return path
-
-
 @pytest.fixture(scope="module")
-def hosts(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
-    folder = tmp_path_factory.mktemp("torture")
-    return {version: compile_host(f"fmi{version}_torture", folder) for version in (2, 3)}
+def hosts(tmp_path_factory: pytest.TempPathFactory) -> dict[int, Path]:
+    """The torture hosts by FMI version, compiled once for the session (host_binaries; sanitized with
+    DOUBLE_PENDULUM_SANITIZE=1)."""
+    return {version: compiled_host(tmp_path_factory, f"fmi{version}_torture") for version in (2, 3)}
 
 
 @pytest.fixture(scope="module")

@@ -24,7 +24,8 @@ import sys
 from pathlib import Path
 
 import pytest
-from test_guard import compile_host, host_command
+from host_binaries import compiled_host
+from test_guard import host_command
 
 from double_pendulum.fmu.build import loader
 
@@ -206,7 +207,7 @@ def matrix(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str
     folder = tmp_path_factory.mktemp("matrix")
     results = {}
     for version, path in ((2, fmu_path), (3, fmu_path.parent / "fmi3" / "DoublePendulum.fmu")):
-        host = compile_host(f"fmi{version}_torture", folder)
+        host = compiled_host(tmp_path_factory, f"fmi{version}_torture")
         unzipped = Path(extract(str(path), str(folder / f"fmi{version}")))
         command = host_command(host, unzipped, read_model_description(str(path)), version, "matrix")
         done = subprocess.run(command, capture_output=True, text=True, cwd=folder, timeout=600,
