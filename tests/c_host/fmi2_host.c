@@ -87,7 +87,7 @@ int main(int argc, char **argv) {
     static input_table table;
     for (int k = 6; k < argc && n_inputs < MAX_ARGS && n_outputs < MAX_ARGS && n_recorded < MAX_ARGS; k++) {
         host_argument a;
-        if (!parse_argument(argv[k], &a) || a.kind == 'j') {
+        if (!parse_argument(argv[k], &a) || a.kind == 'j' || a.kind == 'e') {
             fprintf(stderr, "bad argument %s\n", argv[k]);
             return 2;
         }

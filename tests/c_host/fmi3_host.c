@@ -22,7 +22,8 @@
  * nearest T, in Event Mode), f:PATH (an input table, host_common.h: interpolated at each evaluation under
  * Model Exchange, at each communication point under Co-Simulation), o:VR (Float64 read at the end,
  * printed as "VR VALUE" with 17 digits), O:VR (Float64 read at every step's end from the start, printed
- * as "row T VALUE ..." lines).
+ * as "row T VALUE ..." lines), e:N (the O: rows at t = 0 and at every N-th step's end only: a Model
+ * Exchange run of N RK4 steps per output interval prints a row per interval).
  * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE". At the end it prints "events N",
  * "event-iterations N", "derivative-evaluations N" and "host-unchanged 1" if its environment and
  * signal handlers are as before it loaded the FMU. Exit status: 0 on success, 2 bad usage, 3 library
@@ -60,6 +61,7 @@ static input_table table;
 static fmi3Float64 table_values[MAX_ARGS];
 static fmi3ValueReference recorded[MAX_ARGS];
 static size_t n_recorded;
+static long record_every = 1; /* e:N */
 
 /* Set the input table's values at time t (nothing without a table). */
 static fmi3Status set_table(fmi3Instance c, double t) {
@@ -183,7 +185,7 @@ static int run_model_exchange(fmi3Instance c, int rk4, long steps, double h, lon
             CHECK(fmi3EnterContinuousTimeMode(c));
         }
         if (nz) CHECK(fmi3GetEventIndicators(c, z, nz));
-        CHECK(record_row(c, t_end));
+        if ((step + 1) % record_every == 0) CHECK(record_row(c, t_end));
     }
     return 0;
 }
@@ -203,7 +205,7 @@ static int run_co_simulation(fmi3Instance c, long steps, double h) {
                     step * h, (int)early, (int)terminate, reached);
             return 5;
         }
-        CHECK(record_row(c, (step + 1) * h));
+        if ((step + 1) % record_every == 0) CHECK(record_row(c, (step + 1) * h));
     }
     return 0;
 }
@@ -259,6 +261,11 @@ int main(int argc, char **argv) {
         fmi3Boolean boolean = atoi(a.text) ? fmi3True : fmi3False;
         if (a.kind == 'o') outputs[n_outputs++] = vr;
         else if (a.kind == 'O' && n_recorded < MAX_ARGS) recorded[n_recorded++] = vr;
+        else if (a.kind == 'e' && vr > 0) record_every = vr;
+        else if (a.kind == 'e') {
+            fprintf(stderr, "bad argument %s\n", argv[k]);
+            return 2;
+        }
         else if (a.kind == 'f' && !read_input_table(a.text, &table)) {
             fprintf(stderr, "cannot read the input table %s\n", a.text);
             return 2;

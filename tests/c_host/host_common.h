@@ -50,7 +50,8 @@ static void *symbol(void *library, const char *name) {
 
 /* One argument of a host: K:VR=VALUE (K: r Float64/Real start value, b Boolean 0|1, s String, i input),
  * j:VR=VALUE@T (an input's jump at T, FMI 3 host only), o:VR (an output to print at the end), O:VR (an
- * output to print at every communication point) or f:PATH (an input table, read_input_table). */
+ * output to print at every communication point), e:N (the O: outputs printed at every N-th step's end
+ * only, FMI 3 host only; N in `vr`) or f:PATH (an input table, read_input_table). */
 typedef struct {
     char kind;
     unsigned int vr;
@@ -65,7 +66,7 @@ static int parse_argument(const char *text, host_argument *a) {
     *a = (host_argument){text[0], (unsigned int)strtoul(text + 2, NULL, 10), value ? atof(value + 1) : 0.0,
                          value ? value + 1 : "", at ? atof(at + 1) : 0.0};
     if (text[1] != ':') return 0;
-    if (a->kind == 'o' || a->kind == 'O') return 1;
+    if (a->kind == 'o' || a->kind == 'O' || a->kind == 'e') return 1;
     if (a->kind == 'f') return a->text = text + 2, 1;
     return value && strchr("rbsij", a->kind) && (a->kind != 'j' || at);
 }
