@@ -63,13 +63,15 @@ def test_field_and_central_jvp_in_one_call_equals_separate_calls():
 
 
 def test_tangent_and_two_trajectory_methods_agree_trajectory_by_trajectory():
-    """Benettin's two methods: the tangent (complex step, exact) and a companion 1e-8 away."""
+    """Benettin's two methods: the tangent (complex step, exact) and a companion 1e-8 away, over 3 s (six
+    renormalisations; 1.0 s of CPU, 6 s took 2.0 s): the two-trajectory estimates within 2e-5 of the tangent's, the
+    central-difference tangent within 4e-9."""
     y0 = releases.release_ensemble(*CHAOTIC, 0.005, 6, P, seed=2)
     integration = lyapunov.Integration("rk4", h=2e-3)
-    tangent = lyapunov.lyapunov_benettin(FIELD, y0, 6.0, renorm_interval=0.5, integration=integration)
-    _, two = lyapunov.lyapunov_two_trajectory(FIELD, y0, 6.0, renorm_interval=0.5, integration=integration)
+    tangent = lyapunov.lyapunov_benettin(FIELD, y0, 3.0, renorm_interval=0.5, integration=integration)
+    _, two = lyapunov.lyapunov_two_trajectory(FIELD, y0, 3.0, renorm_interval=0.5, integration=integration)
     np.testing.assert_allclose(two[-1], tangent.exponents[0], rtol=1e-3)
-    augmented = lyapunov.lyapunov_benettin(FIELD, y0, 6.0, renorm_interval=0.5, integration=integration, jvp="central")
+    augmented = lyapunov.lyapunov_benettin(FIELD, y0, 3.0, renorm_interval=0.5, integration=integration, jvp="central")
     np.testing.assert_allclose(augmented.exponents[0], tangent.exponents[0], rtol=1e-6)
 
 
@@ -90,7 +92,10 @@ def test_lyapunov_exponent_of_a_regular_start_converges_towards_zero():
 
 @pytest.fixture(scope="module")
 def chaotic_estimates():
-    """Largest exponent of the chaotic start, averaged over 64 starts within 5 mm (10 s each)."""
+    """Largest exponent of the chaotic start, averaged over 64 starts within 5 mm (5 s each: 3.3 s of CPU, 10 s took
+    7.1 s). Over 5 s the three integrations still follow the same trajectories (their errors, 1e-10 and below,
+    grow e-fold every half second), so the estimates at h and h / 2 are within 0.6 % and 1e-5 of the reference's
+    mean, not only within the finite-time scatter (over 10 s they had parted: within 1.8 % and 0.9 %)."""
     y0 = releases.release_ensemble(*CHAOTIC, 0.005, 64, P, seed=11, include_nominal=True)
     out = {}
     for label, integration in {
@@ -98,14 +103,14 @@ def chaotic_estimates():
         "h": lyapunov.Integration("rk4", h=2e-3),
         "h/2": lyapunov.Integration("rk4", h=1e-3),
     }.items():
-        res = lyapunov.lyapunov_benettin(FIELD, y0, 10.0, renorm_interval=0.5, integration=integration)
+        res = lyapunov.lyapunov_benettin(FIELD, y0, 5.0, renorm_interval=0.5, integration=integration)
         out[label] = res.exponents[0]
     return out
 
 
 def test_lyapunov_exponent_of_the_chaotic_start_is_positive_and_stable_under_step_halving(chaotic_estimates):
     ref = chaotic_estimates["reference"].mean()
-    assert ref > 1.0  # 1/s: clearly chaotic (a regular start gives < 0.1 over the same time)
+    assert ref > 1.0  # 1/s: clearly chaotic (2.25; a regular start gives 0.13 over the same 5 s)
     for label in ("h", "h/2"):
         lam = chaotic_estimates[label]
         assert np.all(lam > 0.0)
@@ -180,13 +185,14 @@ def test_energetic_bound_on_flipping_is_respected_by_every_trajectory():
 
 def test_flip_times_are_mirror_symmetric_and_the_mirrored_map_is_the_integrated_one_bit_for_bit():
     """(phi1, phi2) -> (-phi1, -phi2) mirrors the motion: the same flip time. Integrated over the whole grid
-    (``mirror=False``) the map is symmetric to rounding, so mirroring half of it gives the same map."""
+    (``mirror=False``) the map is symmetric to rounding, so mirroring half of it gives the same map. Flips up to 2 s
+    (1.5 s of CPU; 3 s took 2.2 s): about half the cells flip by then, on both grids."""
     for n1, n2 in ((20, 20), (15, 21)):  # even and odd rows (the middle row of an odd grid is integrated)
-        full = flips.flip_time_map(n1, n2, P, t_max=3.0, max_workers=1, mirror=False)
+        full = flips.flip_time_map(n1, n2, P, t_max=2.0, max_workers=1, mirror=False)
         np.testing.assert_allclose(full.time, full.time[::-1, ::-1], rtol=1e-12, equal_nan=True)
         np.testing.assert_array_equal(full.rod, full.rod[::-1, ::-1])
         assert np.any(np.isfinite(full.time)) and np.any(np.isnan(full.time))  # both outcomes on the grid
-        half = flips.flip_time_map(n1, n2, P, t_max=3.0, max_workers=1)
+        half = flips.flip_time_map(n1, n2, P, t_max=2.0, max_workers=1)
         np.testing.assert_allclose(half.time, full.time, rtol=1e-12, equal_nan=True)
         np.testing.assert_array_equal(half.rod, full.rod)
 
