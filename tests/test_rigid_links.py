@@ -194,7 +194,9 @@ def test_massless_rods_are_bit_identical_through_the_fmu(runner):
 
 @pytest.mark.parametrize("start", [(0.4, -0.3, 0.0, 1.0), (2.0, 2.0, 0.0, 0.0)])
 def test_trajectory_matches_the_independent_lagrangian(start):
-    """Fixed pivot, seed rods, 1 s: the FMU component against SciPy's DOP853 on the independent equations."""
+    """Fixed pivot, seed rods, 1 s: the FMU component against SciPy's DOP853 on the independent equations, at
+    rtol = atol = 1e-10: within 2.2e-9 of its solution at 1e-12, a ninth of the 2e-8 tolerance, for 60 % of the
+    CPU (the independent equations cost 1.8 ms a call, 1,000 calls instead of 1,700-1,900)."""
     config = ModelConfig(pendulum=RIGID)
     ind = IndependentPendulum(config)
     zeros = np.zeros(4)
@@ -204,7 +206,7 @@ def test_trajectory_matches_the_independent_lagrangian(start):
         return [z[2], z[3], *ind.accelerations(q, qd, zeros)]
 
     times = np.linspace(0.0, 1.0, 11)
-    ref = solve_ivp(rhs, (0.0, 1.0), start, method="DOP853", rtol=1e-12, atol=1e-12, t_eval=times).y
+    ref = solve_ivp(rhs, (0.0, 1.0), start, method="DOP853", rtol=1e-10, atol=1e-10, t_eval=times).y
     r = simulate(
         {**SEED_RIGID_LINKS, **dict(zip(("phi1_0", "phi2_0", "omega1_0", "omega2_0"), start)), "rtol": 1e-12},
         stop_time=1.0,
