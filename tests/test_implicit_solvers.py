@@ -120,12 +120,14 @@ def _energy_errors(name: str, t_end: float, window: float, **settings) -> tuple[
     return first, last
 
 
-def test_gauss4_energy_error_stays_bounded_over_400_s_while_dop853_drifts():
-    first, last = _energy_errors("gauss4", 400.0, 40.0, rtol=1.0, atol=1.0, fixed_step=0.02)
+def test_gauss4_energy_error_stays_bounded_over_200_s_while_dop853_drifts():
+    """First and last 20 s of 200 s (1.4 s of CPU; 400 s took 2.9 s): Gauss's error ends within 1 % of where it
+    started (1.8e-9 J), DOP853's grows 7.6 times (9.2 times over 400 s)."""
+    first, last = _energy_errors("gauss4", 200.0, 20.0, rtol=1.0, atol=1.0, fixed_step=0.02)
     assert last <= 2.0 * first
     assert last < 1e-8  # J, of E0 = 0.103 J
-    first, last = _energy_errors("dop853", 400.0, 40.0, rtol=1e-6, atol=1e-9, fixed_step=1.0)
-    assert last > 5.0 * first  # the explicit method's energy error grows about linearly (9 times here)
+    first, last = _energy_errors("dop853", 200.0, 20.0, rtol=1e-6, atol=1e-9, fixed_step=1.0)
+    assert last > 5.0 * first  # the explicit method's energy error grows about linearly (7.6 times here)
 
 
 def test_gauss_stage_iteration_failure_raises_solver_error():
