@@ -21,7 +21,7 @@ suspension, and compares them by AIC/BIC with the residuals' correlation account
 - ``report.md``.
 
 Default: the one- and two-mechanism models but air+drag2
-(:data:`~double_pendulum.analysis.losses.identification.FULL_MODELS`), about 80 s of CPU on one worker
+(:data:`~double_pendulum.analysis.losses.identification.FULL_MODELS`), about 45 s of CPU on one worker
 process per core (the worker pool is started once for every fitting round). ``thorough``
 (``--thorough``) adds air+drag2 (one drag torque per joint), the three-mechanism models
 air+drag+bearing, air+drag+viscous and air+drag+suspension, with 30 runs for every fit, and the top
