@@ -64,7 +64,7 @@ EXPECTED_QUICK_CPU_S: dict[str, float] = {
 """CPU time [s] of each scenario's quick run (``--quick``), as last measured (2 cores, ``run all --quick``
 on a fresh cache, mean of 6 runs, 2026-12-02; ``measured_vs_sim`` reading ``loss_identification``'s fit;
 ``cosimulation`` scaled by its own drop when it came to reuse the Suspension FMU ``run`` keeps beside the
-pendulum's, 3.6 s -> 2.3 s run alone, 2026-12-06): ``run all
+pendulum's, 3.6 s -> 2.3 s run alone, 2026-12-05): ``run all
 --quick`` shares the scenarios out among its processes by them and weights its progress bar by them;
 nothing else depends on them. Measure again when a quick run gets cheaper or dearer."""
 
