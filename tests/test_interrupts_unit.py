@@ -53,3 +53,39 @@ def test_an_interrupt_lost_in_a_finaliser_prints_no_traceback_while_the_run_hand
 
 def test_outside_a_run_python_reports_it_as_usual():
     assert "KeyboardInterrupt: from a finaliser" in _stderr("plain")
+
+
+ENDING = """
+import os, signal, sys, time
+from double_pendulum.runs import interrupts
+
+if sys.argv[1] == "process":
+    interrupts.ends_the_process()
+try:
+    with interrupts.handling_interrupts():
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(5)
+        except KeyboardInterrupt:
+            interrupts.acknowledge()
+        raise ImportError("initialization failed")  # what a C extension makes of an interrupt in its import
+except KeyboardInterrupt:
+    print("interrupt, not the error", flush=True)
+os.kill(os.getpid(), signal.SIGINT)  # a second Ctrl-C after the clean-up, as the process ends
+time.sleep(0.2)
+print("still here", flush=True)
+sys.exit(130)
+"""
+
+
+def test_after_an_interrupted_run_the_ending_process_ignores_ctrl_c_and_errors_are_the_interrupt():
+    """An error leaving the run after Ctrl-C is the interrupt (KeyboardInterrupt); in the command's own process a
+    later Ctrl-C, after the clean-up, is ignored through exit (status 130, no traceback). A run started from
+    Python (no ends_the_process) gets the caller's handler back, so the same Ctrl-C is Python's KeyboardInterrupt."""
+    ending = subprocess.run([sys.executable, "-c", ENDING, "process"], capture_output=True, text=True, timeout=60)
+    assert ending.returncode == 130, ending.stderr
+    assert ending.stdout.split("\n")[:2] == ["interrupt, not the error", "still here"]
+    assert "Traceback" not in ending.stderr
+    embedded = subprocess.run([sys.executable, "-c", ENDING, "python"], capture_output=True, text=True, timeout=60)
+    assert embedded.stdout.startswith("interrupt, not the error") and "still here" not in embedded.stdout
+    assert "KeyboardInterrupt" in embedded.stderr

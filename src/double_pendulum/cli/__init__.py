@@ -24,7 +24,7 @@ import sys
 
 from .. import __version__
 from ..app.server import add_app_command
-from ..runs.interrupts import handling_interrupts
+from ..runs.interrupts import ends_the_process, handling_interrupts
 from .build import add_build_parser, add_cross_check_parser
 from .common import PROG, CliError
 from .info import add_list_parser, add_variables_parser
@@ -83,7 +83,9 @@ def _stdout_to_devnull() -> None:
 
 def entry() -> None:
     """Console-script entry point: run :func:`main` and exit with its code, through the interpreter's
-    ordinary teardown (the FMUs' binary is safe through exit: scripts/check_memory.sh)."""
+    ordinary teardown (the FMUs' binary is safe through exit: scripts/check_memory.sh). The process ends with the
+    run, so a Ctrl-C after an interrupted run's clean-up only hurries its exit (:func:`ends_the_process`)."""
+    ends_the_process()
     try:
         code = main()
     except KeyboardInterrupt:  # Ctrl-C while parsing or importing

@@ -30,8 +30,11 @@ from typing import Any
 REPEAT_S = 0.25
 """How often [s] an unacknowledged interrupt is raised again in the main thread."""
 
-_state: dict[str, Any] = {"installed": False, "interrupted": False, "acknowledged": False, "hurried": False}
+_state: dict[str, Any] = {"installed": False, "interrupted": False, "acknowledged": False, "hurried": False,
+                          "ends_process": False}
 _stop_repeating = threading.Event()
+_repeating = threading.Lock()
+"""Held while the repeating thread decides to raise again, so that once :func:`_stop_repeat` returns it never does."""
 
 
 def interrupted() -> bool:
@@ -49,7 +52,33 @@ def _repeat() -> None:
     import _thread
 
     while not _stop_repeating.wait(REPEAT_S):
-        _thread.interrupt_main(signal.SIGINT)
+        with _repeating:
+            if _stop_repeating.is_set():  # stopped while this thread woke: an interrupt now would come too late
+                return
+            _thread.interrupt_main(signal.SIGINT)
+
+
+def _stop_repeat() -> None:
+    """Stop raising the interrupt again; after this returns no new one is raised."""
+    with _repeating:
+        _stop_repeating.set()
+
+
+def ends_the_process() -> None:
+    """Called by the command's entry point, whose process ends with the run: after an interrupted run SIGINT is
+    ignored (:data:`signal.SIG_IGN`, which Python's finalisation keeps, where it resets a Python handler to the
+    default) until the process exits. Without this a second Ctrl-C that came after the clean-up, while the
+    interpreter exited, killed the process by the signal (exit status -2, not 130) or printed a traceback."""
+    _state["ends_process"] = True
+
+
+def _ignore_sigint() -> None:
+    """Ignore SIGINT. :func:`signal.signal` may first run the handler of a SIGINT still pending, :func:`_on_first`
+    raising the interrupt being handled already: that one is dropped."""
+    for _ in range(3):
+        with contextlib.suppress(KeyboardInterrupt):
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
+            return
 
 
 def _on_first(signum: int, frame: Any) -> None:
@@ -70,7 +99,7 @@ def acknowledge() -> None:
     if not _state["installed"] or _state["acknowledged"]:
         return
     _state["acknowledged"] = True
-    _stop_repeating.set()
+    _stop_repeat()
     with contextlib.suppress(ValueError):  # not the main thread: the handler stays
         signal.signal(signal.SIGINT, _on_later)
 
@@ -90,7 +119,10 @@ def _quiet_unraisable(hook: Any) -> Any:
 @contextlib.contextmanager
 def handling_interrupts() -> Iterator[None]:
     """Within the block, SIGINT acts as described in the module docstring; the previous handler is restored
-    after it (a run started from Python, e.g. by the tests, leaves the caller's handler as it was)."""
+    after it (a run started from Python, e.g. by the tests, leaves the caller's handler as it was), except after
+    an interrupted run in a process that ends with it (:func:`ends_the_process`). An error that leaves the block
+    after SIGINT leaves it as KeyboardInterrupt: the interrupt, reported as an error by code that could not pass
+    it on (scipy's C extension raised "ImportError: initialization failed" when it landed in its import)."""
     try:
         previous = signal.signal(signal.SIGINT, _on_first)
     except ValueError:  # not the main thread: Python's own handling
@@ -102,9 +134,16 @@ def handling_interrupts() -> Iterator[None]:
     sys.unraisablehook = _quiet_unraisable(previous_hook)
     try:
         yield
+    except Exception:
+        if _state["interrupted"]:  # Ctrl-C that code in between turned into an error of its own: an FMU's error
+            raise KeyboardInterrupt from None  # status, a C extension's "ImportError: initialization failed"
+        raise
     finally:
-        _stop_repeating.set()
-        signal.signal(signal.SIGINT, previous)
+        _stop_repeat()
+        if _state["interrupted"] and _state["ends_process"]:
+            _ignore_sigint()  # the run is cleaned up and the process ends: a later Ctrl-C has nothing to do
+        else:
+            signal.signal(signal.SIGINT, previous)
         sys.unraisablehook = previous_hook
         _state.update(installed=False)
 
