@@ -203,13 +203,16 @@ def quick_scenario(results: Path, name: str) -> tuple[Path, dict]:
 # module to whichever worker is free: the longest first, so that no long module is left for the end while the
 # other worker idles. LONGEST_FIRST are the modules of the most seconds (tests and module fixtures, measured on
 # 2 workers, issue 36); the one second does not need the session's FMUs, so its worker works while the first
-# builds them (conftest's built_fmus; the quick run needs them too). The rest follow by their number of tests,
-# as pytest-xdist orders them itself, within a module the tests keep their order.
+# builds them (conftest's built_fmus; the quick run needs them too). test_reference_results reads the
+# cross-check's tree (cross_check_tree), which test_cross_check makes on the other worker: it comes last of them,
+# where that tree is done, instead of beside test_cross_check, where its worker waited about 10 s for the tree.
+# The rest follow by their number of tests, as pytest-xdist orders them itself, within a module the tests keep
+# their order.
 LONGEST_FIRST = (
     "test_host_hygiene", "test_loss_noise", "test_reports", "test_guard", "test_loss_identification",
     "test_python_host", "test_c_host", "test_cli", "test_cross_check", "test_state_matrix", "test_summary_types",
-    "test_reference_results", "test_app", "test_page", "test_scenario_pool", "test_fmpy_tools", "test_bad_input",
-    "test_chaos", "test_energy_budget",
+    "test_app", "test_page", "test_scenario_pool", "test_fmpy_tools", "test_bad_input", "test_chaos",
+    "test_energy_budget", "test_reference_results",
 )
 
 
