@@ -84,7 +84,7 @@ def _stdout_to_devnull() -> None:
 def entry() -> None:
     """Console-script entry point: run :func:`main` and exit with its code, through the interpreter's
     ordinary teardown (the FMUs' binary is safe through exit: scripts/check_memory.sh). The process ends with the
-    run, so a Ctrl-C after an interrupted run's clean-up only hurries its exit (:func:`ends_the_process`)."""
+    run, so a Ctrl-C after an interrupted run's clean-up is ignored through its exit (:func:`ends_the_process`)."""
     ends_the_process()
     try:
         code = main()

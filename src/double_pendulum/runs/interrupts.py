@@ -74,7 +74,8 @@ def ends_the_process() -> None:
 
 def _ignore_sigint() -> None:
     """Ignore SIGINT. :func:`signal.signal` may first run the handler of a SIGINT still pending, :func:`_on_first`
-    raising the interrupt being handled already: that one is dropped."""
+    raising the interrupt being handled already: that one is dropped and the call made again (a pending SIGINT is
+    consumed by the attempt that runs it, so a further one needs yet another Ctrl-C in between; three attempts)."""
     for _ in range(3):
         with contextlib.suppress(KeyboardInterrupt):
             signal.signal(signal.SIGINT, signal.SIG_IGN)
