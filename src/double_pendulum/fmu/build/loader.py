@@ -22,8 +22,8 @@ nothing compiled is committed. Building the FMUs needs Linux and a compiler: els
 with one line saying so (:class:`LoaderUnavailable`).
 
 ``DOUBLE_PENDULUM_LOADER_CFLAGS`` (:data:`EXTRA_CFLAGS_VARIABLE`), if set, holds more compiler flags
-(split as a shell would): they go at the end of the one command that compiles and links the loader,
-so they reach the linker too, and they are part of the compile cache's key. The memory check
+(split as a shell would): they go at the end of each command that compiles a source and of the one that links
+the loader, so they reach the linker too, and they are part of the compile cache's key. The memory check
 (``scripts/check_memory.sh``) builds a sanitized loader this way, e.g.
 ``DOUBLE_PENDULUM_LOADER_CFLAGS="-fsanitize=address,undefined -fno-omit-frame-pointer -g -O1"``.
 """
@@ -107,20 +107,64 @@ def _is_gcc(compiler: tuple[str, ...]) -> bool:
     return "clang" not in version and ("gcc" in version or "free software foundation" in version)
 
 
+IDENTITY_SOURCES = ("fmi2_guard.c", "fmi3_guard.c")
+IDENTITY_MACROS = ("MODEL_IDENTIFIER", "FMU_GUID", "N_CONTINUOUS_STATES")
+"""The sources that take one FMU's macros (:data:`IDENTITY_MACROS`) are compiled for each FMU. The others take
+only the other macros (none in a build; the tests shorten ``QUERY_TIMEOUT_MS``) and are compiled once per process
+and set of those (:func:`_object`): a build writes three loaders, the cross-check tree a dozen."""
+
+
+def _flags(compiler: tuple[str, ...]) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The compiler's own flags (Zig's target, gcc's warnings) and the libraries the link needs."""
+    zig = "ziglang" in compiler
+    own = ZIG_FLAGS.get(os.uname().machine, ()) if zig else GCC_CFLAGS if _is_gcc(compiler) else ()
+    return own, ZIG_LIBS if zig else LIBS
+
+
+def _run_compiler(command: list[str]) -> None:
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"compiling the FMU's loader failed: {shlex.join(command)}\n{done.stderr}")
+
+
+def _compile_object(compiler: tuple[str, ...], source: Path, macros: tuple[str, ...], extra_flags: tuple[str, ...],
+                    folder: Path) -> Path:
+    """``source`` compiled (not linked) into ``folder``, with :data:`CFLAGS` but ``-shared``."""
+    output = folder / f"{source.stem}.o"
+    flags = [flag for flag in CFLAGS if flag != "-shared"]
+    _run_compiler([*compiler, *flags, *_flags(compiler)[0], *macros, f"-I{fmi_headers()}", "-c", "-o", str(output),
+                   str(source), *extra_flags])
+    return output
+
+
+@functools.cache
+def _object(compiler: tuple[str, ...], source: Path, mtimes: tuple[float, ...], macros: tuple[str, ...],
+            extra_flags: tuple[str, ...]) -> bytes:
+    """The object file of ``source``, one that takes no FMU's macros, kept for the process (``mtimes``: of every
+    source and header, part of the key)."""
+    with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
+        return _compile_object(compiler, source, macros, extra_flags, Path(tmp)).read_bytes()
+
+
 @functools.cache
 def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tuple[float, ...],
               defines: tuple[tuple[str, str], ...], extra_flags: tuple[str, ...] = ()) -> bytes:
-    c_files = [str(path) for path in sources if path.suffix == ".c"]
+    def macros(pairs: tuple[tuple[str, str], ...]) -> tuple[str, ...]:
+        return tuple(f"-D{name}={value}" if value.isdigit() else f'-D{name}="{value}"' for name, value in pairs)
+
+    shared = macros(tuple((name, value) for name, value in defines if name not in IDENTITY_MACROS))
     with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
-        output = Path(tmp) / "loader.so"
-        macros = [f"-D{name}={value}" if value.isdigit() else f'-D{name}="{value}"' for name, value in defines]
-        zig = "ziglang" in compiler
-        own = ZIG_FLAGS.get(os.uname().machine, ()) if zig else GCC_CFLAGS if _is_gcc(compiler) else ()
-        command = [*compiler, *CFLAGS, *own, *macros, f"-I{fmi_headers()}", "-o", str(output), *c_files,
-                   *(ZIG_LIBS if zig else LIBS), *extra_flags]
-        done = subprocess.run(command, capture_output=True, text=True)
-        if done.returncode != 0:
-            raise RuntimeError(f"compiling the FMU's loader failed: {shlex.join(command)}\n{done.stderr}")
+        folder = Path(tmp)
+        objects = []
+        for source in (path for path in sources if path.suffix == ".c"):
+            if source.name in IDENTITY_SOURCES:
+                objects.append(_compile_object(compiler, source, macros(defines), extra_flags, folder))
+            else:
+                objects.append(folder / f"{source.stem}.o")
+                objects[-1].write_bytes(_object(compiler, source, mtimes, shared, extra_flags))
+        output = folder / "loader.so"
+        _run_compiler([*compiler, *CFLAGS, *_flags(compiler)[0], "-o", str(output), *map(str, objects),
+                       *_flags(compiler)[1], *extra_flags])
         return output.read_bytes()
 
 
