@@ -59,7 +59,20 @@ def run(
     ``load``: the Suspension's inputs (its default inputs leave it at rest; the plot applies
     :data:`SUSPENSION_STEP`); ``macro_step`` [s]: the coupled system's (``interval`` by default; ``interval``
     must be a multiple of it).
+
+    Runs are kept per process for the same arguments, as plots are: a process that builds the FMUs again (the
+    tests, the cross-check tree's cases) computes each reference once; each call gets lists of its own.
     """
+    load_json = json.dumps(None if load is None else dict(load), sort_keys=True)
+    rows = _run(model, json.dumps(dict(start_values), sort_keys=True), float(stop_time), float(interval),
+                None if names is None else tuple(names), load_json, macro_step)
+    return {name: list(values) for name, values in rows.items()}
+
+
+@functools.lru_cache(maxsize=32)
+def _run(model: str, start_json: str, stop_time: float, interval: float, names: tuple[str, ...] | None,
+         load_json: str, macro_step: float | None) -> dict[str, list[float]]:
+    start_values, load = json.loads(start_json), json.loads(load_json)
     names = list(names) if names is not None else [n for group in PLOTTED[model] for n in group]
     if model == "PendulumOnSuspension":
         return _coupled(start_values, stop_time, interval, names, macro_step or interval)

@@ -14,6 +14,8 @@ these numbers: fmpy does, to rounding under Co-Simulation and within the toleran
 
 from __future__ import annotations
 
+import functools
+import json
 from collections.abc import Mapping
 from typing import Any
 from xml.etree import ElementTree as ET
@@ -90,12 +92,18 @@ def ssp_reference_files(values: Mapping[str, Any], stop_time: float, macro_step:
     libcosim's fixed-step algorithm steps it (``jacobi``: both FMUs step on the inputs of the last exchange, then
     all outputs are passed; two extra exchanges while initialising), macro step ``macro_step`` [s], to
     ``stop_time`` [s], :data:`SSP_STATES` every :func:`interval`. Computed at build in-process with the two
-    components; ``run_coupled`` reproduces libcosim to rounding (``tests/test_engines.py``)."""
+    components; ``run_coupled`` reproduces libcosim to rounding (``tests/test_engines.py``). Kept per process for
+    the same arguments, as :func:`double_pendulum.fmu.carries.doc_plot.run` keeps its runs."""
+    return dict(_ssp_reference_files(json.dumps(dict(values), sort_keys=True), float(stop_time), float(macro_step)))
+
+
+@functools.lru_cache(maxsize=8)
+def _ssp_reference_files(values_json: str, stop_time: float, macro_step: float) -> dict[str, bytes]:
     from ..masters.coupling import run_coupled, split_values
     from ..presets import COMPONENTS
 
     every = interval(0.0, stop_time, macro_step, macro_step)
-    pendulum_values, suspension_values = split_values(values)
+    pendulum_values, suspension_values = split_values(json.loads(values_json))
     pendulum, suspension = COMPONENTS["DoublePendulum"](), COMPONENTS["Suspension"]()
     for component, start in ((pendulum, pendulum_values), (suspension, suspension_values)):
         for name, value in start.items():
