@@ -33,12 +33,10 @@
 #include "fmi2Functions.h"
 #include "guard.h"
 
-#ifndef FMU_GUID
-#error "the build defines FMU_GUID, the guid of the FMU's modelDescription.xml"
-#endif
-#ifndef MODEL_IDENTIFIER
-#error "the build defines MODEL_IDENTIFIER"
-#endif
+#include "identity.h"
+
+#define MODEL_IDENTIFIER identity_model_identifier
+#define FMU_GUID identity_token /* the guid of the FMU's modelDescription.xml */
 
 /* ----------------------------------------------------------------------------------- states */
 

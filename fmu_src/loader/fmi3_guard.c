@@ -23,15 +23,11 @@
 #include "fmi3Functions.h"
 #include "guard.h"
 
-#ifndef FMU_GUID
-#error "the build defines FMU_GUID, the instantiationToken of the FMU's modelDescription.xml"
-#endif
-#ifndef MODEL_IDENTIFIER
-#error "the build defines MODEL_IDENTIFIER"
-#endif
-#ifndef N_CONTINUOUS_STATES
-#error "the build defines N_CONTINUOUS_STATES"
-#endif
+#include "identity.h"
+
+#define MODEL_IDENTIFIER identity_model_identifier
+#define FMU_GUID identity_token /* the instantiationToken of the FMU's modelDescription.xml */
+#define N_CONTINUOUS_STATES identity_continuous_states
 #define N_EVENT_INDICATORS 0 /* a smooth right-hand side (component/model_exchange.py) */
 
 #define MODEL_EXCHANGE "ModelExchange"

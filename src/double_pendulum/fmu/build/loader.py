@@ -6,7 +6,8 @@ instantiation, logging), ``fmu_state.c`` (FMU states) and ``pointer_set.c``; ``b
 FMU's Python side (``fmu_src/fmi_bridge.py``) through CPython's C API, and ``python_runtime.c``
 finds, loads and starts a CPython where the host has none. No FMI library's binary is involved
 (docs/architecture.md says why pythonfmu's C++ layer was replaced). The loader becomes the FMU's
-``binaries/<platform>/<model identifier>.so``, compiled with the FMU's GUID (``FMU_GUID``).
+``binaries/<platform>/<model identifier>.so``, compiled with the FMU's GUID (``FMU_GUID``, in ``identity.c``,
+the one source compiled for each FMU; the others once per process).
 In a Python host the loader uses the host's interpreter and changes nothing; in any other host it
 finds a CPython >= 3.11 with a shared libpython: the one named by ``DOUBLE_PENDULUM_FMU_PYTHON``,
 else the one the FMU was built with (``resources/python.cfg``, :func:`python_record`), else
@@ -43,8 +44,8 @@ from pathlib import Path
 
 LOADER_FOLDER = "loader"  # in fmu_src/ (installed as double_pendulum.adapters)
 _SHARED_SOURCES = ("python_runtime.c", "pointer_set.c", "guard.c", "fmu_state.c", "bridge.c")
-LOADER_SOURCES = {2: (*_SHARED_SOURCES, "fmi2_guard.c"), 3: (*_SHARED_SOURCES, "fmi3_guard.c")}
-LOADER_HEADERS = ("python_runtime.h", "guard.h", "bridge.h", "glibc_compat.h")
+LOADER_SOURCES = {version: (*_SHARED_SOURCES, f"fmi{version}_guard.c", "identity.c") for version in (2, 3)}
+LOADER_HEADERS = ("python_runtime.h", "guard.h", "bridge.h", "identity.h", "glibc_compat.h")
 # The platform of the loader, as each FMI version names its binaries folder.
 PLATFORMS = {2: "linux64", 3: "x86_64-linux"}
 PLATFORM = PLATFORMS[2]
@@ -107,11 +108,11 @@ def _is_gcc(compiler: tuple[str, ...]) -> bool:
     return "clang" not in version and ("gcc" in version or "free software foundation" in version)
 
 
-IDENTITY_SOURCES = ("fmi2_guard.c", "fmi3_guard.c")
+IDENTITY_SOURCES = ("identity.c",)
 IDENTITY_MACROS = ("MODEL_IDENTIFIER", "FMU_GUID", "N_CONTINUOUS_STATES")
-"""The sources that take one FMU's macros (:data:`IDENTITY_MACROS`) are compiled for each FMU. The others take
-only the other macros (none in a build; the tests shorten ``QUERY_TIMEOUT_MS``) and are compiled once per process
-and set of those (:func:`_object`): a build writes three loaders, the cross-check tree a dozen."""
+"""Only ``identity.c`` takes one FMU's macros (:data:`IDENTITY_MACROS`) and is compiled for each FMU. The others
+take only the other macros (none in a build; the tests shorten ``QUERY_TIMEOUT_MS``) and are compiled once per
+process and set of those (:func:`_object`): a build writes three loaders, the cross-check tree a dozen."""
 
 
 def _flags(compiler: tuple[str, ...]) -> tuple[tuple[str, ...], tuple[str, ...]]:
