@@ -49,22 +49,21 @@ starts the longest first, packs the small ones into shared children and weights 
 nothing else depends on them."""
 
 EXPECTED_QUICK_CPU_S: dict[str, float] = {
-    "cosimulation": 3.3,
-    "free_swing": 2.6,
-    "friction_budget": 1.7,
-    "energy_decay": 1.6,
-    "loss_identification": 7.0,
-    "suspension_transfer": 13.2,
-    "measured_vs_sim": 5.8,
-    "work_precision": 0.9,
-    "stability": 4.0,
-    "chaos": 8.7,
-    "base_excitation": 5.3,
+    "cosimulation": 2.1,
+    "free_swing": 1.4,
+    "friction_budget": 0.5,
+    "energy_decay": 0.9,
+    "loss_identification": 3.7,
+    "suspension_transfer": 5.0,
+    "measured_vs_sim": 3.7,
+    "work_precision": 0.2,
+    "stability": 1.2,
+    "chaos": 3.3,
+    "base_excitation": 1.6,
 }
 """CPU time [s] of each scenario's quick run (``--quick``), as last measured (2 cores, ``run all --quick``
-on a fresh cache, mean of 6 runs, 2026-12-02; ``measured_vs_sim`` reading ``loss_identification``'s fit;
-``cosimulation`` scaled by its own drop when it came to reuse the Suspension FMU ``run`` keeps beside the
-pendulum's, 3.6 s -> 2.3 s run alone, 2026-12-05): ``run all
+on a fresh cache, mean of 4 runs, quiet machine, 2026-12-06; ``measured_vs_sim`` reading ``loss_identification``'s
+fit; the runs of 2026-12-02 took 1.5 to 3.3 times as long on a slower day and before the faster scenes): ``run all
 --quick`` shares the scenarios out among its processes by them and weights its progress bar by them;
 nothing else depends on them. Measure again when a quick run gets cheaper or dearer."""
 
