@@ -139,10 +139,11 @@ def _compile_object(compiler: tuple[str, ...], source: Path, macros: tuple[str, 
 
 
 @functools.cache
-def _object(compiler: tuple[str, ...], source: Path, mtimes: tuple[float, ...], macros: tuple[str, ...],
+def _object(compiler: tuple[str, ...], source: Path, stamp: tuple[float, tuple[float, ...]], macros: tuple[str, ...],
             extra_flags: tuple[str, ...]) -> bytes:
-    """The object file of ``source``, one that takes no FMU's macros, kept for the process (``mtimes``: of every
-    source and header, part of the key)."""
+    """The object file of ``source``, one that takes no FMU's macros, kept for the process (``stamp``: the mtimes
+    of ``source`` and of every header, part of the key; not the other sources', so that the FMI 2 and FMI 3 loaders
+    share the objects)."""
     with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
         return _compile_object(compiler, source, macros, extra_flags, Path(tmp)).read_bytes()
 
@@ -154,15 +155,16 @@ def _compiled(compiler: tuple[str, ...], sources: tuple[Path, ...], mtimes: tupl
         return tuple(f"-D{name}={value}" if value.isdigit() else f'-D{name}="{value}"' for name, value in pairs)
 
     shared = macros(tuple((name, value) for name, value in defines if name not in IDENTITY_MACROS))
+    headers = tuple(mtime for path, mtime in zip(sources, mtimes) if path.suffix == ".h")
     with tempfile.TemporaryDirectory(prefix="dp_loader_") as tmp:
         folder = Path(tmp)
         objects = []
-        for source in (path for path in sources if path.suffix == ".c"):
+        for source, mtime in ((path, mtime) for path, mtime in zip(sources, mtimes) if path.suffix == ".c"):
             if source.name in IDENTITY_SOURCES:
                 objects.append(_compile_object(compiler, source, macros(defines), extra_flags, folder))
             else:
                 objects.append(folder / f"{source.stem}.o")
-                objects[-1].write_bytes(_object(compiler, source, mtimes, shared, extra_flags))
+                objects[-1].write_bytes(_object(compiler, source, (mtime, headers), shared, extra_flags))
         output = folder / "loader.so"
         _run_compiler([*compiler, *CFLAGS, *_flags(compiler)[0], "-o", str(output), *map(str, objects),
                        *_flags(compiler)[1], *extra_flags])
