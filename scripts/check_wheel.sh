@@ -17,7 +17,7 @@ rm -rf build/lib build/bdist.*
 "$tmp/venv/bin/pip" install -q "$tmp"/wheel/*.whl
 cd "$tmp"
 "$tmp/venv/bin/double-pendulum" --version
-MPLBACKEND=Agg "$tmp/venv/bin/double-pendulum" run all $mode --out "$tmp/results" --fmu "$tmp/DoublePendulum.fmu"
+MPLBACKEND=Agg "$tmp/venv/bin/double-pendulum" run all $mode --out "$tmp/results" --build-dir "$tmp"
 test -s "$tmp/results/index.html"  # the run's page, from the installed package
 echo "wheel install: every scenario ran from $(find "$tmp/results" -mindepth 1 -maxdepth 1 -type d | wc -l) result" \
      "folders, and the run's page is there"

@@ -76,6 +76,37 @@ def built_by_the_command(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path
     return record / "fmu", command["code"], command["out"]
 
 
+OLD = 1577836800.0
+"""2020-01-01, an mtime older than any source of the project: the project would rebuild an FMU of its own this old."""
+
+
+def users_folder(folder: Path, built_fmus: list[Path]) -> Path:
+    """Make ``folder``, a user's folder with FMUs of theirs dated 2020 (:data:`OLD`, older than the sources) in
+    ``models/``: ``Other.fmu`` (a copy of the project's DoublePendulum.fmu), ``Other3.fmu`` (of the FMI 3.0 one),
+    ``Suspension.fmu`` beside them and ``Container.fmu`` (fmpy's container FMU of the coupled system: a real FMU,
+    not the pendulum's), and a note of theirs; every entry, the folders too, dated 2020."""
+    models = folder / "models"
+    models.mkdir(parents=True)
+    built = dict(zip(BUILT_FMUS, built_fmus))
+    for source, name in (("DoublePendulum.fmu", "Other.fmu"), ("fmi3/DoublePendulum.fmu", "Other3.fmu"),
+                         ("Suspension.fmu", "Suspension.fmu"), ("PendulumOnSuspension.fmu", "Container.fmu")):
+        shutil.copyfile(built[source], models / name)
+    (models / "notes.txt").write_text("the user's own file\n")
+    for path in (*models.iterdir(), models, folder):
+        os.utime(path, (OLD, OLD))
+    return folder
+
+
+def folder_state(folder: Path) -> dict[str, tuple[str, int, int]]:
+    """Every entry under ``folder``, recursively, and the folder itself: its kind, size and mtime (ns), by path."""
+    state = {}
+    for path in [folder, *folder.rglob("*")]:
+        info = path.lstat()
+        kind = "folder" if path.is_dir() and not path.is_symlink() else "file"
+        state[path.relative_to(folder).as_posix()] = (kind, info.st_size, info.st_mtime_ns)
+    return state
+
+
 @pytest.fixture(scope="session")
 def fmu_path(built_fmus: list[Path]) -> Path:
     """A freshly built DoublePendulum.fmu, with the other FMUs and the coupled system next to it, as ``run``

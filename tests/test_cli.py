@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 import pytest
-from conftest import BUILT_FMUS, quick_run_leftovers, quick_scenario
+from conftest import BUILT_FMUS, folder_state, quick_run_leftovers, quick_scenario
 from double_pendulum.scenarios import SCENARIOS
 
 import double_pendulum
@@ -138,13 +138,14 @@ def test_an_unknown_option_shows_the_usage_of_its_command(capsys):
     assert err.startswith("usage: double-pendulum run ") and "unrecognized arguments: --frobnicate" in err
 
 
-def test_corrupt_fmu_is_one_clear_line(tmp_path, capsys, monkeypatch):
+def test_corrupt_fmu_is_one_clear_line(tmp_path, capsys):
     fmu = tmp_path / "broken.fmu"
     fmu.write_bytes(b"not a zip file")
-    monkeypatch.setattr("double_pendulum.fmu.build.fmi2.fmu_is_current", lambda path: True)  # do not rebuild it
+    before = folder_state(tmp_path)
     assert main(["run", "free_swing", "--fmu", str(fmu), "--out", str(tmp_path / "out")]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "is not a usable FMU" in err and "BadZipFile" in err
+    assert err.count("\n") == 1 and f"{fmu} is not a usable FMU" in err and "BadZipFile" in err
+    assert folder_state(tmp_path) == before  # neither rebuilt nor any output folder made
 
 
 class _Scenario:
@@ -191,7 +192,7 @@ def _recorded_runs(monkeypatch) -> list[str]:
     import contextlib
 
     runs: list[str] = []
-    monkeypatch.setattr("double_pendulum.cli.run.load_fmu", lambda path, rebuild: contextlib.nullcontext())
+    monkeypatch.setattr("double_pendulum.cli.run.load_fmu", lambda fmu, rebuild: contextlib.nullcontext())
     monkeypatch.setattr("double_pendulum.cli.run.run_scenario", lambda module, name, *args: runs.append(name))
     return runs
 
@@ -270,9 +271,10 @@ def test_in_the_project_folder_the_fmus_stay_in_build(tmp_path, monkeypatch):
     assert default_fmu_path(Path("results")) == Path("build") / "DoublePendulum.fmu"
 
 
-def test_an_fmu_that_cannot_be_built_names_the_option_to_build_it_elsewhere(tmp_path, capsys):
+def test_fmus_that_cannot_be_built_name_the_option_to_build_them_elsewhere(tmp_path, capsys):
     blocker = tmp_path / "a_file"
-    blocker.write_text("x")  # a file where the FMU's folder should be
-    assert main(["run", "free_swing", "--fmu", str(blocker / "DoublePendulum.fmu"), "--out", str(tmp_path)]) == 2
+    blocker.write_text("x")  # a file where the build folder should be
+    assert main(["run", "free_swing", "--build-dir", str(blocker), "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "cannot build the FMU" in err and "--fmu" in err
+    assert err.count("\n") == 1 and f"cannot build the FMUs in {blocker}" in err and "--build-dir DIR" in err
+    assert blocker.read_text() == "x"

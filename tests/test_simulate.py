@@ -70,12 +70,12 @@ def test_a_case_writes_csv_figure_animation_and_summary_with_fmpy_s_numbers(fmu_
     assert f"output={list(OUTPUT_NAMES)!r})" in summary["fmpy_call"]  # fmpy records only the outputs by default
 
 
-def test_model_exchange_through_the_fmi3_fmu_gives_fmpy_s_numbers(fmu_path, tmp_path):
+def test_model_exchange_through_the_fmi3_fmu_gives_fmpy_s_numbers(fmu3_path, tmp_path):
     out = tmp_path / "me"
-    assert main(["simulate", "--fmi", "3", "--me", "--set", "phi2_0=0.5", "--stop", "1", "--fmu", str(fmu_path),
+    assert main(["simulate", "--fmi", "3", "--me", "--set", "phi2_0=0.5", "--stop", "1", "--fmu", str(fmu3_path),
                  "--out", str(out), "--no-animation"]) == 0
     assert not (out / "simulation.gif").exists()
-    fmu3 = fmu_path.parent / "fmi3" / fmu_path.name
+    fmu3 = fmu3_path
     plain = simulate_fmu(str(fmu3), fmi_type="ModelExchange", start_values={"phi2_0": 0.5}, stop_time=1.0,
                          output_interval=0.01)
     written = read_results_csv(out / "simulation.csv")
@@ -105,14 +105,23 @@ def test_a_bad_set_is_refused_in_one_line_that_says_why(fmu_path, tmp_path, caps
 
 
 @pytest.mark.parametrize("argv, words", [
-    (["--me"], "--me needs --fmi 3"),
+    (["--me"], "--me needs an FMU with Model Exchange"),
+    (["--fmi", "3"], "--fmi 3 does not match"),
     (["--stop", "-1"], "--stop must be a positive number"),
     (["--step", "0"], "--step must be a positive number"),
     (["--stop", "1", "--step", "2"], "longer than the run"),
 ])
 def test_misuse_of_the_options_is_one_line(fmu_path, tmp_path, capsys, argv, words):
-    assert main(["simulate", *argv, "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 2
+    assert main(["simulate", *argv, "--fmu", str(fmu_path), "--out", str(tmp_path / "out")]) == 2
     assert words in _one_error_line(capsys)
+    assert list(tmp_path.iterdir()) == []  # checked before the output folder is made
+
+
+@pytest.mark.parametrize("argv", [["--me"], ["--fmi", "2", "--me"]])
+def test_model_exchange_of_the_project_s_fmu_needs_fmi_3_before_anything_is_built(tmp_path, capsys, argv):
+    assert main(["simulate", *argv, "--build-dir", str(tmp_path / "fmus"), "--out", str(tmp_path / "out")]) == 2
+    assert "--me needs --fmi 3: the project's FMI 2.0 FMU is co-simulation only" in _one_error_line(capsys)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_value_the_fmu_refuses_is_one_line_with_the_fmu_s_reason(fmu_path, tmp_path, capsys):

@@ -1,34 +1,86 @@
-"""The FMUs a command uses: where they are kept unless ``--fmu`` says, which files ``build`` writes with them,
-whether they are current, and opening them (built first if missing or stale)."""
+"""The FMUs a command uses and the options that choose them: an FMU the user names (``--fmu``: read, never built
+or written) or the project's, kept together in a build folder (``--build-dir``, else ``build/`` in the project's
+folder, else ``OUT/fmu/``) and built there when missing or stale; which files ``build`` writes with them, whether
+they are current, and opening them."""
 
 from __future__ import annotations
 
+import argparse
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from ..component.variables import INTERFACES
 from ..fmu.build.fmi2 import DEFAULT_FMU_PATH
 from ..fmu.build.loader import LoaderUnavailable
 from ..fmu.build.systems import build_all
+from ..fmu.running.choice import FmuPathError, given_fmu, is_project_folder, read_pendulum_fmu
 from .common import CliError
 
+BUILD_DIR_HELP = (f"the folder the project's FMUs are built and kept in, all of them, built there when one is "
+                  f"missing or older than the sources (default: {DEFAULT_FMU_PATH.parent}/ in the project's folder, "
+                  "elsewhere OUT/fmu/); not with --fmu")
 
-def is_project_folder(folder: Path) -> bool:
-    """Whether ``folder`` is this project's own source folder (its pyproject.toml names the project), where
-    the README's commands keep the FMUs in ``build/``."""
-    pyproject = folder / "pyproject.toml"
-    try:
-        return 'name = "double-pendulum-fmu"' in pyproject.read_text(encoding="utf-8")
-    except OSError:
-        return False
+
+@dataclass(frozen=True)
+class FmuChoice:
+    """The FMU a command runs: ``path``, and whether the user ``given`` it (``--fmu``: it is read, never built or
+    written; ``description`` is its fmpy model description, checked to be the double pendulum's) or it is the
+    project's, kept with the other FMUs in its folder and built there when missing or stale."""
+
+    path: Path
+    given: bool
+    description: Any = None
+
+    @property
+    def folder(self) -> Path:
+        """The folder of the FMU (for the project's: the build folder)."""
+        return self.path.parent
+
+
+def add_fmu_options(parser: argparse.ArgumentParser, fmu_help: str) -> None:
+    """Add ``--fmu PATH`` (help ``fmu_help``), ``--build-dir DIR`` and ``--rebuild`` to a command's parser."""
+    parser.add_argument("--fmu", default=None, metavar="PATH", help=fmu_help)
+    parser.add_argument("--build-dir", default=None, metavar="DIR", help=BUILD_DIR_HELP)
+    parser.add_argument("--rebuild", action="store_true",
+                        help="rebuild the project's FMUs first, in the build folder (not with --fmu)")
 
 
 def default_fmu_path(out: Path) -> Path:
-    """Where ``run`` keeps the FMUs unless ``--fmu`` says: ``build/DoublePendulum.fmu`` in the project's own
+    """Where a command keeps the FMUs unless ``--build-dir`` says: ``build/DoublePendulum.fmu`` in the project's own
     folder, elsewhere ``OUT/fmu/DoublePendulum.fmu``, so that a run from any other folder writes only into
     its ``--out`` folder."""
     if is_project_folder(Path.cwd()):
         return DEFAULT_FMU_PATH
     return out / "fmu" / DEFAULT_FMU_PATH.name
+
+
+def choose_fmu(args: argparse.Namespace) -> FmuChoice:
+    """The FMU the command's options name (``--fmu``, ``--build-dir``, ``--rebuild``, ``--out``), checked before
+    anything is written: a given FMU must be there and be a usable FMU of the double pendulum; ``--fmu`` excludes
+    ``--build-dir`` and ``--rebuild``, which would build over it. Misuse is a CliError naming the path."""
+    if args.fmu is None:
+        if args.build_dir is None:
+            return FmuChoice(default_fmu_path(Path(args.out)), given=False)
+        if not args.build_dir.strip():
+            raise CliError("--build-dir needs a folder name (got an empty one); use --build-dir . for the current "
+                           "folder")
+        return FmuChoice(Path(args.build_dir) / DEFAULT_FMU_PATH.name, given=False)
+    if args.build_dir is not None:
+        raise CliError("--fmu and --build-dir exclude each other: --fmu runs an FMU file you have, as it is; "
+                       "--build-dir DIR builds the project's FMUs in DIR")
+    if args.rebuild:
+        raise CliError("--rebuild and --fmu exclude each other: --fmu runs an FMU file you have and never builds "
+                       "over it (--build-dir DIR --rebuild rebuilds the project's FMUs in DIR)")
+    try:
+        path = given_fmu(args.fmu)
+    except FmuPathError as error:
+        raise CliError(f"--fmu {error} (--fmu reads an FMU you have and never builds one; --build-dir DIR "
+                       "builds the project's FMUs in DIR)") from None
+    try:
+        return FmuChoice(path, given=True, description=read_pendulum_fmu(path))
+    except FmuPathError as error:
+        raise CliError(str(error)) from None
 
 
 def fmu_set(fmu: Path) -> list[Path]:
@@ -59,27 +111,33 @@ def fmu_set_is_current(fmu: Path) -> bool:
     ) and all(source.stat().st_mtime <= fmi3.stat().st_mtime for source in fmi3_sources())
 
 
-def load_fmu(path: str, rebuild: bool):
-    """Build the FMUs if the FMU or the rest of its set is missing or stale (:func:`fmu_set_is_current`), then
-    open the FMU with fmpy; unusable files become a CliError."""
+def build_fmus(folder: Path, rebuild: bool) -> None:
+    """Build the project's FMUs (:func:`fmu_set`) in the build folder ``folder``; a failure is a CliError."""
+    why = "--rebuild" if rebuild else "missing or older than the sources"
+    print(f"building the FMUs in {folder} ({why}) ...", flush=True)
+    try:
+        build_all(folder / DEFAULT_FMU_PATH.name)
+    except LoaderUnavailable as error:
+        raise CliError(f"cannot build the FMUs: {error}") from None
+    except OSError as error:
+        raise CliError(f"cannot build the FMUs in {folder}: {error.strerror or error} "
+                       "(pass --build-dir DIR to build them elsewhere)") from None
+
+
+def load_fmu(choice: FmuChoice, rebuild: bool):
+    """Open the chosen FMU with fmpy: a given one as it is; the project's after building the FMUs in its folder if
+    ``rebuild`` or if one of them is missing or stale (:func:`fmu_set_is_current`). Unusable files become a
+    CliError."""
     import zipfile
 
     from ..fmu.running.runner import FmuRunner
 
-    fmu = Path(path)
-    if rebuild or not fmu_set_is_current(fmu):
-        print(f"building the FMUs next to {fmu} (missing or older than the sources) ...", flush=True)
-        try:
-            build_all(fmu)
-        except LoaderUnavailable as error:
-            raise CliError(f"cannot build the FMUs: {error}") from None
-        except OSError as error:
-            raise CliError(f"cannot build the FMU at {fmu}: {error.strerror or error} "
-                           "(pass --fmu PATH to build it elsewhere)") from None
+    if not choice.given and (rebuild or not fmu_set_is_current(choice.path)):
+        build_fmus(choice.folder, rebuild)
+    hint = "" if choice.given else "; delete it or pass --rebuild"
     try:
-        return FmuRunner(fmu)
+        return FmuRunner(choice.path)
     except (zipfile.BadZipFile, KeyError, OSError) as error:
-        raise CliError(f"{fmu} is not a usable FMU ({type(error).__name__}: {error}); "
-                       "delete it or pass --rebuild") from None
+        raise CliError(f"{choice.path} is not a usable FMU ({type(error).__name__}: {error}){hint}") from None
     except Exception as error:  # fmpy's own validation errors
-        raise CliError(f"{fmu} is not a usable FMU: {error}") from None
+        raise CliError(f"{choice.path} is not a usable FMU: {error}{hint}") from None

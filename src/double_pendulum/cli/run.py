@@ -14,12 +14,11 @@ import time
 from pathlib import Path
 
 from .. import __version__
-from ..fmu.build.fmi2 import DEFAULT_FMU_PATH
 from ..runs.interrupts import acknowledge, interrupted
 from ..runs.lines import failed_line, header_line, wrote_line
 from .catalogue import check_scenarios, scenario_description, scenario_listing
 from .common import PROG, CliError, private_tempdir, writable_folder
-from .fmus import default_fmu_path, load_fmu
+from .fmus import FmuChoice, add_fmu_options, choose_fmu, load_fmu
 
 
 def _indices(index: str | None, count: int) -> list[str]:
@@ -104,13 +103,13 @@ def _cpu_seconds() -> float:
     return total + children.ru_utime + children.ru_stime
 
 
-def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: Path) -> list[str]:
-    """Run the scenarios one after another in this process, in the order given; return the names of those
-    that failed."""
+def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: Path, fmu: FmuChoice) -> list[str]:
+    """Run the scenarios one after another in this process through the FMU ``fmu``, in the order given; return
+    the names of those that failed."""
     failed = []
     order = list(names)
     indices = _indices(args.index, len(order))
-    with load_fmu(args.fmu, args.rebuild) as runner:
+    with load_fmu(fmu, args.rebuild) as runner:
         for index, name in zip(indices, order):
             print(header_line(index, name, scenario_description(name)), flush=True)
             module = importlib.import_module(f"double_pendulum.scenarios.{name}")
@@ -129,12 +128,14 @@ def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: 
     return [name for name in names if name in failed]
 
 
-def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path, jobs: int) -> list[str]:
-    """Build the FMU if needed, then run the scenarios in child processes, ``jobs`` at a time."""
+def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path, fmu: FmuChoice,
+                     jobs: int) -> list[str]:  # fmt: skip
+    """Build the project's FMUs if needed (not a given FMU), then run the scenarios in child processes, ``jobs`` at a
+    time, each given the FMU by ``--fmu`` (which it only reads)."""
     from ..runs.pool import Costs, run_in_children
     from ..scenarios import EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF
 
-    load_fmu(args.fmu, args.rebuild).close()  # build once here, and fail early on an unusable FMU
+    load_fmu(fmu, args.rebuild).close()  # build once here, and fail early on an unusable FMU
     if args.quick:
         print(f"running {len(names)} scenarios in {jobs} processes, each running its share one after another",
               flush=True)
@@ -143,7 +144,7 @@ def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path
         print(f"running {len(names)} scenarios, {jobs} at a time in their own processes, the longest first"
               + (f" ({', '.join(after)} in one process: it reads its cached fits)" if after else ""), flush=True)
     costs = Costs(EXPECTED_CPU_S, EXPECTED_QUICK_CPU_S, READS_FITS_OF)
-    return run_in_children(names, out, Path(args.fmu), costs, quick=args.quick, thorough=args.thorough, jobs=jobs)
+    return run_in_children(names, out, fmu.path, costs, quick=args.quick, thorough=args.thorough, jobs=jobs)
 
 
 def _run_command(args: argparse.Namespace) -> str:
@@ -169,15 +170,15 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise CliError("--quick and --thorough exclude each other")
     if args.jobs is not None and args.jobs < 1:
         raise CliError(f"--jobs must be at least 1, got {args.jobs}")
+    fmu = choose_fmu(args)  # before --out is made: a given FMU that is missing or unusable changes nothing
     out = writable_folder(args.out)
-    if args.fmu is None:
-        args.fmu = str(default_fmu_path(out))
     from ..runs.workers import default_workers  # one scenario per core this process may use
 
     jobs = min(len(names), args.jobs or default_workers())
     started, start, cpu_start = datetime.datetime.now(datetime.UTC), time.perf_counter(), _cpu_seconds()
     with private_tempdir():
-        failed = _run_in_children(names, args, out, jobs) if jobs > 1 else _run_in_this_process(names, args, out)
+        failed = (_run_in_children(names, args, out, fmu, jobs) if jobs > 1
+                  else _run_in_this_process(names, args, out, fmu))
     wall_s, cpu_s = time.perf_counter() - start, _cpu_seconds() - cpu_start
     if len(names) > 1 and args.index is None:  # a child of run_in_children leaves the sum to its parent
         print(f"{len(names) - len(failed)} of {len(names)} scenarios wrote {out} in "
@@ -206,11 +207,10 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:
     p_run.add_argument("scenarios", nargs="+", metavar="SCENARIO",
                        help="scenario names (see below), or 'all' alone")
     p_run.add_argument("--out", default="results", help="output folder (default: results)")
-    p_run.add_argument("--fmu", default=None,
-                       help=f"FMU to use, built with the other FMUs next to it if missing or older than the sources "
-                       f"(default: {DEFAULT_FMU_PATH} in the project's folder, elsewhere OUT/fmu/"
-                       f"{DEFAULT_FMU_PATH.name})")
-    p_run.add_argument("--rebuild", action="store_true", help="rebuild the FMU first")
+    add_fmu_options(p_run, "an FMU file of the double pendulum to run instead of the project's: read as it is, "
+                    "never built or written (an error if it is missing or not usable); a scenario that needs "
+                    "another FMU (cosimulation: Suspension.fmu) takes the current one beside it, else builds one in "
+                    "the run's temporary folder")
     p_run.add_argument("--quick", action="store_true", help="short runs, for smoke tests (about 30 s for all)")
     p_run.add_argument("--thorough", action="store_true",
                        help="heavier, publication-grade settings where a scenario has them (chaos, "

@@ -4,10 +4,29 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from .common import PROG, CliError, positive, private_tempdir, writable_folder
-from .fmus import default_fmu_path, load_fmu
+from .fmus import FmuChoice, add_fmu_options, choose_fmu, load_fmu
+
+
+def check_fmi(args: argparse.Namespace, fmu: FmuChoice) -> None:
+    """Check ``--fmi`` and ``--me`` against the FMU: a given FMU's FMI version is its own (``--fmi``, if given,
+    must match it), and it must have the interface asked for (Model Exchange with ``--me``, else Co-Simulation);
+    the project's FMU is FMI 2.0 co-simulation, or with ``--fmi 3`` the FMI 3.0 one with both. A CliError if not."""
+    if not fmu.given:
+        if args.me and args.fmi != "3":
+            raise CliError("--me needs --fmi 3: the project's FMI 2.0 FMU is co-simulation only")
+        return
+    md = fmu.description
+    version = md.fmiVersion.split(".")[0]
+    if args.fmi is not None and args.fmi != version:
+        raise CliError(f"--fmi {args.fmi} does not match {fmu.path}: it is an FMI {md.fmiVersion} FMU (with --fmu "
+                       "the FMU's own version is used: leave --fmi out)")
+    if args.me and md.modelExchange is None:
+        raise CliError(f"--me needs an FMU with Model Exchange: {fmu.path} (FMI {md.fmiVersion}) is co-simulation "
+                       "only")
+    if not args.me and md.coSimulation is None:
+        raise CliError(f"{fmu.path} (FMI {md.fmiVersion}) is model exchange only: pass --me")
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
@@ -17,18 +36,21 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from ..case import Case, run_case, start_state_words
     from ..fmu.running.start_values import StartValueError, parse_start_values
 
-    if args.me and args.fmi != "3":
-        raise CliError("--me needs --fmi 3: the FMI 2.0 FMU is co-simulation only")
+    chosen = choose_fmu(args)  # before --out is made: a given FMU that is missing or unusable changes nothing
+    check_fmi(args, chosen)
     stop, step = positive("--stop", args.stop), positive("--step", args.step)
     if step > stop:
         raise CliError(f"--step {step:g} s is longer than the run (--stop {stop:g} s)")
     out = writable_folder(args.out)
-    fmu2 = Path(args.fmu) if args.fmu is not None else default_fmu_path(out)
     with private_tempdir():
-        load_fmu(str(fmu2), args.rebuild).close()  # builds the FMUs if they are missing or stale
-        fmu = fmu2 if args.fmi == "2" else fmu2.parent / "fmi3" / fmu2.name
+        if chosen.given:
+            fmu, md = chosen.path, chosen.description
+        else:
+            load_fmu(chosen, args.rebuild).close()  # builds the FMUs if they are missing or stale
+            fmu = chosen.path if args.fmi != "3" else chosen.folder / "fmi3" / chosen.path.name
+            md = read_model_description(str(fmu))
         try:
-            values = parse_start_values(args.set, read_model_description(str(fmu)))
+            values = parse_start_values(args.set, md)
         except StartValueError as error:
             raise CliError(str(error)) from None
         case = Case(fmu, values, stop, step, "ModelExchange" if args.me else "CoSimulation")
@@ -63,13 +85,15 @@ def add_simulate_parser(sub: argparse._SubParsersAction) -> None:
     p_sim.add_argument("--stop", type=float, default=10.0, metavar="SECONDS", help="stop time (default: 10)")
     p_sim.add_argument("--step", type=float, default=0.01, metavar="SECONDS",
                        help="output interval, also the co-simulation step (default: 0.01)")
-    p_sim.add_argument("--fmi", choices=("2", "3"), default="2", help="FMI version of the FMU (default: 2)")
+    p_sim.add_argument("--fmi", choices=("2", "3"), default=None,
+                       help="FMI version of the project's FMU: 2 (the default), or 3 for fmi3/DoublePendulum.fmu in "
+                       "the build folder; with --fmu the FMU's own version is used (a --fmi that differs is an error)")
     p_sim.add_argument("--me", action="store_true",
-                       help="model exchange (with --fmi 3): fmpy integrates the FMU with its own solver")
+                       help="model exchange: fmpy integrates the FMU with its own solver (the project's FMU: with "
+                       "--fmi 3; with --fmu: an FMU that has Model Exchange)")
     p_sim.add_argument("--out", default="results/simulate", help="output folder (default: results/simulate)")
-    p_sim.add_argument("--fmu", default=None,
-                       help="the FMI 2.0 FMU, built with the others next to it if missing or older than the sources "
-                       "(--fmi 3 uses fmi3/ next to it; default as for run)")
-    p_sim.add_argument("--rebuild", action="store_true", help="rebuild the FMUs first")
+    add_fmu_options(p_sim, "an FMU file of the double pendulum to run instead of the project's (FMI 2.0 or 3.0: "
+                    "its own version, read from its modelDescription): read as it is, never built or written (an "
+                    "error if it is missing or not usable)")
     p_sim.add_argument("--no-animation", action="store_true", help="write no simulation.gif")
     p_sim.set_defaults(func=cmd_simulate)
