@@ -5,6 +5,7 @@ FMUs are built in the build folder, ``--build-dir``."""
 
 from __future__ import annotations
 
+import importlib.util
 import shutil
 from pathlib import Path
 
@@ -152,3 +153,21 @@ def test_rebuild_rebuilds_in_the_build_folder(tmp_path, built_fmus, capsys, monk
     assert main([*argv, "--rebuild"]) == 0
     assert built == [build / "DoublePendulum.fmu"]
     assert f"building the FMUs in {build} (--rebuild) ..." in capsys.readouterr().out
+
+
+needs_dash = pytest.mark.skipif(importlib.util.find_spec("dash") is None,
+                                reason="Dash is not installed (pip install -e \".[app]\")")
+
+
+@needs_dash
+@pytest.mark.parametrize(("argv", "words"), [
+    (["--fmu", "models/nonexistent.fmu"], "--fmu models/nonexistent.fmu: no such file"),
+    (["--fmu", "models/Container.fmu"], "models/Container.fmu is not an FMU of the double pendulum"),
+    (["--fmu", "models/Other.fmu", "--build-dir", "models"], "--fmu and --build-dir exclude each other"),
+])  # fmt: skip
+def test_the_app_refuses_a_missing_or_foreign_fmu_in_one_line_and_changes_nothing(home, capsys, argv, words):
+    before = folder_state(home)
+    assert main(["app", *argv]) == 2
+    err = _one_error_line(capsys)
+    assert err.startswith("double-pendulum app: ") and words in err
+    assert folder_state(home) == before
