@@ -1,6 +1,6 @@
 """Print the core figures of the FMU: energy drift, cost per doStep through fmpy, start-up time.
 
-Usage: ``python benchmarks/core_figures.py [--fmu build/DoublePendulum.fmu]``
+Usage: ``python benchmarks/core_figures.py [--fmu PATH]``
 
 Timings are CPU times (``time.process_time``) on this machine; the median of several repeats
 is printed with the spread. Compare them as ratios within one run, not across machines.
@@ -14,7 +14,8 @@ import time
 
 import numpy as np
 
-from double_pendulum.fmu.running.runner import FmuRunner, ensure_fmu
+from double_pendulum.fmu.running.choice import fmu_to_run
+from double_pendulum.fmu.running.runner import FmuRunner
 
 
 def _median_spread(samples: list[float]) -> str:
@@ -68,10 +69,11 @@ def energy_drift(runner: FmuRunner) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--fmu", default="build/DoublePendulum.fmu")
+    parser.add_argument("--fmu", default=None, help="the FMU to measure, read and never built over (default: "
+                        "build/DoublePendulum.fmu, built there if missing or older than the sources)")
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
-    with FmuRunner(ensure_fmu(args.fmu)) as runner:
+    with FmuRunner(fmu_to_run(args.fmu)) as runner:
         print(f"energy drift, chaotic start, 30 s, dop853 rtol 1e-12: {energy_drift(runner):.2e} (relative)")
         steps = _median_spread(do_step_times(runner, args.repeats))
         print(f"doStep through fmpy, 1 ms step, dop853 rtol 1e-9:     {steps}")

@@ -1,6 +1,6 @@
 """Speed of the FMU, measured side by side in one run and printed as ratios (issue: performance).
 
-Usage: ``python benchmarks/fmu_performance.py [--fmu build/DoublePendulum.fmu] [--repeats 5]``
+Usage: ``python benchmarks/fmu_performance.py [--fmu PATH] [--repeats 5]``
 
 1. The FMU through fmpy versus SciPy ``solve_ivp(method="DOP853")`` called directly on the same
    vector field, each at the loosest tolerance that reaches an error <= 1e-8 at t = 3 s (chaotic
@@ -34,7 +34,8 @@ import numpy as np
 
 from double_pendulum.analysis.solvers.reference import STATE_OUTPUTS, reference_solution
 from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
-from double_pendulum.fmu.running.runner import FmuRunner, ensure_fmu
+from double_pendulum.fmu.running.choice import fmu_to_run
+from double_pendulum.fmu.running.runner import FmuRunner
 
 CHAOTIC = {"phi1_0": 2.0, "phi2_0": 2.0}
 STIFF = {"phi1_0": 1.0, "phi2_0": 1.0, "suspension": True, "M_s": 0.05, "k_x": 1e7, "k_y": 1e7,
@@ -208,10 +209,11 @@ def bench_stiff(runner: FmuRunner, repeats: int) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--fmu", default="build/DoublePendulum.fmu")
+    parser.add_argument("--fmu", default=None, help="the FMU to measure, read and never built over (default: "
+                        "build/DoublePendulum.fmu, built there if missing or older than the sources)")
     parser.add_argument("--repeats", type=int, default=5)
     args = parser.parse_args()
-    with tempfile.TemporaryDirectory() as tmp, FmuRunner(ensure_fmu(args.fmu)) as runner, \
+    with tempfile.TemporaryDirectory() as tmp, FmuRunner(fmu_to_run(args.fmu)) as runner, \
             FmuRunner(build_empty_fmu(Path(tmp))) as empty:
         bench_vs_scipy(runner, args.repeats)
         bench_do_step(runner, empty, args.repeats)

@@ -1,6 +1,6 @@
 """The FMU driven through its inputs: a motor torque at the pivot, at the slow mode's frequency and away from it.
 
-    python examples/drive_inputs.py [--stop 20] [--fmu build/DoublePendulum.fmu]
+    python examples/drive_inputs.py [--stop 20] [--fmu PATH]
 
 An input signal for fmpy is a structured array: a ``time`` column and one column per input, interpolated
 between its rows. Every input of the FMU is in it (the unused ones zero), so fmpy has no missing input to warn
@@ -16,7 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from fmpy import simulate_fmu  # noqa: E402
 
-from double_pendulum.fmu.running.runner import ensure_fmu  # noqa: E402
+from double_pendulum.fmu.running.choice import FmuPathError, fmu_to_run  # noqa: E402
 
 INPUTS = ("pivot_x", "pivot_y", "pivot_vx", "pivot_vy", "pivot_ax", "pivot_ay", "tau1", "tau2")
 TORQUE_N_M = 0.002  # amplitude of the motor torque on the upper rod
@@ -34,10 +34,14 @@ def torque_signal(omega: float, stop: float) -> np.ndarray:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stop", type=float, default=20.0, help="length of each run [s] (default: 20)")
-    parser.add_argument("--fmu", default="build/DoublePendulum.fmu", help="the FMU (built there if missing)")
+    parser.add_argument("--fmu", default=None, help="an FMU of the double pendulum to run, read and never built "
+                        "over (default: build/DoublePendulum.fmu, built there if missing or older than the sources)")
     parser.add_argument("--out", default="drive_inputs.png", help="the figure to write")
     args = parser.parse_args()
-    fmu = str(ensure_fmu(args.fmu))
+    try:  # a path given is only read; the default is built first if missing or older than the sources
+        fmu = str(fmu_to_run(args.fmu))
+    except FmuPathError as error:
+        parser.exit(2, f"{parser.prog}: error: --fmu {error}\n")
 
     fig, (ax_angle, ax_work) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True, layout="constrained")
     for omega in (SLOW_MODE_RAD_S, 0.6 * SLOW_MODE_RAD_S):

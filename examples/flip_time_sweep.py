@@ -1,6 +1,6 @@
 """How long until the lower rod first turns over, for every pair of start angles: a parameter sweep.
 
-    python examples/flip_time_sweep.py [--grid 24] [--stop 10] [--workers N] [--fmu build/DoublePendulum.fmu]
+    python examples/flip_time_sweep.py [--grid 24] [--stop 10] [--workers N] [--fmu PATH]
 
 ``run_sweep`` runs the FMU once per case (a dict of start values) on worker processes, one per core, and gives
 the results back in the order of the cases. ``reduce`` is applied on the worker, so only one number per run
@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from double_pendulum.analysis.sweep import grid_cases, run_sweep  # noqa: E402
-from double_pendulum.fmu.running.runner import ensure_fmu  # noqa: E402
+from double_pendulum.fmu.running.choice import FmuPathError, fmu_to_run  # noqa: E402
 
 
 def first_flip_s(result: np.ndarray) -> float:
@@ -31,13 +31,18 @@ def main() -> None:
     parser.add_argument("--grid", type=int, default=24, help="start angles per axis (default: 24)")
     parser.add_argument("--stop", type=float, default=10.0, help="length of each run [s] (default: 10)")
     parser.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core)")
-    parser.add_argument("--fmu", default="build/DoublePendulum.fmu", help="the FMU (built there if missing)")
+    parser.add_argument("--fmu", default=None, help="an FMU of the double pendulum to run, read and never built "
+                        "over (default: build/DoublePendulum.fmu, built there if missing or older than the sources)")
     parser.add_argument("--out", default="flip_times.png", help="the figure to write")
     args = parser.parse_args()
+    try:  # a path given is only read; the default is built first if missing or older than the sources
+        fmu = str(fmu_to_run(args.fmu))
+    except FmuPathError as error:
+        parser.exit(2, f"{parser.prog}: error: --fmu {error}\n")
 
     angles = np.linspace(-3.0, 3.0, args.grid)  # rad, both rods released from rest
     cases = grid_cases({"solver": "dop853", "rtol": 1e-8}, phi1_0=angles, phi2_0=angles)
-    times = run_sweep(ensure_fmu(args.fmu), cases, stop_time=args.stop, output_interval=0.01,
+    times = run_sweep(fmu, cases, stop_time=args.stop, output_interval=0.01,
                       outputs=("phi1", "phi2"), reduce=first_flip_s, max_workers=args.workers)
     grid = np.array(times).reshape(len(angles), len(angles))  # rows: phi1_0, columns: phi2_0
 

@@ -8,7 +8,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from conftest import REPO
+from conftest import REPO, folder_state, users_folder
 
 EXAMPLES = REPO / "examples"
 
@@ -35,8 +35,13 @@ def test_the_flip_time_sweep_runs_on_worker_processes(fmu_path, tmp_path):
     assert (tmp_path / "flips.png").stat().st_size > 10_000
 
 
-def test_the_driven_pendulum_takes_energy_from_the_motor_at_resonance(fmu_path, tmp_path):
-    out = _run("drive_inputs.py", "--stop", "4", "--fmu", str(fmu_path), "--out", "driven.png", cwd=tmp_path)
+def test_the_driven_pendulum_takes_energy_from_the_motor_at_resonance(built_fmus, tmp_path):
+    """Through a user's FMU dated 2020 (older than the sources), which the example reads and never builds over."""
+    home = users_folder(tmp_path / "home", built_fmus)
+    before = folder_state(home)
+    out = _run("drive_inputs.py", "--stop", "4", "--fmu", str(home / "models" / "Other.fmu"), "--out", "driven.png",
+               cwd=tmp_path)
+    assert folder_state(home) == before
     lines = {line.split(":")[0]: line for line in out.splitlines()}
     fed = {name: float(line.split("work fed in ")[1].split()[0]) for name, line in lines.items() if "work" in line}
     at, off = fed["torque at 4.81 rad/s"], fed["torque at 2.89 rad/s"]

@@ -6,11 +6,14 @@ FMUs are built in the build folder, ``--build-dir``."""
 from __future__ import annotations
 
 import importlib.util
+import os
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
-from conftest import BUILT_FMUS, folder_state, users_folder
+from conftest import BUILT_FMUS, REPO, folder_state, users_folder
 from fmpy import read_model_description
 
 from double_pendulum.cli import main
@@ -170,4 +173,15 @@ def test_the_app_refuses_a_missing_or_foreign_fmu_in_one_line_and_changes_nothin
     assert main(["app", *argv]) == 2
     err = _one_error_line(capsys)
     assert err.startswith("double-pendulum app: ") and words in err
+    assert folder_state(home) == before
+
+
+def test_an_example_refuses_a_missing_fmu_in_one_line_and_changes_nothing(home):
+    before = folder_state(home)
+    env = {**os.environ, "MPLBACKEND": "Agg", "DOUBLE_PENDULUM_PROGRESS": "off"}
+    done = subprocess.run([sys.executable, str(REPO / "examples" / "drive_inputs.py"), "--fmu",
+                           "models/nonexistent.fmu", "--out", "driven.png"], cwd=home, env=env, capture_output=True,
+                          text=True)  # fmt: skip
+    assert done.returncode == 2 and done.stdout == ""
+    assert done.stderr == "drive_inputs.py: error: --fmu models/nonexistent.fmu: no such file\n"
     assert folder_state(home) == before
