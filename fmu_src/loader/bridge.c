@@ -11,22 +11,23 @@
 
 #define PY_FILE_INPUT 257 /* Py_file_input */
 
-/* Load the FMU's package `package` (the folder resources/<package>/) and its entry module `entry`
- * (resources/<entry>.py) under their own (private) names, once per process, and take the entry's
- * bridge.  The folder's path crosses as bytes (os.fsdecode: it names the same folder whatever the file
- * system encoding of a Python host).  Nothing is put on sys.path; the modules stay in sys.modules, so an FMU unloaded and loaded
+/* Load the FMU's package `package` and its entry module `entry` from the zip resources/<archive> (the FMU's code,
+ * fmu/build/bundle.py) under their own (private) names, once per process, and take the entry's bridge.  The
+ * folder's path crosses as bytes (os.fsdecode: it names the same folder whatever the file system encoding of a
+ * Python host).  Nothing is put on sys.path; the modules stay in sys.modules, so an FMU unloaded and loaded
  * again, or extracted again elsewhere, finds them there.  One thread at a time loads (the lock lives in
  * sys.modules, shared by every FMU of this project): another sees a module only once it is complete. */
 static const char BOOTSTRAP[] =
-    "import os, sys, threading, types\n"
+    "import os, sys, threading, types, zipimport\n"
     "resources = os.fsdecode(resources)  # the folder's bytes, whatever the file system encoding\n"
     "loading = sys.modules.setdefault('_dp_fmu_loading', types.ModuleType('_dp_fmu_loading'))\n"
     "with vars(loading).setdefault('lock', threading.RLock()):\n"
-    "    for name, path, folder in ((package, resources + '/' + package + '/__init__.py', [resources + '/' + package]),\n"
-    "                               (entry, resources + '/' + entry + '.py', None)):\n"
+    "    for name in (package, entry):\n"
     "        if name not in sys.modules:\n"
     "            import importlib.util\n"
-    "            spec = importlib.util.spec_from_file_location(name, path, submodule_search_locations=folder)\n"
+    "            spec = zipimport.zipimporter(os.path.join(resources, archive)).find_spec(name)\n"
+    "            if spec is None:\n"
+    "                raise ImportError(f'{name} is not in {os.path.join(resources, archive)}')\n"
     "            module = importlib.util.module_from_spec(spec)\n"
     "            sys.modules[name] = module\n"
     "            try:\n"
@@ -232,8 +233,9 @@ static int call_bridge(guard_instance *g, PyObject *bridge, bridge_payload paylo
     return status;
 }
 
-int bridge_instantiate(guard_instance *g, const python_api *py, const char *resources, const char *package,
-                       const char *entry, const char *interface, int visible, PyObject **instance) {
+int bridge_instantiate(guard_instance *g, const python_api *py, const char *resources, const char *archive,
+                       const char *package, const char *entry, const char *interface, int visible,
+                       PyObject **instance) {
     g->api = py;
     answer_notes notes = {0};
     int gil = py->GILState_Ensure();
@@ -241,10 +243,12 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
     PyObject *resources_text = py->Bytes_FromStringAndSize(resources, (ssize_t)strlen(resources));
     PyObject *entry_text = py->Unicode_FromString(entry);
     PyObject *package_text = py->Unicode_FromString(package);
+    PyObject *archive_text = py->Unicode_FromString(archive);
     PyObject *code = py->CompileString(BOOTSTRAP, "<double-pendulum-fmu loader>", PY_FILE_INPUT);
     PyObject *bridge = NULL;
-    if (globals && resources_text && entry_text && package_text && code &&
+    if (globals && resources_text && entry_text && package_text && archive_text && code &&
         py->Dict_SetItemString(globals, "resources", resources_text) == 0 &&
+        py->Dict_SetItemString(globals, "archive", archive_text) == 0 &&
         py->Dict_SetItemString(globals, "package", package_text) == 0 &&
         py->Dict_SetItemString(globals, "entry", entry_text) == 0) {
         PyObject *done = py->Eval_EvalCode(code, globals, globals);
@@ -259,6 +263,7 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
     if (code) py->DecRef(code);
     if (entry_text) py->DecRef(entry_text);
     if (package_text) py->DecRef(package_text);
+    if (archive_text) py->DecRef(archive_text);
     if (resources_text) py->DecRef(resources_text);
     py->GILState_Release(gil);
     if (!bridge) {

@@ -38,11 +38,12 @@ typedef struct {
  * own interrupt is raised again once the call returns (a Python host then sees KeyboardInterrupt). */
 #define BRIDGE_INTERRUPTED 5
 
-/* Make the Python instance of g: load the FMU's package `package` and entry module `entry` from
- * `resources` (once per process) and call the entry's bridge's instantiate(resources, name, interface,
+/* Make the Python instance of g: load the FMU's package `package` and entry module `entry` from the zip
+ * `resources`/`archive` (once per process) and call the entry's bridge's instantiate(resources, name, interface,
  * visible).  Returns the status; on success *instance is the new Python object. */
-int bridge_instantiate(guard_instance *g, const python_api *api, const char *resources, const char *package,
-                       const char *entry, const char *interface, int visible, PyObject **instance);
+int bridge_instantiate(guard_instance *g, const python_api *api, const char *resources, const char *archive,
+                       const char *package, const char *entry, const char *interface, int visible,
+                       PyObject **instance);
 
 /* Call method `method` of g's Python object with the arguments `format` (Py_BuildValue's, always a
  * tuple: "()", "(dd)", "(y#)" with Py_ssize_t lengths ...) and take its payload.  Returns the status

@@ -33,11 +33,11 @@ typedef struct {
 static guard_state *known(guard_instance *g, void *s) {
     if (!s) return guard_fail(g, "%s: the FMU state is NULL", g->function), NULL;
     char owner[256] = "";
-    pthread_mutex_lock(&fmu_states.lock);
+    platform_lock(&fmu_states.lock);
     int live = pointer_set_has_locked(&fmu_states, s);
     int foreign = live && ((guard_state *)s)->owner != g;
     if (foreign) guard_format(owner, sizeof owner, "%s", ((guard_state *)s)->owner->name);
-    pthread_mutex_unlock(&fmu_states.lock);
+    platform_unlock(&fmu_states.lock);
     if (!live)
         return guard_fail(g, "%s: FMU state %p is not a live state of this FMU (freed, or from another FMU)",
                           g->function, s), NULL;
@@ -51,13 +51,13 @@ static guard_state *new_state(guard_instance *g, PyObject *python, guard_positio
     guard_state *s = calloc(1, sizeof *s);
     if (!s) return NULL;
     *s = (guard_state){g, python, at, NULL, 0, NULL, g->states};
-    pthread_mutex_lock(&fmu_states.lock);
+    platform_lock(&fmu_states.lock);
     int added = pointer_set_add_locked(&fmu_states, s);
     if (added) {
         if (g->states) g->states->previous = s;
         g->states = s;
     }
-    pthread_mutex_unlock(&fmu_states.lock);
+    platform_unlock(&fmu_states.lock);
     if (!added) free(s);
     return added ? s : NULL;
 }
@@ -106,12 +106,12 @@ int guard_free_state(guard_instance *g, void **FMUstate) {
     if (!*FMUstate) return STATUS_OK; /* nothing to free */
     guard_state *s = known(g, *FMUstate);
     if (!s) return STATUS_ERROR;
-    pthread_mutex_lock(&fmu_states.lock);
+    platform_lock(&fmu_states.lock);
     pointer_set_remove_locked(&fmu_states, s);
     if (s->previous) s->previous->next = s->next;
     else g->states = s->next;
     if (s->next) s->next->previous = s->previous;
-    pthread_mutex_unlock(&fmu_states.lock);
+    platform_unlock(&fmu_states.lock);
     replace_python(g, s, NULL, s->at);
     free(s);
     *FMUstate = NULL;

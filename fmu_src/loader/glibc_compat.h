@@ -9,11 +9,13 @@
  * --no-as-needed) and does not call stat at all.  The floor is glibc 2.17 (CentOS 7,
  * manylinux2014); tests/test_loader_symbols.py fails when a build asks for anything newer.
  *
- * Included first by every loader source. */
+ * Included first by every loader source; it does nothing where the C library is not glibc (Windows). */
 #ifndef GLIBC_COMPAT_H
 #define GLIBC_COMPAT_H
 
+#if defined(__linux__)
 #include <features.h> /* defines __GLIBC__ */
+#endif
 
 #if defined(__linux__) && defined(__GLIBC__)
 #if defined(__x86_64__)

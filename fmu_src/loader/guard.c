@@ -4,19 +4,16 @@
 
 #include "guard.h"
 
-#include <errno.h>
-#include <fcntl.h>
-#include <limits.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "bridge.h"
+#include "text.h"
 
-#define IDENTITY_FILE "identity.cfg" /* in resources/, written by the build: model, token, entry */
+#define IDENTITY_FILE "identity.cfg" /* in resources/, written by the build: model, token, archive, entry */
 
 /* ------------------------------------------------------------------------------- instances */
 
@@ -32,10 +29,10 @@ guard_instance *guard_acquire(void *c, const char *model_identifier, const char 
         guard_orphan(model_identifier, function, "the instance is NULL");
         return NULL;
     }
-    pthread_mutex_lock(&instances.lock);
+    platform_lock(&instances.lock);
     int live = pointer_set_has_locked(&instances, c);
     if (live) ((guard_instance *)c)->references++;
-    pthread_mutex_unlock(&instances.lock);
+    platform_unlock(&instances.lock);
     if (!live) {
         guard_orphan(model_identifier, function,
                      "%p is not a live instance of this FMU (freed, or never instantiated here)", c);
@@ -52,9 +49,9 @@ void guard_deliver_interrupt(guard_instance *g) {
 
 void guard_release(guard_instance *g) {
     guard_deliver_interrupt(g);
-    pthread_mutex_lock(&instances.lock);
+    platform_lock(&instances.lock);
     int last = --g->references == 0;
-    pthread_mutex_unlock(&instances.lock);
+    platform_unlock(&instances.lock);
     if (last) g->destroy(g);
 }
 
@@ -64,9 +61,9 @@ void guard_release_variable(void *variable) {
 }
 
 int guard_unregister(void *c) {
-    pthread_mutex_lock(&instances.lock);
+    platform_lock(&instances.lock);
     int live = c && pointer_set_remove_locked(&instances, c);
-    pthread_mutex_unlock(&instances.lock);
+    platform_unlock(&instances.lock);
     if (live) guard_release(c); /* the host's reference */
     return live;
 }
@@ -98,16 +95,17 @@ void guard_free_common(guard_instance *g) {
 
 /* ---------------------------------------------------------------------------- instantiation */
 
-/* resources/identity.cfg: the model, token, package and entry module of the FMU whose resources these are. */
+/* resources/identity.cfg: the model, token, code archive, package and entry module of the FMU whose resources
+ * these are. */
 typedef struct {
-    char model[256], token[256], package[256], entry[256];
+    char model[256], token[256], archive[256], package[256], entry[256];
 } identity;
 
 static int read_identity(const char *resources, identity *id) {
-    char path[PATH_MAX], line[512];
+    char path[PLATFORM_PATH_MAX], line[512];
     memset(id, 0, sizeof *id);
     if (snprintf(path, sizeof path, "%s/%s", resources, IDENTITY_FILE) >= (int)sizeof path) return 0;
-    FILE *file = fopen(path, "re");
+    FILE *file = platform_open_text(path);
     if (!file) return 0;
     while (fgets(line, sizeof line, file)) {
         line[strcspn(line, "\r\n")] = '\0';
@@ -115,11 +113,12 @@ static int read_identity(const char *resources, identity *id) {
         if (!value || line[0] == '#') continue;
         *value++ = '\0';
         char *field = strcmp(line, "model") == 0 ? id->model : strcmp(line, "token") == 0 ? id->token
-                      : strcmp(line, "entry") == 0 ? id->entry : strcmp(line, "package") == 0 ? id->package : NULL;
+                      : strcmp(line, "entry") == 0 ? id->entry : strcmp(line, "package") == 0 ? id->package
+                      : strcmp(line, "archive") == 0 ? id->archive : NULL;
         if (field) guard_format(field, sizeof id->model, "%s", value);
     }
     fclose(file);
-    return id->model[0] && id->token[0] && id->package[0] && id->entry[0];
+    return id->model[0] && id->token[0] && id->archive[0] && id->package[0] && id->entry[0];
 }
 
 int guard_check_instantiation(const guard_version *v, const char *name, const char *token, const char *location,
@@ -146,7 +145,7 @@ int guard_check_instantiation(const guard_version *v, const char *name, const ch
     else if ((bad = guard_utf8_error(resources)) >= 0)
         guard_format(why, why_size, "%s \"%.1000s\": the folder's path is not UTF-8 (byte %ld), which the FMU's "
                      "Python side cannot take", v->resources_name, location, bad);
-    else if (!guard_is_directory(resources))
+    else if (!platform_is_directory(resources))
         guard_format(why, why_size, "%s \"%.1000s\": there is no folder %.1000s", v->resources_name, location,
                      resources);
     else if (!read_identity(resources, &id))
@@ -164,12 +163,18 @@ int guard_check_instantiation(const guard_version *v, const char *name, const ch
 int guard_start_python(guard_instance *g, const char *resources, int visible) {
     char why[2048] = "";
     identity id;
-    const python_api *py = python_runtime_start(resources, why, sizeof why);
+    const char *chosen = NULL;
+    const python_api *py = python_runtime_start(resources, why, sizeof why, &chosen);
     if (!py) return guard_fail(g, "%s: %s", g->function, why), 0;
+    if (chosen) { /* with debug logging on: which Python runs the FMU, and why that one */
+        char line[sizeof why + 64];
+        guard_format(line, sizeof line, "%s: the FMU's Python side runs in %s", g->function, chosen);
+        guard_emit(g, STATUS_OK, "logAll", line);
+    }
     if (!read_identity(resources, &id))
         return guard_fail(g, "%s: %s/%s cannot be read", g->function, resources, IDENTITY_FILE), 0;
     PyObject *python = NULL;
-    int status = bridge_instantiate(g, py, resources, id.package, id.entry, g->interface, visible, &python);
+    int status = bridge_instantiate(g, py, resources, id.archive, id.package, id.entry, g->interface, visible, &python);
     if (status > STATUS_WARNING || !python) {
         if (python) bridge_release(g, python);
         return guard_fail(g, "%s: the FMU's Python side could not be instantiated (the message before says why)",
@@ -279,7 +284,11 @@ int guard_set_strings(guard_instance *g, const unsigned int vr[], size_t n, cons
     }
     char *joined = malloc(size ? size : 1), *at = joined;
     if (!joined) return guard_fail(g, "%s: out of memory", g->function);
-    for (size_t k = 0; k < n; k++) at = stpcpy(at, values[k]) + 1;
+    for (size_t k = 0; k < n; k++) {
+        size_t length = strlen(values[k]) + 1;
+        memcpy(at, values[k], length);
+        at += length;
+    }
     int status = guard_settle(g, bridge_call(g, NO_PAYLOAD, "set_strings", "(y#y#)", (const char *)vr,
                                              (ssize_t)(n * sizeof *vr), joined, (ssize_t)size));
     free(joined);
@@ -352,13 +361,10 @@ int guard_debug_categories(int *mask, int on, size_t n, const char *const catego
 }
 
 void guard_format(char *out, size_t size, const char *format, ...) {
-    if (!size) return;
     va_list args;
     va_start(args, format);
-    int n = vsnprintf(out, size, format, args);
+    text_vformat(out, size, format, args);
     va_end(args);
-    if (n < 0) out[0] = '\0';
-    else if ((size_t)n >= size && size > 4) memcpy(out + size - 4, "...", 4);
 }
 
 long guard_utf8_error(const char *text) {
@@ -381,23 +387,6 @@ long guard_utf8_error(const char *text) {
 
 /* ------------------------------------------------------------------------------- paths */
 
-int guard_is_directory(const char *path) {
-    int fd = open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-    if (fd < 0) return 0;
-    close(fd);
-    return 1;
-}
-
-int guard_is_file(const char *path) {
-    if (access(path, R_OK) != 0) return 0;
-    int fd = open(path, O_RDONLY | O_DIRECTORY | O_CLOEXEC); /* no stat: see glibc_compat.h */
-    if (fd >= 0) {
-        close(fd);
-        return 0;
-    }
-    return errno == ENOTDIR;
-}
-
 static int hex_value(char c) {
     return c >= '0' && c <= '9' ? c - '0' : c >= 'a' && c <= 'f' ? c - 'a' + 10 : c >= 'A' && c <= 'F' ? c - 'A' + 10 : -1;
 }
@@ -411,8 +400,9 @@ int guard_uri_to_path(const char *uri, char *path, size_t size) {
         else if (*p != '/') return 0; /* file://host/...: another machine */
     } else if (is_uri) {
         p += 5;
-    } else if (strchr(p, ':') && strchr(p, ':') < (strchr(p, '/') ? strchr(p, '/') : p + strlen(p))) {
-        return 0; /* another scheme */
+    } else {
+        size_t scheme = strspn(p, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789+.-");
+        if (scheme >= 2 && p[scheme] == ':') return 0; /* another scheme (one letter and a colon: a drive) */
     }
     size_t n = 0;
     for (; *p; p++) {
@@ -427,6 +417,7 @@ int guard_uri_to_path(const char *uri, char *path, size_t size) {
         }
     }
     path[n] = '\0';
-    while (n > 1 && path[n - 1] == '/') path[--n] = '\0';
+    if (is_uri) platform_uri_path(path), n = strlen(path);
+    while (n > 1 && platform_is_separator(path[n - 1])) path[--n] = '\0';
     return n > 0;
 }

@@ -12,9 +12,9 @@
 #ifndef GUARD_H
 #define GUARD_H
 
-#include <pthread.h>
 #include <stddef.h>
 
+#include "platform.h"
 #include "python_runtime.h"
 
 /* ------------------------------------------------------------------------- live pointers */
@@ -22,12 +22,12 @@
 /* A set of pointers (an open-addressing hash set under a mutex), for the instances and FMU states
  * this binary handed out: a pointer the host passes is dereferenced only if it is in the set. */
 typedef struct {
-    pthread_mutex_t lock;
+    platform_mutex lock;
     void **slots;
     size_t capacity, count, used; /* used: live entries and tombstones */
 } pointer_set;
 
-#define POINTER_SET_INIT {PTHREAD_MUTEX_INITIALIZER, NULL, 0, 0, 0}
+#define POINTER_SET_INIT {PLATFORM_MUTEX_INIT, NULL, 0, 0, 0}
 
 int pointer_set_add(pointer_set *set, void *pointer);    /* 0 if out of memory */
 int pointer_set_remove(pointer_set *set, void *pointer); /* 1 if it was in the set */
@@ -197,8 +197,6 @@ long guard_utf8_error(const char *text);
 
 /* ------------------------------------------------------------------------------- paths */
 
-int guard_is_directory(const char *path);
-int guard_is_file(const char *path); /* a readable file that is not a folder */
 /* A file URI (file:///p, file://localhost/p, file:/p), %XX decoded, or a plain path, to a path
  * without a trailing slash.  Returns 0 for a URI of another scheme or host, a malformed %-escape, a
  * NUL byte, or a path that does not fit. */

@@ -7,9 +7,21 @@
 #ifndef MODEL_IDENTIFIER
 #error "the build defines MODEL_IDENTIFIER"
 #endif
+#ifndef BUNDLED_PYTHON_LIBRARY /* a lean FMU: it finds a Python on the machine */
+#define BUNDLED_PYTHON_LIBRARY ""
+#define BUNDLED_PYTHON_STDLIB ""
+#define BUNDLED_PYTHON_MINOR 0
+#endif
+#ifndef BUNDLED_PYTHON_PRELOAD
+#define BUNDLED_PYTHON_PRELOAD ""
+#endif
 
 const char identity_model_identifier[] = MODEL_IDENTIFIER;
 const char identity_token[] = FMU_GUID;
 #ifdef N_CONTINUOUS_STATES
 const size_t identity_continuous_states = N_CONTINUOUS_STATES;
 #endif
+const char identity_python_library[] = BUNDLED_PYTHON_LIBRARY;
+const char identity_python_stdlib[] = BUNDLED_PYTHON_STDLIB;
+const int identity_python_minor = BUNDLED_PYTHON_MINOR;
+const char identity_python_preload[] = BUNDLED_PYTHON_PRELOAD;

@@ -49,9 +49,9 @@ int pointer_set_add_locked(pointer_set *set, void *pointer) {
 }
 
 int pointer_set_add(pointer_set *set, void *pointer) {
-    pthread_mutex_lock(&set->lock);
+    platform_lock(&set->lock);
     int ok = pointer_set_add_locked(set, pointer);
-    pthread_mutex_unlock(&set->lock);
+    platform_unlock(&set->lock);
     return ok;
 }
 
@@ -79,15 +79,15 @@ int pointer_set_remove_locked(pointer_set *set, void *pointer) {
 int pointer_set_has_locked(pointer_set *set, void *pointer) { return find(set, pointer) != NULL; }
 
 int pointer_set_remove(pointer_set *set, void *pointer) {
-    pthread_mutex_lock(&set->lock);
+    platform_lock(&set->lock);
     int removed = pointer_set_remove_locked(set, pointer);
-    pthread_mutex_unlock(&set->lock);
+    platform_unlock(&set->lock);
     return removed;
 }
 
 int pointer_set_has(pointer_set *set, void *pointer) {
-    pthread_mutex_lock(&set->lock);
+    platform_lock(&set->lock);
     int found = pointer_set_has_locked(set, pointer);
-    pthread_mutex_unlock(&set->lock);
+    platform_unlock(&set->lock);
     return found;
 }

@@ -1,25 +1,27 @@
-/* Find, load and start the CPython that runs the FMU's Python side, in any host process, and give the
- * rest of the loader the few functions of its C API it calls (bridge.c).
+/* Choose the CPython that runs the FMU's Python side, in any host process, start it if it is not running
+ * yet (python_start.c), and give the rest of the loader the few functions of its C API it calls
+ * (bridge.c).
  *
- * The loader does not link libpython: the Python is chosen at run time (docs/fmu.md, "Use the FMU in
- * other FMI tools"):
+ * The loader does not link libpython: the Python is chosen at run time (docs/fmu.md, "What a target
+ * machine needs"), one per process:
  *
- *  1. a CPython already in the process (every Python host) is used as it is: nothing is loaded,
- *     nothing is changed;
- *  2. otherwise one is found, in this order: the interpreter or libpython named by the environment
- *     variable DOUBLE_PENDULUM_FMU_PYTHON (if set, it is the only candidate); the interpreter the FMU
- *     was built with (resources/python.cfg); python3 on PATH.  A candidate must be CPython >= 3.11
- *     with a shared libpython.  An interpreter is asked about itself by running it (bounded by
- *     QUERY_TIMEOUT_MS, in a process group of its own that is killed whole: nothing is left behind);
- *  3. its libpython is loaded privately, checked, then made global, and initialised with that Python's
- *     own home, in UTF-8 mode (file names decode in any locale), without touching the host: no signal
- *     handlers, no change of its locale (configure_locale = 0), no environment variable read or set,
- *     no site-packages.  It stays loaded until the process ends and is never finalised.
+ *  1. a CPython already in the process is used as it is: a Python host's own interpreter, or the one an
+ *     earlier FMU started.  Nothing is loaded, nothing is changed.  One that is older than 3.11, or loaded
+ *     but not started by its owner, is refused with one line: a second libpython is never loaded beside
+ *     one that is already in the process;
+ *  2. otherwise the interpreter or libpython named by the environment variable DOUBLE_PENDULUM_FMU_PYTHON,
+ *     if it is set (then it is the only candidate);
+ *  3. otherwise, in a self-contained FMU, the CPython it carries beside this binary (binaries/<platform>/:
+ *     its shared library, its standard library pruned and zipped, its extension modules);
+ *  4. otherwise (a lean FMU, built with `double-pendulum build --lean`; POSIX only) the interpreter the FMU
+ *     was built with (resources/python.cfg), then python3 on PATH.  An interpreter is asked about itself
+ *     by running it (bounded by QUERY_TIMEOUT_MS, in a process group of its own that is killed whole:
+ *     nothing is left behind).  A candidate must be CPython >= 3.11 with a shared libpython.
  *
  * A failed search is remembered: later instantiations fail at once with the same message, until
- * DOUBLE_PENDULUM_FMU_PYTHON changes.  No lock of the host (not even stderr's) is held while
- * candidates are asked; stderr's lock, the one lock every copy of the loader in the process shares,
- * is held only for the moment Python is started. */
+ * DOUBLE_PENDULUM_FMU_PYTHON changes.  No lock of the host is held while candidates are asked; the
+ * process-wide lock every copy of the loader shares (platform_lock_process) is held only for the moment
+ * Python is started. */
 #ifndef PYTHON_RUNTIME_H
 #define PYTHON_RUNTIME_H
 
@@ -27,8 +29,9 @@
 #include <stddef.h>
 #include <sys/types.h>
 
+#include "python_start.h"
+
 #define PYTHON_OVERRIDE_VARIABLE "DOUBLE_PENDULUM_FMU_PYTHON"
-#define PYTHON_MIN_MINOR 11 /* CPython 3.11 or newer */
 
 typedef struct _object PyObject; /* opaque: the loader never looks inside a Python object */
 
@@ -62,10 +65,10 @@ typedef struct {
     void (*Err_SetInterrupt)(void);
 } python_api;
 
-/* Make a CPython available (see above) and return its C API; `resources` is the FMU's resources
- * folder (a path).  The first call does the work, later calls return the same table.  On failure
- * returns NULL and writes one line to `error` saying what was looked for, where, and how to point the
- * FMU at a Python. */
-const python_api *python_runtime_start(const char *resources, char *error, size_t error_size);
+/* Make a CPython available (see above) and return its C API; `resources` is the FMU's resources folder
+ * (a path).  The first call does the work, later calls return the same table.  `chosen` (may be NULL)
+ * receives which Python runs and why, for the debug log.  On failure returns NULL and writes one line to
+ * `error` saying what was looked for, where, and how to point the FMU at a Python. */
+const python_api *python_runtime_start(const char *resources, char *error, size_t error_size, const char **chosen);
 
 #endif
