@@ -1,23 +1,24 @@
 """What every FMU's Python side shares, FMI 2 (pythonfmu) and FMI 3 (pythonfmu3): the bundled code
 under private names, and the mapping of a slave onto one co-simulation component.
 
-The build bundles the package's runtime (model, solvers, component), the FMI library's Python part
-and these adapters into the FMU's resources::
+The build bundles the package's runtime (model, solvers, component, codegen), the FMI library's slave
+modules and these adapters into one zip in the FMU's resources (``double_pendulum.fmu.build.bundle``)::
 
-    resources/_dp_fmu_<id>_<Model>.py   the module the FMI library imports (slavemodule.txt names it)
-    resources/_dp_fmu_<id>_adapters/    these adapters, a package
-    resources/double_pendulum/          the runtime, imported as _dp_fmu_<id>
-    resources/pythonfmu/ (pythonfmu3/)  the FMI library's Python part, imported as _dp_fmu_<id>_pythonfmu
-    resources/bundle.json               {"id": a hash of the bundled code}
-    resources/identity.cfg              the model, its GUID and the entry module, for the C loader
+    resources/python_code.zip
+        _dp_fmu_<id>_<Model>.py       the module the loader imports (slavemodule.txt names it)
+        _dp_fmu_<id>_adapters/        these adapters, a package
+        _dp_fmu_<id>/                 the runtime
+        _dp_fmu_<id>_pythonfmu/       the FMI library's slave modules (pythonfmu3 for FMI 3)
+    resources/identity.cfg            the model, its GUID, the archive and the entry module, for the C loader
+    resources/start_values.json       start values baked in by the build (if any)
 
-In a built FMU (``bundle.json`` present) every module is imported under a private name, so the FMU
-always runs its own code, whatever ``DoublePendulum``, ``slave_common``, ``double_pendulum``,
-``pythonfmu`` or ``pythonfmu3`` the process holds (another author's FMU of the same name, an older
-build of this one), and imports nothing under a public name; nothing is put on ``sys.path`` (the
-loader imports the entry module from its file: ``loader/bridge.c``). At build time (no
-``bundle.json``) the installed packages are used, as the FMI library's builder needs its own slave
-classes.
+In a built FMU (these adapters imported from that zip under a private name) every module is imported
+under a private name, so the FMU always runs its own code, whatever ``DoublePendulum``,
+``slave_common``, ``double_pendulum``, ``pythonfmu`` or ``pythonfmu3`` the process holds (another author's
+FMU of the same name, an older build of this one), and imports nothing under a public name; nothing is
+put on ``sys.path`` (the loader imports the entry module from the archive: ``loader/bridge.c``). At build
+time (imported as ``double_pendulum.adapters``) the installed packages are used, as the FMI library's
+builder needs its own slave classes.
 """
 
 from __future__ import annotations
@@ -26,34 +27,28 @@ import importlib
 import importlib.util
 import json
 import sys
+import zipimport
 from pathlib import Path
 from types import ModuleType
 
-RESOURCES = Path(__file__).resolve().parent.parent  # in a built FMU: this package's folder is in resources/
-BUNDLE_FILE = "bundle.json"  # written by the build (double_pendulum.fmu.build.staging)
 PRESET_FILE = "start_values.json"  # start values baked in by the build (double_pendulum.fmu.presets)
 PRIVATE_MARK = "_dp_fmu_"  # every private module name starts with it
+ADAPTERS_SUFFIX = "_adapters"
+
+# In a built FMU: the archive these adapters were imported from, and the private prefix _dp_fmu_<id> of the
+# bundle (this package is _dp_fmu_<id>_adapters); at build time both None.
+ARCHIVE = getattr(globals().get("__loader__"), "archive", None) if __package__.startswith(PRIVATE_MARK) else None
+PRIVATE_PREFIX = __package__.removesuffix(ADAPTERS_SUFFIX) if ARCHIVE else None
+RESOURCES = Path(ARCHIVE).parent if ARCHIVE else Path(__file__).resolve().parent
 
 
-def _bundle() -> dict:
-    """``bundle.json`` in a built FMU, ``{}`` at build time."""
-    try:
-        return json.loads((RESOURCES / BUNDLE_FILE).read_text())
-    except FileNotFoundError:
-        return {}
-
-
-BUNDLE = _bundle()
-PRIVATE_PREFIX = PRIVATE_MARK + BUNDLE["id"] if "id" in BUNDLE else None  # _dp_fmu_<id>; None at build time
-
-
-def _import_private(name: str, folder: Path, *, run_init: bool = True) -> ModuleType:
-    """Import the package in ``folder`` as ``name`` (once per process); ``run_init=False`` registers it
-    without running its ``__init__.py``, for its submodules alone."""
+def _import_private(name: str, *, run_init: bool = True) -> ModuleType:
+    """Import the package ``name`` from the bundle's archive (once per process); ``run_init=False`` registers it
+    without running its ``__init__``, for its submodules alone."""
     if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(
-            name, folder / "__init__.py", submodule_search_locations=[str(folder)]
-        )
+        spec = zipimport.zipimporter(ARCHIVE).find_spec(name)
+        if spec is None:
+            raise ImportError(f"{name} is not in {ARCHIVE}", name=name)
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
         try:
@@ -69,17 +64,18 @@ def fmi_library(name: str) -> str:
     """The name to import the FMI library ``name`` (``pythonfmu`` or ``pythonfmu3``) under.
 
     In a built FMU its bundled copy is registered privately without running its ``__init__``, which
-    would also import its builder (argparse, inspect, xml.dom): the slave side needs only submodules.
+    would also import its builder (argparse, inspect, xml.dom; not bundled): the slave side needs only
+    submodules.
     """
     if PRIVATE_PREFIX:
-        return _import_private(f"{PRIVATE_PREFIX}_{name}", RESOURCES / name, run_init=False).__name__
+        return _import_private(f"{PRIVATE_PREFIX}_{name}", run_init=False).__name__
     return name
 
 
 def runtime_package() -> ModuleType:
     """The ``double_pendulum`` package this FMU runs: the bundled copy (privately), or the installed one."""
     if PRIVATE_PREFIX:
-        return _import_private(PRIVATE_PREFIX, RESOURCES / "double_pendulum")
+        return _import_private(PRIVATE_PREFIX)
     return importlib.import_module("double_pendulum")
 
 

@@ -35,7 +35,8 @@ def test_build_writes_the_fmu(built_by_the_command):
     assert (target.parent / "PendulumOnSuspension.ssp").is_file()  # and the coupled system
     assert (target.parent / "PendulumOnSuspension.fmu").is_file()
     named = [Path(line.removeprefix("built ")) for line in out.splitlines() if line.startswith("built ")]
-    assert out.startswith(f"building the FMUs next to {target} ...")
+    assert out.startswith(f"building the FMUs next to {target} (each carries its own CPython for Linux and "
+                          "Windows) ...")
     assert [path.relative_to(folder).as_posix() for path in named] == list(BUILT_FMUS)
     assert all(path.is_file() for path in named)
 

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import json
+import io
 import math
 import os
+import re
 import subprocess
 import sys
 import sysconfig
@@ -54,31 +55,51 @@ def test_physical_variables_carry_fmi_units_and_descriptions(fmu_path):
     assert set(OUTPUT_NAMES) <= {sv.get("name") for sv in root.find("ModelVariables")}
 
 
-def test_fmu_bundles_the_package_its_loader_and_the_python_it_was_built_with(fmu_path):
+def test_fmu_bundles_its_code_in_one_archive_its_loaders_and_the_pythons_it_carries(fmu_path):
+    from double_pendulum.fmu.build import carried_python
+
     with zipfile.ZipFile(fmu_path) as z:
         names = z.namelist()
-        assert "resources/double_pendulum/model/dynamics.py" in names
-        bundle = json.loads(z.read("resources/bundle.json"))
-        assert len(bundle["id"]) == 16
-        entry = f"_dp_fmu_{bundle['id']}_DoublePendulum"  # every module under a private name
-        assert z.read("resources/slavemodule.txt").decode() == entry
-        assert f"resources/{entry}.py" in names
-        assert f"resources/_dp_fmu_{bundle['id']}_adapters/DoublePendulum.py" in names
-        assert not [n for n in names if n.startswith("resources/") and n.count("/") == 1 and n.endswith(".py")
-                    and not n.startswith("resources/_dp_fmu_")]  # nothing importable under a public name
-        assert "resources/requirements.txt" not in names  # it needs nothing installed
-        assert [n for n in names if n.startswith("binaries/")] == ["binaries/linux64/DoublePendulum.so"]  # the loader
-        identity = z.read("resources/identity.cfg").decode()
-        assert "model=DoublePendulum\n" in identity and f"entry={entry}\n" in identity
-        assert f"package=_dp_fmu_{bundle['id']}_adapters\n" in identity
-        if sys.platform.startswith("linux") and loader.c_compiler():
-            record = z.read("resources/python.cfg").decode()
-            assert f"version={sys.version_info[0]}.{sys.version_info[1]}" in record
-            assert f"home={sys.base_prefix}" in record
-        # bytecode only for the FMU's own sources (nothing copied from a local __pycache__)
-        for name in (n for n in names if "__pycache__" in n):
-            folder, cached = name.split("/__pycache__/")
-            assert f"{folder}/{cached.split('.')[0]}.py" in names, name
+        identity = dict(line.split("=", 1) for line in z.read("resources/identity.cfg").decode().splitlines()
+                        if "=" in line and not line.startswith("#"))
+        code = zipfile.ZipFile(io.BytesIO(z.read(f"resources/{identity['archive']}")))
+        modules = code.namelist()
+        slavemodule = z.read("resources/slavemodule.txt").decode()
+    assert identity["model"] == "DoublePendulum" and identity["archive"] == "python_code.zip"
+    entry, package = identity["entry"], identity["package"]
+    prefix = package.removesuffix("_adapters")
+    assert re.fullmatch(r"_dp_fmu_[0-9a-f]{16}", prefix) and entry == f"{prefix}_DoublePendulum"
+    assert slavemodule == entry  # pythonfmu's convention, for tools that read it
+    assert f"{entry}.py" in modules and f"{package}/DoublePendulum.py" in modules
+    assert f"{prefix}/model/dynamics.py" in modules and f"{prefix}_pythonfmu/fmi2slave.py" in modules
+    assert not [n for n in modules if not n.startswith("_dp_fmu_")]  # nothing importable under a public name
+    assert not [n for n in modules if n.rpartition("/")[2] in ("builder.py", "__main__.py")]  # no builder
+    assert not [n for n in names if n.startswith("resources/") and n.endswith((".py", ".pyc"))]  # one archive
+    assert "resources/requirements.txt" not in names  # it needs nothing installed
+    assert "resources/python.cfg" not in names  # a self-contained FMU records no Python of the build machine
+    for python in carried_python.PLATFORMS:
+        folder = f"binaries/{loader.TARGETS[python].folder(2)}/"
+        binary = f"{folder}DoublePendulum{loader.TARGETS[python].suffix}"
+        assert binary in names, binary
+        minor = sys.version_info[1]
+        library = f"libpython3.{minor}.so.1.0" if python == "x86_64-linux" else f"python3{minor}.dll"
+        assert f"{folder}{library}" in names and f"{folder}python3{minor}.zip" in names
+    assert {n.split("/")[1] for n in names if n.startswith("binaries/")} == {"linux64", "win64"}
+
+
+def test_a_lean_fmu_carries_no_python_and_records_the_builds(tmp_path):
+    """``build --lean``: the Linux loader alone, and the CPython of the build recorded for it to find."""
+    from double_pendulum.fmu.build.fmi2 import build_fmu
+
+    lean = build_fmu(tmp_path / "DoublePendulum.fmu", lean=True)
+    with zipfile.ZipFile(lean) as z:
+        names = z.namelist()
+        record = z.read("resources/python.cfg").decode()
+        tool = ET.fromstring(z.read("modelDescription.xml")).find("CoSimulation").get("needsExecutionTool")
+    assert [n for n in names if n.startswith("binaries/")] == ["binaries/linux64/DoublePendulum.so"]
+    assert f"version={sys.version_info[0]}.{sys.version_info[1]}" in record and f"home={sys.base_prefix}" in record
+    assert tool == "true"  # it needs a CPython where it runs
+    assert lean.stat().st_size < 1e6
 
 
 def test_fmu_runs_without_the_project_installed(fmu_path, tmp_path):
@@ -252,24 +273,31 @@ def test_repeated_plain_fmpy_runs_with_fresh_extractions_work(fmu_path):
         assert r["time"][-1] == pytest.approx(0.2)
 
 
-def test_fmu_ships_hash_checked_bytecode(fmu_path):
+def test_fmu_ships_hash_checked_bytecode_beside_each_source(fmu_path):
     import importlib.util
 
-    with zipfile.ZipFile(fmu_path) as z:
-        names = set(z.namelist())
-        cached = importlib.util.cache_from_source("resources/double_pendulum/model/dynamics.py")
-        assert cached in names
-        flags = int.from_bytes(z.read(cached)[4:8], "little")
-        assert flags == 0b11  # PEP 552: hash-based, checked against the source
+    with zipfile.ZipFile(fmu_path) as z, zipfile.ZipFile(io.BytesIO(z.read("resources/python_code.zip"))) as code:
+        names = set(code.namelist())
+        sources = [n for n in names if n.endswith(".py")]
+        assert sources and all(f"{n}c" in names for n in sources)  # mod.pyc beside mod.py, where zipimport looks
+        dynamics = next(n for n in sources if n.endswith("/model/dynamics.py"))
+        compiled = code.read(f"{dynamics}c")
+        assert compiled[:4] == importlib.util.MAGIC_NUMBER
+        assert int.from_bytes(compiled[4:8], "little") == 0b11  # PEP 552: hash-based, checked against the source
+        assert compiled[8:16] == importlib.util.source_hash(code.read(dynamics))
+        assert all(info.compress_type == zipfile.ZIP_STORED for info in code.infolist())  # no zlib needed to read
 
 
 def test_fmu_bundles_only_the_runtime(fmu_path):
-    """resources/ holds the adapter, pythonfmu and the runtime subpackages: no analysis, plots or CLI."""
+    """The archive holds the adapters, pythonfmu's slave modules and the runtime subpackages: no analysis, plots
+    or CLI."""
     from double_pendulum.fmu.build.staging import RUNTIME_SUBPACKAGES
 
-    with zipfile.ZipFile(fmu_path) as fmu:
-        sources = [n for n in fmu.namelist() if n.startswith("resources/double_pendulum/") and n.endswith(".py")]
-    parts = {n.split("/")[2] for n in sources}
+    with zipfile.ZipFile(fmu_path) as z, zipfile.ZipFile(io.BytesIO(z.read("resources/python_code.zip"))) as code:
+        identity = z.read("resources/identity.cfg").decode()
+        runtime = re.search(r"package=(_dp_fmu_[0-9a-f]+)_adapters", identity).group(1) + "/"
+        sources = [n for n in code.namelist() if n.startswith(runtime) and n.endswith(".py")]
+    parts = {n.split("/")[1] for n in sources}
     assert parts == {"__init__.py", *RUNTIME_SUBPACKAGES}
     assert not any(word in n for n in sources for word in ("analysis", "plots", "cli", "scenarios", "fmu/"))
 
@@ -303,26 +331,34 @@ def test_a_newer_build_module_makes_the_fmu_stale(fmu_path, tmp_path, monkeypatc
     assert not fmi2.fmu_is_current(fmu_path)
 
 
-def test_every_fmu_claims_only_the_platform_it_ran_on_and_no_sources_that_do_not_build_it(fmu_path):
-    """Each FMU's binaries are the Linux loader alone (pythonfmu's binaries for other platforms, never run, are
-    left out), the container's only fmpy's Linux binary (every member has the Linux loader only), and no FMU
-    ships sources/ (pythonfmu3's sources build its own C++ library, not the FMU's binary)."""
+def test_every_fmu_claims_only_the_platforms_it_ran_on_and_no_sources_that_do_not_build_it(fmu_path):
+    """Each FMU's binaries are the loaders for x86_64 Linux and Windows with the CPython each carries, where both
+    are run in the tests (tests/test_self_contained.py: Linux without any Python, Windows under Wine); no
+    pythonfmu binary, no macOS; the container carries fmpy's binaries for the platforms every member has; and no
+    FMU ships sources/ (pythonfmu3's sources build its own C++ library, not the FMU's binary)."""
     folder = fmu_path.parent
-    for fmu, platform in ((fmu_path, "linux64"), (folder / "Suspension.fmu", "linux64"),
-                          (folder / "fmi3" / "DoublePendulum.fmu", "x86_64-linux"),
-                          (folder / "PendulumOnSuspension.fmu", "linux64")):
+    for fmu, platforms in ((fmu_path, {"linux64", "win64"}), (folder / "Suspension.fmu", {"linux64", "win64"}),
+                           (folder / "fmi3" / "DoublePendulum.fmu", {"x86_64-linux", "x86_64-windows"}),
+                           (folder / "PendulumOnSuspension.fmu", {"linux64", "win64"})):
         with zipfile.ZipFile(fmu) as z:
             names = z.namelist()
-        platforms = {n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") >= 2}
-        assert platforms == {platform}, (fmu.name, platforms)
+        found = {n.split("/")[1] for n in names if n.startswith("binaries/") and n.count("/") >= 2}
+        assert found == platforms, (fmu.name, found)
         assert not [n for n in names if n.startswith("sources/")], fmu.name
+        assert not [n for n in names if "pythonfmu-export" in n or n.endswith(".dylib")], fmu.name
         members = {n.split("/")[3] for n in names if n.startswith("resources/") and "/binaries/" in n}
-        assert members <= {"linux64"}, (fmu.name, members)
+        assert members <= {"linux64", "win64"}, (fmu.name, members)
+
+
+CARRIED_LIBRARY_LICENCES = {"libffi.txt", "libz.txt", "libbz2.txt", "liblzma.txt", "libuuid.txt"}
+"""The system libraries a carried Linux CPython's extension modules need (their Debian copyright files, where the
+build machine has them)."""
 
 
 def test_every_fmu_carries_the_licences_of_what_it_bundles(fmu_path):
     """documentation/licenses/: the project's MIT licence and those of pythonfmu (FMI 2) or pythonfmu3 (FMI 3),
-    and for the container fmpy's (its container binary), each the text the distribution ships."""
+    and for the container fmpy's (its container binary), each the text the distribution ships; and CPython's
+    for each platform's carried CPython (python.org's Windows text covers the libraries its build carries)."""
     from double_pendulum.fmu.carries.presentation import distribution_licence
 
     project = (Path(__file__).resolve().parents[1] / "LICENSE").read_bytes()
@@ -334,7 +370,13 @@ def test_every_fmu_carries_the_licences_of_what_it_bundles(fmu_path):
         with zipfile.ZipFile(fmu) as z:
             licences = {n.rpartition("/")[2]: z.read(n) for n in z.namelist()
                         if n.startswith("documentation/licenses/")}
-        assert set(licences) == {f"{name}.txt" for name in bundled}, (fmu.name, sorted(licences))
+        carried = {n for n in licences if n.startswith("CPython-")}  # the CPython each platform's binaries carry
+        assert set(licences) - carried - {f"{name}.txt" for name in bundled} <= CARRIED_LIBRARY_LICENCES, \
+            (fmu.name, sorted(licences))
+        assert {f"{name}.txt" for name in bundled} <= set(licences), (fmu.name, sorted(licences))
         assert licences["double-pendulum-fmu.txt"].strip() == project.strip()
         for name in bundled:
             assert licences[f"{name}.txt"] == distribution_licence(name) and len(licences[f"{name}.txt"]) > 200
+        if fmu.name != "PendulumOnSuspension.fmu":  # the container's members carry their own
+            assert {re.sub(r"CPython-3\.\d+\.\d+-", "", n) for n in carried} == {"linux.txt", "windows.txt"}
+            assert all(b"PYTHON SOFTWARE FOUNDATION LICENSE" in licences[n] for n in carried)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import html
 import re
+import sys
 import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
@@ -123,8 +124,12 @@ def test_the_pendulums_page_has_its_equations_switches_rules_and_needs(contents)
     assert "<td>m1</td>" not in page and "<code>m1</code></td><td>parameter</td><td>fixed</td><td>Real</td>" in page
     assert re.search(r"<code>l1</code>.*?<td>&gt; 0</td>", page)  # l1 must be > 0
     needs = page.split("What a target machine needs")[1]
-    assert "binaries/linux64/DoublePendulum.so" in needs and "glibc &gt;= 2.17" in needs
-    assert "DOUBLE_PENDULUM_FMU_PYTHON" in needs and "version=3." in needs  # how it finds its Python
+    minor = sys.version_info[1]
+    for folder, library, system in (("linux64", f"libpython3.{minor}.so.1.0", "glibc &gt;= 2."),
+                                    ("win64", f"python3{minor}.dll", "Windows 10 or newer")):
+        row = re.search(rf"<tr><td><code>binaries/{folder}/</code></td>(.*?)</tr>", needs).group(1)
+        assert f"the CPython 3.{minor}." in row and f"<code>{library}</code>" in row and system in row, row
+    assert "DOUBLE_PENDULUM_FMU_PYTHON" in needs  # how it finds its Python
     assert "needs nothing installed" in needs and "only the standard library" in needs  # and what that Python needs
     fmi3 = contents["fmi3/DoublePendulum.fmu"]["documentation/index.html"].decode()
     assert "Model Exchange of the FMI 3 <code>DoublePendulum</code> FMU" in fmi3

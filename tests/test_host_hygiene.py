@@ -195,20 +195,24 @@ CYCLES = SLAVE + textwrap.dedent("""
 
 
 def test_thousands_of_instantiate_free_cycles_in_fmpy_cost_no_memory(unzipped, tmp_path):
-    """3,000 FMU2Slave instantiate / fmi2FreeInstance cycles after a warm-up of 500, the library kept loaded,
+    """4,000 FMU2Slave instantiate / fmi2FreeInstance cycles after a warm-up of 1,500, the library kept loaded,
     in a fresh interpreter: resident memory (/proc/self/statm) grows by less than 0.2 KiB a cycle, no
     DoublePendulum slave object survives its cycle (one is alive while instantiated), and the number of
     objects the collector tracks does not grow. No gc.collect: the cycles must not need one."""
     folder, guid = unzipped
-    done = subprocess.run([sys.executable, "-c", CYCLES, str(folder), guid, "3500"], capture_output=True, text=True,
+    # The resident memory settles over the first ~1,500 cycles (about 430 KiB), and the allocator takes one more
+    # block of about 530 KiB once, somewhere between cycles 3,000 and 4,000 (the FMU of ad909ce and this one
+    # alike; flat before and after it over 9,000 cycles): measured from cycle 1,500 over 4,000 cycles that step is
+    # 0.13 KiB a cycle, a second one (a leak that shows as blocks) would exceed the bound.
+    done = subprocess.run([sys.executable, "-c", CYCLES, str(folder), guid, "5500"], capture_output=True, text=True,
                           cwd=tmp_path, timeout=300)
     assert done.returncode == 0, done.stderr[-3000:]
     result = json.loads(done.stdout.strip().splitlines()[-1])
     readings = {int(k): v for k, v in result["readings"].items()}
-    slope = (readings[3500][0] - readings[500][0]) / 3000
-    late = (readings[3500][0] - readings[1500][0]) / 2000
-    print(f"fmpy: {slope:.3f} KiB a cycle over cycles 500-3500, {late:.3f} over 1500-3500; "
-          f"RSS {readings[500][0]:.0f} -> {readings[3500][0]:.0f} KiB")
+    slope = (readings[5500][0] - readings[1500][0]) / 4000
+    late = (readings[5500][0] - readings[3500][0]) / 2000
+    print(f"fmpy: {slope:.3f} KiB a cycle over cycles 1500-5500, {late:.3f} over 3500-5500; "
+          f"RSS {readings[1500][0]:.0f} -> {readings[5500][0]:.0f} KiB")
     assert result["alive"] == 1
     assert all(slaves == 0 for _, slaves, _ in readings.values()), readings
     # after the warm-up, as the slope: the interpreter's first full (generation 2) collection falls in the

@@ -25,14 +25,32 @@ pytestmark = [
 
 
 def binaries(fmu_path: Path) -> dict[str, bytes]:
-    """Every FMU's Linux binaries, by ``<FMU>/<file>``."""
+    """Every FMU's Linux loader (its binary named after the model: ``binaries/<platform>/<Model>.so``; the CPython
+    it carries beside it is not the loader's), by ``<FMU>/<file>``."""
     out = {}
     for fmu in (fmu_path, fmu_path.parent / "Suspension.fmu", fmu_path.parent / "fmi3" / "DoublePendulum.fmu"):
         with zipfile.ZipFile(fmu) as archive:
             for name in archive.namelist():
-                if name.endswith(".so"):
+                if name.startswith("binaries/") and name.endswith((f"/{fmu.stem}.so", "/Suspension.so")):
                     out[f"{fmu.parent.name}/{fmu.name}/{name}"] = archive.read(name)
     return out
+
+
+def test_the_carried_pythons_glibc_floor_is_read_from_its_files_and_stated(fmu_path):
+    """The carried Linux CPython asks for what the building interpreter was built against: the FMU's page states
+    the newest glibc version any of its Linux files needs, and docs/fmu.md the one of the build these docs were
+    made with (CPython 3.11.7 of pyenv on Debian 12: glibc 2.35)."""
+    import re
+
+    with zipfile.ZipFile(fmu_path) as archive:
+        files = {n: archive.read(n) for n in archive.namelist() if n.startswith("binaries/linux64/")}
+        page = archive.read("documentation/index.html").decode()
+    floors = [elf_needs.newest(elf_needs.version_needs(d), "GLIBC") for d in files.values() if d[:4] == b"\x7fELF"]
+    floor = max((f for f in floors if f), key=elf_needs.version_key).partition("_")[2]
+    row = re.search(r"<tr><td><code>binaries/linux64/</code></td>(.*?)</tr>", page).group(1)
+    assert f"glibc &gt;= {floor}<" in row, row
+    if sys.version.startswith("3.11.7 ") and "pyenv" in sys.base_prefix:
+        assert f"glibc {floor}" in DOCS.read_text() and floor == "2.35"
 
 
 def test_the_loader_asks_only_for_old_glibc_symbol_versions_and_the_c_libraries(fmu_path):

@@ -8,6 +8,7 @@ import os
 import sys
 from pathlib import Path
 
+from ..fmu.build.carried_python import CarriedPythonUnavailable
 from ..fmu.build.fmi2 import DEFAULT_FMU_PATH
 from ..fmu.build.loader import LoaderUnavailable
 from ..fmu.build.systems import build_all
@@ -15,10 +16,15 @@ from .common import CliError, private_tempdir, writable_folder
 
 
 def cmd_build(args: argparse.Namespace) -> int:
-    print(f"building the FMUs next to {args.output} ...", flush=True)
+    if args.lean:
+        print(f"building the lean FMUs next to {args.output} (Linux only; they need a CPython >= 3.11 where they "
+              "run) ...", flush=True)
+    else:
+        print(f"building the FMUs next to {args.output} (each carries its own CPython for Linux and Windows) ...",
+              flush=True)
     try:
-        paths = build_all(args.output)
-    except LoaderUnavailable as error:
+        paths = build_all(args.output, lean=args.lean)
+    except (LoaderUnavailable, CarriedPythonUnavailable) as error:
         raise CliError(f"cannot build the FMUs: {error}") from None
     except OSError as error:
         raise CliError(f"cannot build the FMUs at {args.output}: {error.strerror or error}") from None
@@ -81,8 +87,14 @@ def add_build_parser(sub: argparse._SubParsersAction) -> None:
                              description="Build DoublePendulum.fmu and, next to it, Suspension.fmu, "
                              "PendulumOnSuspension.ssp (SSP, for libcosim), PendulumOnSuspension.fmu "
                              "(fmpy's container FMU) and fmi3/DoublePendulum.fmu (FMI 3.0, Model Exchange and "
-                             "Co-Simulation).")
+                             "Co-Simulation). Each FMU carries a CPython for x86_64 Linux and Windows and runs "
+                             "where no Python is installed (in a Python host it uses the host's); --lean writes "
+                             "FMUs without one.")
     p_build.add_argument("-o", "--output", default=str(DEFAULT_FMU_PATH), help="DoublePendulum FMU path or folder")
+    p_build.add_argument("--lean", action="store_true",
+                         help="write lean FMUs: a Linux binary only, without a CPython of their own (about 0.6 MB "
+                         "instead of 15 MB); they use the Python of a Python host, else the CPython they were built "
+                         "with, python3 on PATH, or the one DOUBLE_PENDULUM_FMU_PYTHON names")
     p_build.set_defaults(func=cmd_build)
 
 

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from ..component.variables import INTERFACES
+from ..fmu.build.carried_python import CarriedPythonUnavailable
 from ..fmu.build.fmi2 import DEFAULT_FMU_PATH
 from ..fmu.build.loader import LoaderUnavailable
 from ..fmu.build.systems import build_all
@@ -117,7 +118,7 @@ def build_fmus(folder: Path, rebuild: bool) -> None:
     print(f"building the FMUs in {folder} ({why}) ...", flush=True)
     try:
         build_all(folder / DEFAULT_FMU_PATH.name)
-    except LoaderUnavailable as error:
+    except (LoaderUnavailable, CarriedPythonUnavailable) as error:
         raise CliError(f"cannot build the FMUs: {error}") from None
     except OSError as error:
         raise CliError(f"cannot build the FMUs in {folder}: {error.strerror or error} "

@@ -47,6 +47,8 @@ EXPOSED_PARAMETERS = {
     SUSPENSION: ("M_s", "k_x", "k_y", "c_x", "c_y", "F_static_y"),
 }
 """Parameters the container always exposes (start: the value given, else the component's own start)."""
+CONTAINER_BINARIES = (("x86_64-linux", "linux64", "container_fmu.so"), ("x86_64-windows", "win64", "container_fmu.dll"))
+"""fmpy's container binaries the container may carry: (fmpy's folder, the FMI 2 platform, the file)."""
 
 
 def _component(fmu: Path) -> Any:
@@ -160,11 +162,13 @@ def write_container(
         write_model_description(config.modelDescription, root / "modelDescription.xml")
         write_configuration(config, root / "resources" / "container.json")
         _fix_connection_types(root / "resources" / "container.json")
-        # fmpy's container binary only for the platforms every member has a binary for (their loaders: Linux):
-        # a container claims to run only where all of it can
-        for platform_tuple, fmi2_platform, library in (("x86_64-linux", "linux64", "container_fmu.so"),):
-            (root / "binaries" / fmi2_platform).mkdir(parents=True, exist_ok=True)
-            shutil.copyfile(binaries / platform_tuple / library, root / "binaries" / fmi2_platform / library)
+        # fmpy's container binary only for the platforms every member has a binary for (Linux, and Windows for
+        # self-contained members; never macOS): a container claims to run only where all of it can
+        for platform_tuple, fmi2_platform, library in CONTAINER_BINARIES:
+            if all((root / "resources" / Path(component.filename).stem / "binaries" / fmi2_platform).is_dir()
+                   for component in config.components):
+                (root / "binaries" / fmi2_platform).mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(binaries / platform_tuple / library, root / "binaries" / fmi2_platform / library)
         if documented:
             _add_presentation(root)
         tmp_fmu = dest.with_suffix(".fmu.tmp")

@@ -39,6 +39,7 @@ from xml.etree import ElementTree as ET
 from ...component.variables import INTERFACES, MODEL_IDENTIFIER, FmuInterface
 from .. import presets
 from . import bundle, loader
+from .carried_python import PLATFORMS
 from .staging import (
     adapter_sources,
     builder_imports_forgotten,
@@ -93,11 +94,14 @@ def _set_output_dependencies(structure: ET.Element, index_of: dict[str, int], in
 
 
 def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL_IDENTIFIER,
-              start_values: Mapping[str, Any] | None = None) -> Path:
+              start_values: Mapping[str, Any] | None = None, lean: bool = False,
+              platforms: tuple[str, ...] = PLATFORMS) -> Path:
     """Build the FMU ``model_identifier`` at ``dest`` (a ``.fmu`` path or a folder) and return its path.
 
     ``start_values`` (parameters by name) are baked in as the FMU's defaults
-    (:mod:`double_pendulum.fmu.presets`). The FMU is first written to a temporary folder and moved into
+    (:mod:`double_pendulum.fmu.presets`). A self-contained FMU carries a CPython for each of ``platforms`` (Linux
+    and Windows); a ``lean`` one ships the Linux binary alone and needs a CPython where it runs
+    (:func:`~.staging.rewrite_fmu`). The FMU is first written to a temporary folder and moved into
     place at the end, so a failed build never leaves a broken FMU behind.
     """
     from pythonfmu.builder import FmuBuilder
@@ -121,7 +125,7 @@ def build_fmu(dest: str | Path = DEFAULT_FMU_PATH, model_identifier: str = MODEL
             )
         rewrite_fmu(Path(built), model_identifier, functools.partial(complete_model_description,
                                                                      model_identifier=model_identifier),
-                    start_values=start_values)
+                    start_values=start_values, lean=lean, platforms=platforms)
         check_platform_binary(Path(built), model_identifier)
         shutil.move(str(built), fmu_path)
     return fmu_path

@@ -28,6 +28,7 @@ from ...component.model_exchange import STATES
 from ...component.variables import INTERFACES, MODEL_IDENTIFIER
 from .. import presets
 from . import bundle
+from .carried_python import PLATFORMS
 from .staging import adapter_sources as _adapter_sources
 from .staging import (
     builder_imports_forgotten,
@@ -85,11 +86,13 @@ def complete_model_description_fmi3(xml_text: bytes) -> bytes:
     return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
 
 
-def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH, start_values: Mapping[str, Any] | None = None) -> Path:
+def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH, start_values: Mapping[str, Any] | None = None,
+               lean: bool = False, platforms: tuple[str, ...] = PLATFORMS) -> Path:
     """Build the FMI 3.0 ``DoublePendulum`` FMU at ``dest`` (a ``.fmu`` path or a folder); return its path.
 
     ``start_values`` (parameters by name) are baked in as the FMU's defaults
-    (:mod:`double_pendulum.fmu.presets`). Written to a temporary folder first and moved into place at the end,
+    (:mod:`double_pendulum.fmu.presets`); ``lean`` and ``platforms``: as for FMI 2 (:func:`~.fmi2.build_fmu`).
+    Written to a temporary folder first and moved into place at the end,
     so a failed build never leaves a broken FMU behind.
     """
     from pythonfmu3.builder import FmuBuilder
@@ -112,7 +115,8 @@ def build_fmu3(dest: str | Path = DEFAULT_FMU3_PATH, start_values: Mapping[str, 
                 needsCompletedIntegratorStep=False,
             ))
         rewrite_fmu(built, MODEL_IDENTIFIER, complete_model_description_fmi3, fmi_version=3,
-                    defines={"N_CONTINUOUS_STATES": str(len(STATES))}, start_values=start_values)
+                    defines={"N_CONTINUOUS_STATES": str(len(STATES))}, start_values=start_values, lean=lean,
+                    platforms=platforms)
         check_platform_binary(built, MODEL_IDENTIFIER, fmi_version=3)
         shutil.move(str(built), fmu_path)
     return fmu_path

@@ -5,14 +5,15 @@ hand their FMI library's builder the runtime (``__init__``, :mod:`~double_pendul
 :mod:`~double_pendulum.solvers`, :mod:`~double_pendulum.component`: :data:`RUNTIME_SUBPACKAGES`) and the
 adapters, then :func:`rewrite_fmu` rewrites what the builder wrote:
 
-* the bundled code's private layout (:mod:`double_pendulum.fmu.build.bundle`: every module under a private name)
-  with hash-checked bytecode;
-* the FMU's one binary: the loader of :mod:`double_pendulum.fmu.build.loader`, compiled from source with the FMU's
-  GUID, which calls the Python side itself (the FMI library's binaries are left out), and
-  ``resources/python.cfg``, the building CPython;
-* ``resources/identity.cfg`` (model, GUID, entry module: the loader refuses another FMU's resources) and
-  ``resources/bundle.json`` (a hash of the bundled code), which makes the FMU import its bundled code under
-  private names (``fmu_src/slave_common.py``);
+* the bundled code in one archive, ``resources/python_code.zip``, every module under a private name
+  (:mod:`double_pendulum.fmu.build.bundle`), with hash-checked bytecode;
+* the FMU's binaries: the loader of :mod:`double_pendulum.fmu.build.loader`, compiled from source with the FMU's
+  GUID for each platform it ships, which calls the Python side itself (the FMI library's binaries are left out),
+  and beside it the CPython it carries there (:mod:`double_pendulum.fmu.build.carried_python`: x86_64 Linux and
+  Windows); a lean FMU (``--lean``) ships the Linux loader alone and ``resources/python.cfg``, the building
+  CPython, which it looks for where it runs;
+* ``resources/identity.cfg`` (model, GUID, the code's archive, its package and entry module: the loader refuses
+  another FMU's resources and imports the bundled code under private names, ``fmu_src/slave_common.py``);
 * the start values it is given (:mod:`double_pendulum.fmu.presets`);
 * what a tool shows of the FMU: ``documentation/``, the icon and ``terminalsAndIcons/``
   (:mod:`double_pendulum.fmu.carries.presentation`).
@@ -24,11 +25,9 @@ from __future__ import annotations
 
 import contextlib
 import importlib.util
-import json
 import os
 import shutil
 import sys
-import tempfile
 import zipfile
 from collections.abc import Callable, Iterable, Iterator, Mapping
 from pathlib import Path
@@ -36,7 +35,7 @@ from typing import Any
 from xml.etree import ElementTree as ET
 
 from .. import presets
-from . import bundle, loader
+from . import bundle, carried_python, loader
 
 PACKAGE_DIR = Path(__file__).resolve().parents[2]
 # The runtime the FMU runs: the package's __init__ and these subpackages, nothing else.
@@ -63,7 +62,6 @@ UNIT_EXPONENTS: dict[str, dict[str, int]] = {
     "W": {"kg": 1, "m": 2, "s": -3},
 }
 
-BUNDLE_FILE = "resources/bundle.json"  # the bundle's id: the private name its code is imported under
 
 
 def _adapters_dir() -> Path:
@@ -140,37 +138,60 @@ def unit_definitions(units: Iterable[str]) -> ET.Element:
     return definitions
 
 
-def compiled_bytecode(source: bytes, arcname: str) -> tuple[str, bytes]:
-    """Return the ``__pycache__`` path and hash-checked bytecode of one Python source in the FMU.
-
-    Hosts extract FMUs without restoring file times, so the bytecode is checked against a hash
-    of the source (PEP 552) rather than its time stamp; a Python of another minor version simply
-    ignores it (other cache tag) and compiles the source as usual.
-    """
-    import importlib.util
-    import py_compile
-
-    with tempfile.TemporaryDirectory() as tmp:
-        src = Path(tmp) / "module.py"
-        src.write_bytes(source)
-        cfile = Path(tmp) / "module.pyc"
-        py_compile.compile(str(src), cfile=str(cfile), dfile=arcname, doraise=True,
-                           invalidation_mode=py_compile.PycInvalidationMode.CHECKED_HASH)
-        cached = importlib.util.cache_from_source(arcname)
-        return cached, cfile.read_bytes()
-
-
 def instantiation_token(model_description: bytes) -> str:
     """The FMU's GUID (FMI 2) or instantiation token (FMI 3), which the guard checks at instantiation."""
     root = ET.fromstring(model_description)
     return root.get("guid") or root.get("instantiationToken") or ""
 
 
+# What a host's tool reads of a self-contained FMU: nothing outside it is needed (FMI 2.0 and 3.0,
+# needsExecutionTool); a lean FMU needs a CPython installed where it runs.
+INTERFACE_ELEMENTS = ("CoSimulation", "ModelExchange")
+# Stored, not deflated: fmpy extracts an FMU anew for each simulate_fmu call, and inflating the carried Pythons'
+# libraries (about 12 MB) would cost every call more than copying them (docs/performance.md); their zipped
+# standard libraries are deflated inside.
+STORED_SUFFIXES = (".dll", ".so.1.0", ".pyd", ".zip")
+
+
+def mark_execution_tool(model_description: bytes, needed: bool) -> bytes:
+    """The modelDescription with ``needsExecutionTool`` set on each interface to ``needed``."""
+    root = ET.fromstring(model_description)
+    for element in root:
+        if element.tag in INTERFACE_ELEMENTS:
+            element.set("needsExecutionTool", "true" if needed else "false")
+    return ET.tostring(root, encoding="UTF-8", xml_declaration=True)
+
+
+def _binaries(model_identifier: str, fmi_version: int, token: str, defines: Mapping[str, str],
+              code: Mapping[str, bytes], lean: bool, platforms: tuple[str, ...]) -> dict[str, bytes]:
+    """``binaries/``: the loader for each of ``platforms`` and, unless ``lean``, the CPython it carries there
+    (:mod:`double_pendulum.fmu.build.carried_python`) with its licences; a lean FMU ships the Linux loader and
+    ``resources/python.cfg`` (the building CPython, which it looks for where it runs)."""
+    identity = {"MODEL_IDENTIFIER": model_identifier, "FMU_GUID": token, **defines}
+    if lean:
+        return {f"binaries/{loader.LINUX.folder(fmi_version)}/{model_identifier}{loader.LINUX.suffix}":
+                loader.compiled_loader(fmi_version, identity), f"resources/{loader.CONFIG_NAME}":
+                loader.python_record().encode()}
+    files = {}
+    for python in carried_python.carried_pythons(code, platforms):
+        target = loader.TARGETS[python.platform]
+        folder = f"binaries/{target.folder(fmi_version)}/"
+        names = {"BUNDLED_PYTHON_LIBRARY": python.library, "BUNDLED_PYTHON_STDLIB": python.stdlib,
+                 "BUNDLED_PYTHON_MINOR": str(python.minor), "BUNDLED_PYTHON_PRELOAD": ":".join(python.preload)}
+        files[f"{folder}{model_identifier}{target.suffix}"] = loader.compiled_loader(fmi_version,
+                                                                                     {**identity, **names}, target)
+        files.update({folder + name: data for name, data in python.files.items()})
+        files.update({f"documentation/licenses/{name}": text for name, text in carried_python.licenses(python).items()})
+    return files
+
+
 def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], bytes], fmi_version: int = 2,
-                defines: dict[str, str] | None = None, start_values: Mapping[str, Any] | None = None) -> None:
-    """Rewrite the zip: the private layout of the bundled code, the completed modelDescription, bytecode,
-    the loader (compiled with the FMU's GUID and ``defines``), ``bundle.json``, and what a tool shows of
-    the FMU (documentation, icon, terminals: :mod:`double_pendulum.fmu.carries.presentation`).
+                defines: dict[str, str] | None = None, start_values: Mapping[str, Any] | None = None,
+                lean: bool = False, platforms: tuple[str, ...] = carried_python.PLATFORMS) -> None:
+    """Rewrite the zip: the bundled code in one archive under private names, the completed modelDescription,
+    the loaders (compiled with the FMU's GUID and ``defines``) for ``platforms`` with the CPython each carries (a
+    ``lean`` FMU: the Linux loader alone), ``identity.cfg``, and what a tool shows of the FMU (documentation, icon,
+    terminals: :mod:`double_pendulum.fmu.carries.presentation`).
 
     ``complete`` completes the modelDescription. Precompiled bytecode spares every fresh extraction
     (fmpy extracts the FMU anew for each ``simulate_fmu`` call) the compilation of the bundled
@@ -178,32 +199,27 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
     """
     with zipfile.ZipFile(fmu) as src:
         files = {item.filename: src.read(item.filename) for item in src.infolist()}
-    files, identity = bundle.bundled_entries(files, model_identifier, fmi_version)
-    files["modelDescription.xml"] = presets.apply_start_values(complete(files["modelDescription.xml"]),
-                                                               start_values or {})
+    files, code, identity = bundle.bundled_entries(files, model_identifier, fmi_version)
+    description = mark_execution_tool(complete(files["modelDescription.xml"]), needed=lean)
+    files["modelDescription.xml"] = presets.apply_start_values(description, start_values or {})
     if start_values:
         files[presets.PRESET_FILE] = presets.preset_file(start_values)
     token = instantiation_token(files["modelDescription.xml"])
     # The FMI library's binaries (pythonfmu's C++ layer, for every platform it ships) are left out: the
-    # FMU's one binary is the loader, built here from source, which calls the Python side itself.
+    # FMU's binaries are the loader, built here from source, which calls the Python side itself.
     # pythonfmu3's sources/ build its own C++ library, not this binary: an FMU carries no sources that do not
     # build it
     files = {name: data for name, data in files.items() if not name.startswith(("binaries/", "sources/"))}
-    binary = f"binaries/{loader.PLATFORMS[fmi_version]}/{model_identifier}.so"
-    files[binary] = loader.compiled_loader(fmi_version, {"MODEL_IDENTIFIER": model_identifier, "FMU_GUID": token,
-                                                         **(defines or {})})
-    files[f"resources/{loader.CONFIG_NAME}"] = loader.python_record().encode()
+    files.update(_binaries(model_identifier, fmi_version, token, defines or {}, code, lean, platforms))
     files[bundle.IDENTITY_FILE] = bundle.identity_record(model_identifier, token, identity)
-    files[BUNDLE_FILE] = json.dumps({"id": identity}).encode()
     from ..carries.presentation import presentation_files  # here: matplotlib and numpy only when building
 
     files.update(presentation_files(model_identifier, fmi_version, files, start_values))
     tmp = fmu.with_suffix(".fmu.tmp")
     with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
         for name, data in files.items():
-            dst.writestr(name, data)
-            if name.startswith("resources/") and name.endswith(".py"):
-                dst.writestr(*compiled_bytecode(data, name))
+            stored = name.startswith("binaries/") and name.endswith(STORED_SUFFIXES)
+            dst.writestr(name, data, compress_type=zipfile.ZIP_STORED if stored else zipfile.ZIP_DEFLATED)
     tmp.replace(fmu)
 
 

@@ -14,16 +14,18 @@ from ...component.variables import INTERFACES, MODEL_IDENTIFIER
 from .fmi2 import DEFAULT_FMU_PATH, build_fmu
 
 
-def build_all(dest: str | Path = DEFAULT_FMU_PATH) -> list[Path]:
+def build_all(dest: str | Path = DEFAULT_FMU_PATH, lean: bool = False) -> list[Path]:
     """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it,
     then the coupled system (:func:`build_systems`), then the FMI 3.0 ``DoublePendulum`` in the
-    subfolder ``fmi3/`` (:func:`double_pendulum.fmu.build.fmi3.build_fmu3`)."""
+    subfolder ``fmi3/`` (:func:`double_pendulum.fmu.build.fmi3.build_fmu3`). Self-contained (each carries a CPython
+    for Linux and Windows), or ``lean`` (Linux only, a CPython needed where they run)."""
     from .fmi3 import build_fmu3
 
     dest = Path(dest)
-    first = build_fmu(dest, MODEL_IDENTIFIER)
-    others = [build_fmu(first.parent / f"{name}.fmu", name) for name in INTERFACES if name != MODEL_IDENTIFIER]
-    fmi3 = build_fmu3(first.parent / "fmi3" / f"{MODEL_IDENTIFIER}.fmu")
+    first = build_fmu(dest, MODEL_IDENTIFIER, lean=lean)
+    others = [build_fmu(first.parent / f"{name}.fmu", name, lean=lean) for name in INTERFACES
+              if name != MODEL_IDENTIFIER]
+    fmi3 = build_fmu3(first.parent / "fmi3" / f"{MODEL_IDENTIFIER}.fmu", lean=lean)
     return [first, *others, *build_systems(first), fmi3]
 
 

@@ -8,9 +8,9 @@ Nothing here is a second copy of the documentation: the page is assembled from
 * the model's module docstrings (the equations, :data:`MODEL_SOURCES`), rendered by
   :mod:`double_pendulum.fmu.carries.docstring_html`;
 * the parameter groups' docstrings and switches (:data:`SWITCH_GROUPS`: the switches of a scene);
-* the FMU's binaries, read for what each needs of the target machine
-  (:mod:`double_pendulum.fmu.carries.elf_needs`), the CPython recorded at build and the loader's docstring (how
-  the FMU finds its Python, :mod:`double_pendulum.fmu.build.loader`);
+* the FMU's binaries folders, read for what each holds (the loader, the CPython it carries) and needs of the
+  target machine (:mod:`double_pendulum.fmu.carries.elf_needs`), the CPython a lean FMU recorded at build and the
+  loader's docstring (how the FMU finds its Python, :mod:`double_pendulum.fmu.build.loader`);
 * the result plot ``result.png`` of the FMU's default run (:mod:`double_pendulum.fmu.carries.doc_plot`).
 
 The page is plain HTML with its style inline and no script, so the simple HTML views of FMI tools show
@@ -21,7 +21,9 @@ from __future__ import annotations
 
 import html
 import importlib
+import io
 import re
+import zipfile
 from collections.abc import Mapping, Sequence
 from dataclasses import fields
 from xml.etree import ElementTree as ET
@@ -150,42 +152,79 @@ def about_table(root: ET.Element, start_values: Mapping[str, object]) -> str:
     return "<table>\n" + "\n".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in rows) + "\n</table>"
 
 
-def _role(name: str) -> str:
-    """What a binary of the FMU is, by its file name."""
-    file = name.rpartition("/")[2]
-    if file.startswith("container_fmu"):
-        return "fmpy's container binary (no Python)"
-    if file.endswith(".so"):
-        return "the loader: the FMI functions; starts a CPython >= 3.11 with a shared libpython (below)"
-    if file.endswith(".dll"):
-        return "fmpy's container binary for Windows"
-    return "fmpy's container binary for macOS"
+_PY_VERSION = re.compile(rb"\x00(3\.1\d\.\d+)\x00")  # PY_VERSION, a string of its own in libpython's data
+_DLL_VERSION = re.compile(rb"P\x00r\x00o\x00d\x00u\x00c\x00t\x00V\x00e\x00r\x00s\x00i\x00o\x00n\x00\x00\x00"
+                          rb"((?:[0-9.]\x00)+)")  # the DLL's version resource, UTF-16
 
 
-def _needs(data: bytes) -> str:
-    return html.escape(elf_needs.describe(data)) if data[:4] == b"\x7fELF" else ""
+def python_version(name: str, data: bytes) -> str:
+    """The full version of the CPython library ``name`` ("3.11.7"), read from its bytes, else from its name."""
+    found = _DLL_VERSION.search(data) if name.endswith(".dll") else _PY_VERSION.search(data)
+    if found:
+        return found.group(1).decode("utf-16-le" if name.endswith(".dll") else "ascii")
+    digits = re.search(r"python(\d)\.?(\d+)", name)
+    return f"{digits.group(1)}.{digits.group(2)}" if digits else "?"
+
+
+def _is_python_library(file: str) -> bool:
+    return bool(re.fullmatch(r"libpython3\.\d+\.so(\.[\d.]+)?|python3\d+\.dll", file))
+
+
+def _folder_row(folder: str, files: Mapping[str, bytes]) -> str:
+    """One row of the machine table: what ``folder`` (``.../binaries/<platform>/``) holds and what it needs."""
+    inside = {name[len(folder):]: data for name, data in files.items() if name.startswith(folder) and
+              "/" not in name[len(folder):]}
+    windows = any(name.endswith(".dll") for name in inside)
+    loaders = sorted(name for name in inside if name.startswith("container_fmu") or
+                     (name.endswith((".so", ".dll")) and name.rsplit(".", 1)[0] in INTERFACES))
+    libraries = sorted(name for name in inside if _is_python_library(name))
+    what = [html.escape("fmpy's container binary (no Python)") if name.startswith("container_fmu") else
+            f"the loader <code>{html.escape(name)}</code> (the FMI functions)" for name in loaders]
+    if libraries:
+        extensions = [name for name in inside if name.endswith(".pyd") or ".cpython-" in name]
+        others = sorted(name for name in inside if name.endswith((".dll", ".so")) or ".so." in name)
+        others = [name for name in others if name not in loaders and name not in libraries and name not in extensions]
+        zipped = [name for name in inside if name.endswith(".zip")]
+        modules = sum(1 for n in zipfile.ZipFile(io.BytesIO(inside[zipped[0]])).namelist() if n.endswith(".pyc")) \
+            if zipped else 0
+        what.append(f"the CPython {python_version(libraries[0], inside[libraries[0]])} it carries: "
+                    f"<code>{html.escape(libraries[0])}</code>, {modules} modules of its standard library in "
+                    f"<code>{html.escape(zipped[0] if zipped else '')}</code>, {len(extensions)} extension modules"
+                    + (f", and what they need: {', '.join(f'<code>{html.escape(n)}</code>' for n in others)}"
+                       if others else ""))
+    elif loaders and not any(name.startswith("container_fmu") for name in loaders):
+        what.append("no Python of its own: it uses the one of a Python host, else finds one (below)")
+    if windows:
+        needs = "Windows 10 or newer, x64 (the Universal C Runtime, part of Windows since 10)"
+    else:
+        floors = [elf_needs.newest(elf_needs.version_needs(data), "GLIBC") for data in inside.values()
+                  if data[:4] == b"\x7fELF"]
+        floor = max((f for f in floors if f), key=elf_needs.version_key, default=None)
+        needs = f"Linux on x86-64 with glibc &gt;= {floor.partition('_')[2]}" if floor else "Linux on x86-64"
+    size = sum(len(data) for data in inside.values()) / 1e6
+    return (f"<tr><td><code>{html.escape(folder)}</code></td><td>{'; '.join(what)}</td><td>{needs}</td>"
+            f"<td class=\"number\">{size:.1f} MB</td></tr>")
 
 
 def machine_section(files: Mapping[str, bytes], model: str) -> str:
-    """What a target machine needs: every binary in the FMU (a container's components too), the CPython
-    the build recorded, and how the loader finds a Python (its docstring)."""
-    rows = []
-    for name in sorted(files):
-        parts = name.split("/")
-        if "binaries" in parts and name.endswith((".so", ".dll", ".dylib")):
-            role = _role(name)
-            rows.append(f"<tr><td><code>{html.escape(name)}</code></td><td>{html.escape(role)}</td>"
-                        f"<td>{_needs(files[name])}</td></tr>")
+    """What a target machine needs: each binaries folder of the FMU (a container's components too), what it holds
+    (the loader, the CPython it carries) and what it asks of the system (glibc, read from every Linux binary in
+    it: :mod:`~double_pendulum.fmu.carries.elf_needs`), the CPython a lean FMU was built with, and how the loader
+    finds a Python (its docstring)."""
+    folders = sorted({name.rpartition("/")[0] + "/" for name in files if "binaries/" in name and
+                      name.split("/")[-2] != "binaries" and name.rpartition("/")[0].split("/")[-2] == "binaries"})
+    rows = [_folder_row(folder, files) for folder in folders]
     record = [f for f in sorted(files) if f.endswith("resources/python.cfg")]
     recorded = ""
     if record:
         lines = [line for line in files[record[0]].decode().splitlines() if line and not line.startswith("#")]
         recorded = (f"<p>The CPython this FMU was built with (<code>{html.escape(record[0])}</code>):</p>\n"
                     f"<pre>{html.escape(chr(10).join(lines))}</pre>")
-    intro = ("<p>The container's own binary (fmpy's <code>container_fmu</code>) needs no Python; its two FMUs, "
-             "under <code>resources/</code>, do:</p>" if model == "PendulumOnSuspension" else "")
+    intro = ("<p>The container's own binary (fmpy's <code>container_fmu</code>) needs no Python; each of its two "
+             "FMUs, under <code>resources/</code>, carries its own, and the first to start in a process starts it "
+             "for both:</p>" if model == "PendulumOnSuspension" else "")
     loader_doc = _module_doc("fmu.build.loader")
-    head = "<thead><tr><th>binary</th><th>what it is</th><th>needs of the system</th></tr></thead>"
+    head = "<thead><tr><th>binaries</th><th>what they are</th><th>needs of the system</th><th>size</th></tr></thead>"
     return (f"{intro}\n<table>\n{head}\n<tbody>\n"
             + "\n".join(rows) + f"\n</tbody>\n</table>\n{recorded}\n"
             f"<h3>{inline_html(summary(loader_doc))}</h3>\n{docstring_html(loader_doc)}")

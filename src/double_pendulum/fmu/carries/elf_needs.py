@@ -1,4 +1,5 @@
-"""What a Linux shared library asks of the system it loads on: the symbol versions it needs.
+"""What a Linux shared library asks of the system it loads on: the libraries it links and the symbol versions
+it needs.
 
 An ELF library built against glibc and libstdc++ records, per library it links (``libc.so.6``,
 ``libstdc++.so.6``, ...), the symbol versions it needs (``GLIBC_2.32``, ``GLIBCXX_3.4.30``) in its
@@ -14,19 +15,42 @@ import re
 import struct
 
 SHT_GNU_VERNEED = 0x6FFFFFFE
+SHT_DYNAMIC = 6
+DT_NEEDED = 1
 # The oldest GCC whose libstdc++ has each GLIBCXX version (GCC's ABI policy, libstdc++ manual, "ABI").
 GLIBCXX_GCC = {"3.4.19": "4.8", "3.4.20": "4.9", "3.4.21": "5", "3.4.22": "6", "3.4.23": "7", "3.4.24": "7.2",
                "3.4.25": "8", "3.4.26": "9", "3.4.27": "9.2", "3.4.28": "10", "3.4.29": "11", "3.4.30": "12",
                "3.4.31": "13", "3.4.32": "14", "3.4.33": "15"}
 
 
-def version_needs(data: bytes) -> dict[str, list[str]]:
-    """The symbol versions a 64-bit little-endian ELF file needs, by library: ``{"libc.so.6": [...]}``."""
+def _sections(data: bytes) -> list[tuple[int, ...]]:
+    """The section headers of a 64-bit little-endian ELF file (name, type, flags, address, offset, size, link,
+    info, alignment, entry size)."""
     if data[:4] != b"\x7fELF" or data[4] != 2 or data[5] != 1:
         raise ValueError("not a 64-bit little-endian ELF file")
     shoff, = struct.unpack_from("<Q", data, 0x28)
     shentsize, shnum = struct.unpack_from("<HH", data, 0x3A)
-    sections = [struct.unpack_from("<IIQQQQIIQQ", data, shoff + k * shentsize) for k in range(shnum)]
+    return [struct.unpack_from("<IIQQQQIIQQ", data, shoff + k * shentsize) for k in range(shnum)]
+
+
+def needed_libraries(data: bytes) -> list[str]:
+    """The libraries a 64-bit little-endian ELF file links by name (its ``DT_NEEDED`` entries), in order."""
+    sections = _sections(data)
+    names = []
+    for _, kind, _, _, offset, size, link, _, _, _ in sections:
+        if kind != SHT_DYNAMIC:
+            continue
+        strings = sections[link][4]
+        for at in range(offset, offset + size, 16):
+            tag, value = struct.unpack_from("<qQ", data, at)
+            if tag == DT_NEEDED:
+                names.append(data[strings + value:data.index(b"\0", strings + value)].decode())
+    return names
+
+
+def version_needs(data: bytes) -> dict[str, list[str]]:
+    """The symbol versions a 64-bit little-endian ELF file needs, by library: ``{"libc.so.6": [...]}``."""
+    sections = _sections(data)
     needs: dict[str, list[str]] = {}
     for _, kind, _, _, offset, _, link, count, _, _ in sections:
         if kind != SHT_GNU_VERNEED:
