@@ -2,10 +2,11 @@
  *
  *   fmi2_host DIR IDENTIFIER GUID STEPS STEP_SIZE [ARG ...]
  *
- * DIR is an extracted FMU; the host dlopens DIR/binaries/linux64/IDENTIFIER.so, instantiates it
- * (co-simulation, logging off), applies the ARGs, sets up, initialises (inputs set in initialisation
- * mode), runs STEPS doSteps of STEP_SIZE from t = 0 (inputs set before each), reads the outputs,
- * terminates and frees the instance, and unloads the library.
+ * DIR is an extracted FMU; the host loads DIR/binaries/linux64/IDENTIFIER.so (on Windows
+ * DIR/binaries/win64/IDENTIFIER.dll, host_common.h), instantiates it (co-simulation, logging off),
+ * applies the ARGs, sets up, initialises (inputs set in initialisation mode), runs STEPS doSteps of
+ * STEP_SIZE from t = 0 (inputs set before each), reads the outputs, terminates and frees the instance,
+ * and unloads the library.
  * ARGs: r:VR=VALUE (Real start value), b:VR=0|1 (Boolean), s:VR=TEXT (String), i:VR=VALUE (Real
  * input set before every doStep), f:PATH (an input table, host_common.h: its inputs interpolated at each
  * communication point and set in initialisation mode and before every doStep, as the FMI Compliance
@@ -13,16 +14,15 @@
  * O:VR (Real read at every communication point from the start, printed as "row T VALUE ..." lines).
  * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE". At the end the host prints
  * "startup-cpu-seconds T" (the process's CPU time from loading the library to the end of the first
- * doStep) and "host-unchanged 1" if its environment and its signal handlers are as they were before
- * it loaded the FMU, else "host-unchanged 0". Exit status: 0 on success, 2 bad usage, 3 library not loaded,
- * 4 instantiation failed, 5 a call failed. */
-#include <dlfcn.h>
-#include <signal.h>
+ * doStep) and "host-unchanged 1" if its environment and its signal handlers (on Windows: its environment,
+ * host_common.h) are as they were before it loaded the FMU, else "host-unchanged 0". Exit status: 0 on
+ * success, 2 bad usage, 3 library not loaded, 4 instantiation failed, 5 a call failed, 9 a crash on
+ * Windows (host_common.h; on Linux a crash ends the host by its signal).
+ * On Windows the command line is read as UTF-16: DIR, PATH and TEXT may be any Unicode (host_common.h). */
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "fmi2Functions.h"
 #include "host_common.h"
@@ -41,6 +41,7 @@ static void logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status
 }
 
 int main(int argc, char **argv) {
+    host_start(&argc, &argv);
     if (argc < 6) {
         fprintf(stderr, "usage: %s DIR IDENTIFIER GUID STEPS STEP_SIZE [ARG ...]\n", argv[0]);
         return 2;
@@ -48,20 +49,14 @@ int main(int argc, char **argv) {
     const char *dir = argv[1], *identifier = argv[2], *guid = argv[3];
     long steps = atol(argv[4]);
     double step_size = atof(argv[5]);
-    char path[4096], resources[4200];
-    snprintf(path, sizeof path, "%s/binaries/linux64/%s.so", dir, identifier);
-    snprintf(resources, sizeof resources, "file://%s/resources", dir);
+    char path[4096], resources[4096 * 3];
+    if (!fmu_locations(dir, identifier, 2, path, sizeof path, resources, sizeof resources)) return 2;
 
     static host_state before, after;
     snapshot(&before);
-    struct timespec start, first_step;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &start);
-    first_step = start;
-    void *library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!library) {
-        fprintf(stderr, "cannot load %s: %s\n", path, dlerror());
-        return 3;
-    }
+    double start = cpu_seconds(), first_step = start;
+    host_library library = load_library(path);
+    if (!library) return 3;
     fmi2InstantiateTYPE *instantiate = (fmi2InstantiateTYPE *)symbol(library, "fmi2Instantiate");
     fmi2FreeInstanceTYPE *free_instance = (fmi2FreeInstanceTYPE *)symbol(library, "fmi2FreeInstance");
     fmi2SetupExperimentTYPE *setup = (fmi2SetupExperimentTYPE *)symbol(library, "fmi2SetupExperiment");
@@ -128,7 +123,7 @@ int main(int argc, char **argv) {
         if (n_inputs) CHECK(set_real(c, inputs, n_inputs, input_values));
         SET_TABLE(k * step_size);
         CHECK(do_step(c, k * step_size, (k + 1) * step_size - k * step_size, fmi2True));
-        if (k == 0) clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &first_step);
+        if (k == 0) first_step = cpu_seconds();
         RECORD((k + 1) * step_size);
     }
     fmi2Real values[MAX_ARGS];
@@ -136,10 +131,9 @@ int main(int argc, char **argv) {
     for (size_t k = 0; k < n_outputs; k++) printf("%u %.17g\n", outputs[k], values[k]);
     CHECK(terminate(c));
     free_instance(c);
-    dlclose(library);
+    close_library(library);
     snapshot(&after);
-    printf("startup-cpu-seconds %.6f\n",
-           (double)(first_step.tv_sec - start.tv_sec) + 1e-9 * (double)(first_step.tv_nsec - start.tv_nsec));
+    printf("startup-cpu-seconds %.6f\n", first_step - start);
     printf("host-unchanged %d\n", unchanged(&before, &after));
     return 0;
 }

@@ -2,9 +2,9 @@
  *
  *   fmi3_host DIR IDENTIFIER TOKEN METHOD STEPS STEP_SIZE [ARG ...]
  *
- * DIR is an extracted FMU; the host dlopens DIR/binaries/x86_64-linux/IDENTIFIER.so and runs it from
- * t = 0 over STEPS steps of STEP_SIZE, then reads the outputs, terminates, frees the instance and
- * unloads the library. METHOD:
+ * DIR is an extracted FMU; the host loads DIR/binaries/x86_64-linux/IDENTIFIER.so (on Windows
+ * DIR/binaries/x86_64-windows/IDENTIFIER.dll, host_common.h) and runs it from t = 0 over STEPS steps of
+ * STEP_SIZE, then reads the outputs, terminates, frees the instance and unloads the library. METHOD:
  *   euler, rk4  Model Exchange, integrated by the host with explicit Euler or classical RK4, with
  *               event handling as the FMI 3.0 standard describes it (section 3.2): after every step
  *               fmi3CompletedIntegratorStep; Event Mode on its request, on a time event
@@ -26,12 +26,12 @@
  * Exchange run of N RK4 steps per output interval prints a row per interval).
  * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE". At the end it prints "events N",
  * "event-iterations N", "derivative-evaluations N" and "host-unchanged 1" if its environment and
- * signal handlers are as before it loaded the FMU. Exit status: 0 on success, 2 bad usage, 3 library
- * not loaded, 4 instantiation failed, 5 a call failed, 6 an event iteration did not end, 7 the FMU
- * asked to terminate. */
-#include <dlfcn.h>
+ * signal handlers (on Windows: its environment, host_common.h) are as before it loaded the FMU. Exit
+ * status: 0 on success, 2 bad usage, 3 library not loaded, 4 instantiation failed, 5 a call failed, 6 an
+ * event iteration did not end, 7 the FMU asked to terminate, 9 a crash on Windows (host_common.h; on
+ * Linux a crash ends the host by its signal).
+ * On Windows the command line is read as UTF-16: DIR, PATH and TEXT may be any Unicode (host_common.h). */
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -48,7 +48,7 @@ static void logger(fmi3InstanceEnvironment env, fmi3Status status, fmi3String ca
     fflush(stdout);
 }
 
-static void *library;
+static host_library library;
 
 #define FUNCTION(name) name##TYPE *name = (name##TYPE *)symbol(library, #name)
 
@@ -211,6 +211,7 @@ static int run_co_simulation(fmi3Instance c, long steps, double h) {
 }
 
 int main(int argc, char **argv) {
+    host_start(&argc, &argv);
     if (argc < 7) {
         fprintf(stderr, "usage: %s DIR IDENTIFIER TOKEN euler|rk4|cs STEPS STEP_SIZE [ARG ...]\n", argv[0]);
         return 2;
@@ -220,17 +221,13 @@ int main(int argc, char **argv) {
     double h = atof(argv[6]);
     int cs = strcmp(method, "cs") == 0, rk4 = strcmp(method, "rk4") == 0;
     if (!cs && !rk4 && strcmp(method, "euler") != 0) return 2;
-    char path[4096], resources[4200];
-    snprintf(path, sizeof path, "%s/binaries/x86_64-linux/%s.so", dir, identifier);
-    snprintf(resources, sizeof resources, "%s/resources/", dir);
+    char path[4096], resources[4096];
+    if (!fmu_locations(dir, identifier, 3, path, sizeof path, resources, sizeof resources)) return 2;
 
     static host_state before, after;
     snapshot(&before);
-    library = dlopen(path, RTLD_NOW | RTLD_LOCAL);
-    if (!library) {
-        fprintf(stderr, "cannot load %s: %s\n", path, dlerror());
-        return 3;
-    }
+    library = load_library(path);
+    if (!library) return 3;
     FUNCTION(fmi3InstantiateModelExchange);
     FUNCTION(fmi3InstantiateCoSimulation);
     FUNCTION(fmi3FreeInstance);
@@ -290,7 +287,7 @@ int main(int argc, char **argv) {
     for (size_t k = 0; k < n_outputs; k++) printf("%u %.17g\n", outputs[k], values[k]);
     CHECK(fmi3Terminate(c));
     fmi3FreeInstance(c);
-    dlclose(library);
+    close_library(library);
     snapshot(&after);
     printf("events %ld\nevent-iterations %ld\nderivative-evaluations %ld\n", events, iterations, evaluations);
     printf("host-unchanged %d\n", unchanged(&before, &after));
