@@ -24,12 +24,19 @@
  * printed as "VR VALUE" with 17 digits), O:VR (Float64 read at every step's end from the start, printed
  * as "row T VALUE ..." lines), e:N (the O: rows at t = 0 and at every N-th step's end only: a Model
  * Exchange run of N RK4 steps per output interval prints a row per interval).
- * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE". At the end it prints "events N",
- * "event-iterations N", "derivative-evaluations N" and "host-unchanged 1" if its environment and
- * signal handlers (on Windows: its environment, host_common.h) are as before it loaded the FMU. Exit
- * status: 0 on success, 2 bad usage, 3 library not loaded, 4 instantiation failed, 5 a call failed, 6 an
- * event iteration did not end, 7 the FMU asked to terminate, 9 a crash on Windows (host_common.h; on
- * Linux a crash ends the host by its signal).
+ * For the whole run: l:1 (instantiate with loggingOn = true, so that the FMU logs every category it
+ * has, not only errors) and c:N (cycles: the run above, from fmi3Instantiate... to fmi3FreeInstance, N
+ * times over in the one process with the library loaded once, the outputs printed after the last, the
+ * counts below summed over all; after the first cycle and after every 100th the line
+ * "memory-kib CYCLE KIB", the process's private memory (host_common.h's memory_kib), so that a test can
+ * see it stay flat).
+ * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE"; a failed call (status above fmi3Warning)
+ * prints "CALL failed with status N" on stderr and ends the host (exit status 5). At the end it prints
+ * "events N", "event-iterations N", "derivative-evaluations N" and "host-unchanged 1" if its environment
+ * and signal handlers (on Windows: its environment, host_common.h) are as before it loaded the FMU.
+ * Exit status: 0 on success, 2 bad usage, 3 library not loaded, 4 instantiation failed, 5 a call failed,
+ * 6 an event iteration did not end, 7 the FMU asked to terminate, 9 a crash on Windows (host_common.h;
+ * on Linux a crash ends the host by its signal).
  * On Windows the command line is read as UTF-16: DIR, PATH and TEXT may be any Unicode (host_common.h). */
 #include <math.h>
 #include <stdio.h>
@@ -52,9 +59,11 @@ static host_library library;
 
 #define FUNCTION(name) name##TYPE *name = (name##TYPE *)symbol(library, #name)
 
-/* The host's inputs: continuous values, and jumps in Event Mode. */
+/* The host's inputs: continuous values (as given, and as the jumps changed them in this run), and jumps in
+ * Event Mode. */
 static fmi3ValueReference inputs[MAX_ARGS], jumps[MAX_ARGS];
-static fmi3Float64 input_values[MAX_ARGS], jump_values[MAX_ARGS], jump_times[MAX_ARGS];
+static fmi3Float64 given_input_values[MAX_ARGS], input_values[MAX_ARGS], jump_values[MAX_ARGS],
+    jump_times[MAX_ARGS];
 static size_t n_inputs, n_jumps;
 static long evaluations;
 static input_table table;
@@ -62,6 +71,7 @@ static fmi3Float64 table_values[MAX_ARGS];
 static fmi3ValueReference recorded[MAX_ARGS];
 static size_t n_recorded;
 static long record_every = 1; /* e:N */
+static int printing = 1;      /* the O: rows and the o: outputs: in the last of the c:N cycles only */
 
 /* Set the input table's values at time t (nothing without a table). */
 static fmi3Status set_table(fmi3Instance c, double t) {
@@ -75,7 +85,7 @@ static fmi3Status set_table(fmi3Instance c, double t) {
 static fmi3Status record_row(fmi3Instance c, double t) {
     FUNCTION(fmi3GetFloat64);
     fmi3Float64 row[MAX_ARGS];
-    if (!n_recorded) return fmi3OK;
+    if (!n_recorded || !printing) return fmi3OK;
     fmi3Status status = fmi3GetFloat64(c, recorded, n_recorded, row, n_recorded);
     printf("row %.17g", t);
     for (size_t r = 0; r < n_recorded; r++) printf(" %.17g", row[r]);
@@ -210,24 +220,42 @@ static int run_co_simulation(fmi3Instance c, long steps, double h) {
     return 0;
 }
 
-int main(int argc, char **argv) {
-    host_start(&argc, &argv);
-    if (argc < 7) {
-        fprintf(stderr, "usage: %s DIR IDENTIFIER TOKEN euler|rk4|cs STEPS STEP_SIZE [ARG ...]\n", argv[0]);
-        return 2;
-    }
-    const char *dir = argv[1], *identifier = argv[2], *token = argv[3], *method = argv[4];
-    long steps = atol(argv[5]);
-    double h = atof(argv[6]);
-    int cs = strcmp(method, "cs") == 0, rk4 = strcmp(method, "rk4") == 0;
-    if (!cs && !rk4 && strcmp(method, "euler") != 0) return 2;
-    char path[4096], resources[4096];
-    if (!fmu_locations(dir, identifier, 3, path, sizeof path, resources, sizeof resources)) return 2;
+/* The r:, b: and s: ARGs, applied after every instantiation; the outputs read at the end. */
+static host_argument starts[MAX_ARGS];
+static size_t n_starts;
+static fmi3ValueReference outputs[MAX_ARGS];
+static size_t n_outputs;
 
-    static host_state before, after;
-    snapshot(&before);
-    library = load_library(path);
-    if (!library) return 3;
+/* Sort the ARGs into the host's lists; 0 (after saying why) if one is bad, or one too many of its kind. c:
+ * and l: are the run's: `cycles` and `logging`. */
+static int read_arguments(char **args, int n, long *cycles, fmi3Boolean *logging) {
+    for (int k = 0; k < n; k++) {
+        host_argument a;
+        if (!parse_argument(args[k], &a) || (strchr("ec", a.kind) && a.vr == 0) || n_starts == MAX_ARGS ||
+            n_inputs == MAX_ARGS || n_jumps == MAX_ARGS || n_outputs == MAX_ARGS || n_recorded == MAX_ARGS) {
+            fprintf(stderr, "bad argument %s\n", args[k]);
+            return 0;
+        }
+        if (a.kind == 'o') outputs[n_outputs++] = a.vr;
+        else if (a.kind == 'O') recorded[n_recorded++] = a.vr;
+        else if (a.kind == 'e') record_every = (long)a.vr;
+        else if (a.kind == 'c') *cycles = (long)a.vr;
+        else if (a.kind == 'l') *logging = a.vr ? fmi3True : fmi3False;
+        else if (a.kind == 'i') inputs[n_inputs] = a.vr, given_input_values[n_inputs++] = a.real;
+        else if (a.kind == 'j') jumps[n_jumps] = a.vr, jump_values[n_jumps] = a.real, jump_times[n_jumps++] = a.at;
+        else if (a.kind != 'f') starts[n_starts++] = a; /* r:, b:, s: */
+        else if (!read_input_table(a.text, &table)) {
+            fprintf(stderr, "cannot read the input table %s\n", a.text);
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* One run, from instantiation to fmi3FreeInstance, by METHOD (`cs`, else Model Exchange by RK4 or Euler);
+ * the event counts added to `events` and `iterations`. 0, or the host's exit status. */
+static int run(int cs, int rk4, const char *token, const char *resources, fmi3Boolean logging, long steps, double h,
+               long *events, long *iterations) {
     FUNCTION(fmi3InstantiateModelExchange);
     FUNCTION(fmi3InstantiateCoSimulation);
     FUNCTION(fmi3FreeInstance);
@@ -238,55 +266,63 @@ int main(int argc, char **argv) {
     FUNCTION(fmi3SetString);
     FUNCTION(fmi3GetFloat64);
     FUNCTION(fmi3Terminate);
-    fmi3Instance c = cs ? fmi3InstantiateCoSimulation("host", token, resources, fmi3False, fmi3False, fmi3False,
+    fmi3Instance c = cs ? fmi3InstantiateCoSimulation("host", token, resources, fmi3False, logging, fmi3False,
                                                       fmi3False, NULL, 0, NULL, logger, NULL)
-                        : fmi3InstantiateModelExchange("host", token, resources, fmi3False, fmi3False, NULL, logger);
+                        : fmi3InstantiateModelExchange("host", token, resources, fmi3False, logging, NULL, logger);
     if (!c) {
         fprintf(stderr, "fmi3Instantiate%s returned NULL\n", cs ? "CoSimulation" : "ModelExchange");
         return 4;
     }
-
-    fmi3ValueReference outputs[MAX_ARGS];
-    size_t n_outputs = 0;
-    for (int k = 7; k < argc && n_inputs < MAX_ARGS && n_jumps < MAX_ARGS && n_outputs < MAX_ARGS; k++) {
-        host_argument a;
-        if (!parse_argument(argv[k], &a)) {
-            fprintf(stderr, "bad argument %s\n", argv[k]);
-            return 2;
-        }
-        fmi3ValueReference vr = a.vr;
-        fmi3Boolean boolean = atoi(a.text) ? fmi3True : fmi3False;
-        if (a.kind == 'o') outputs[n_outputs++] = vr;
-        else if (a.kind == 'O' && n_recorded < MAX_ARGS) recorded[n_recorded++] = vr;
-        else if (a.kind == 'e' && vr > 0) record_every = vr;
-        else if (a.kind == 'e') {
-            fprintf(stderr, "bad argument %s\n", argv[k]);
-            return 2;
-        }
-        else if (a.kind == 'f' && !read_input_table(a.text, &table)) {
-            fprintf(stderr, "cannot read the input table %s\n", a.text);
-            return 2;
-        }
-        else if (a.kind == 'f') continue;
-        else if (a.kind == 'r') CHECK(fmi3SetFloat64(c, &vr, 1, &a.real, 1));
-        else if (a.kind == 'b') CHECK(fmi3SetBoolean(c, &vr, 1, &boolean, 1));
-        else if (a.kind == 's') CHECK(fmi3SetString(c, &vr, 1, &a.text, 1));
-        else if (a.kind == 'i') inputs[n_inputs] = vr, input_values[n_inputs++] = a.real;
-        else jumps[n_jumps] = vr, jump_values[n_jumps] = a.real, jump_times[n_jumps++] = a.at;
+    for (const host_argument *a = starts; a < starts + n_starts; a++) {
+        fmi3ValueReference vr = a->vr;
+        fmi3Boolean boolean = atoi(a->text) ? fmi3True : fmi3False;
+        if (a->kind == 'r') CHECK(fmi3SetFloat64(c, &vr, 1, &a->real, 1));
+        else if (a->kind == 'b') CHECK(fmi3SetBoolean(c, &vr, 1, &boolean, 1));
+        else CHECK(fmi3SetString(c, &vr, 1, &a->text, 1));
     }
+    memcpy(input_values, given_input_values, sizeof input_values); /* as given: the last run's jumps undone */
 
     CHECK(fmi3EnterInitializationMode(c, fmi3False, 0.0, 0.0, fmi3True, steps * h));
     if (n_inputs) CHECK(fmi3SetFloat64(c, inputs, n_inputs, input_values, n_inputs));
     CHECK(set_table(c, 0.0));
     CHECK(fmi3ExitInitializationMode(c));
-    long events = 0, iterations = 0;
-    int status = cs ? run_co_simulation(c, steps, h) : run_model_exchange(c, rk4, steps, h, &events, &iterations);
+    int status = cs ? run_co_simulation(c, steps, h) : run_model_exchange(c, rk4, steps, h, events, iterations);
     if (status) return status;
     fmi3Float64 values[MAX_ARGS];
     if (n_outputs) CHECK(fmi3GetFloat64(c, outputs, n_outputs, values, n_outputs));
-    for (size_t k = 0; k < n_outputs; k++) printf("%u %.17g\n", outputs[k], values[k]);
+    for (size_t k = 0; k < n_outputs && printing; k++) printf("%u %.17g\n", outputs[k], values[k]);
     CHECK(fmi3Terminate(c));
     fmi3FreeInstance(c);
+    return 0;
+}
+
+int main(int argc, char **argv) {
+    host_start(&argc, &argv);
+    if (argc < 7) {
+        fprintf(stderr, "usage: %s DIR IDENTIFIER TOKEN euler|rk4|cs STEPS STEP_SIZE [ARG ...]\n", argv[0]);
+        return 2;
+    }
+    const char *dir = argv[1], *identifier = argv[2], *token = argv[3], *method = argv[4];
+    long steps = atol(argv[5]), cycles = 1;
+    double h = atof(argv[6]);
+    fmi3Boolean logging = fmi3False;
+    int cs = strcmp(method, "cs") == 0, rk4 = strcmp(method, "rk4") == 0;
+    if (!cs && !rk4 && strcmp(method, "euler") != 0) return 2;
+    if (!read_arguments(argv + 7, argc - 7, &cycles, &logging)) return 2;
+    char path[4096], resources[4096];
+    if (!fmu_locations(dir, identifier, 3, path, sizeof path, resources, sizeof resources)) return 2;
+
+    static host_state before, after;
+    snapshot(&before);
+    library = load_library(path);
+    if (!library) return 3;
+    long events = 0, iterations = 0;
+    for (long cycle = 1; cycle <= cycles; cycle++) {
+        printing = cycle == cycles;
+        int status = run(cs, rk4, token, resources, logging, steps, h, &events, &iterations);
+        if (status) return status;
+        if (cycles > 1 && (cycle == 1 || cycle % 100 == 0)) printf("memory-kib %ld %ld\n", cycle, memory_kib());
+    }
     close_library(library);
     snapshot(&after);
     printf("events %ld\nevent-iterations %ld\nderivative-evaluations %ld\n", events, iterations, evaluations);

@@ -247,10 +247,13 @@ static inline double cpu_seconds(void) {
  * writable memory, heap and anonymous mappings, whether touched or not). A leak grows both. */
 static inline long memory_kib(void) {
 #ifdef _WIN32
+    /* Windows 8 and later give the commit charge as PrivateUsage and as PagefileUsage, Windows 7 only as
+     * PrivateUsage, Wine (8.0) only as PagefileUsage (Linux's RssAnon + VmSwap): the one that is there */
     PROCESS_MEMORY_COUNTERS_EX counters;
+    memset(&counters, 0, sizeof counters);
     if (!K32GetProcessMemoryInfo(GetCurrentProcess(), (PROCESS_MEMORY_COUNTERS *)&counters, sizeof counters))
         return -1;
-    return (long)(counters.PrivateUsage / 1024);
+    return (long)((counters.PrivateUsage ? counters.PrivateUsage : counters.PagefileUsage) / 1024);
 #else
     FILE *status = fopen("/proc/self/status", "r");
     char line[256];
@@ -313,7 +316,8 @@ static inline int unchanged(const host_state *before, const host_state *after) {
 /* One argument of a host: K:VR=VALUE (K: r Float64/Real start value, b Boolean 0|1, s String, i input),
  * j:VR=VALUE@T (an input's jump at T, FMI 3 host only), o:VR (an output to print at the end), O:VR (an
  * output to print at every communication point), e:N (the O: outputs printed at every N-th step's end
- * only, FMI 3 host only; N in `vr`) or f:PATH (an input table, read_input_table). */
+ * only, FMI 3 host only; N in `vr`), c:N (the run N times over, instantiation to free, printing the
+ * memory; N in `vr`), l:0|1 (loggingOn; in `vr`) or f:PATH (an input table, read_input_table). */
 typedef struct {
     char kind;
     unsigned int vr;
@@ -328,7 +332,7 @@ static inline int parse_argument(const char *text, host_argument *a) {
     *a = (host_argument){text[0], (unsigned int)strtoul(text + 2, NULL, 10), value ? atof(value + 1) : 0.0,
                          value ? value + 1 : "", at ? atof(at + 1) : 0.0};
     if (text[0] == '\0' || text[1] != ':') return 0;
-    if (strchr("oOe", a->kind)) return 1;
+    if (strchr("oOecl", a->kind)) return 1;
     if (a->kind == 'f') return a->text = text + 2, 1;
     return value && strchr("rbsij", a->kind) && (a->kind != 'j' || at);
 }
