@@ -37,9 +37,11 @@ AGREE = 1e-9
 """The largest difference between the Windows and the Linux host, relative to the output's largest magnitude (at
 least 1): the same C compiled twice, apart from the C runtime's formatting and libm."""
 MEMORY_GROWTH_KIB = 64
-"""What 900 cycles (from the 100th to the 1,000th) may add to the process's private memory, where the allocators
-have settled (measured: 0 KiB on both platforms). A build of BouncingBall leaking 1,000 bytes a cycle fails it on
-both (measured: 880 KiB under Wine, 924 KiB on Linux, whose heap grows in steps of 132 KiB)."""
+"""What the last 500 cycles (from the 500th to the 1,000th) may add to the process's private memory: by then the
+allocators have settled (the project's DoublePendulum.fmu in the Linux host grows by one step of 1 MiB between
+the 100th and the 200th cycle, then not at all; the Reference FMUs by nothing after the first). A build of
+BouncingBall leaking 1,000 bytes a cycle fails it on both platforms (measured over 500 cycles: 492 KiB under Wine,
+528 KiB on Linux, whose heap grows in steps of 132 KiB)."""
 NON_ASCII = "Fmüß-π"
 
 # model: (STEPS, STEP_SIZE) of the runs compared
@@ -144,7 +146,7 @@ def test_a_thousand_instantiate_free_cycles_keep_memory_flat(wine, hosts, tmp_pa
     assert sorted(memory) == [1, *range(100, 1001, 100)], memory
     assert min(memory.values()) > 0, memory  # a measure, not a placeholder
     print(f"{platform} fmi{version} {method}: memory over 1,000 cycles (KiB) {memory}")
-    assert memory[1000] - memory[100] <= MEMORY_GROWTH_KIB, memory
+    assert memory[1000] - memory[500] <= MEMORY_GROWTH_KIB, memory
     assert numbers(out)["vr 1"].size == 1  # the outputs printed once, after the last cycle
 
 
