@@ -151,19 +151,30 @@ def test_a_thousand_instantiate_free_cycles_keep_memory_flat(wine, hosts, tmp_pa
 
 
 @pytest.mark.parametrize("platform", ["windows", "linux"])
-def test_two_instances_at_once_print_what_two_single_runs_print(wine, hosts, tmp_path, platform):
-    """Two BouncingBalls alive together, stepped alternately, each with start values of its own."""
-    folder, _ = model(2, "BouncingBall")
+@pytest.mark.parametrize(("version", "method"), [(2, "cs"), (3, "cs"), (3, "rk4")])
+def test_two_instances_at_once_print_what_two_single_runs_print(wine, hosts, tmp_path, platform, version, method):
+    """Two BouncingBalls alive together, stepped alternately, each with start values of its own (and so bounces,
+    events under Model Exchange, of its own)."""
+    folder, _ = model(version, "BouncingBall")
     first, second = ["r:1=1.5", "r:6=0.8"], ["r:1=0.7", "r:6=0.6", "r:3=1"]
-    one = numbers(ok(run(wine, hosts, platform, 2, arguments(2, "BouncingBall", folder, "cs", first), tmp_path)))
-    two = numbers(ok(run(wine, hosts, platform, 2, arguments(2, "BouncingBall", folder, "cs", second), tmp_path)))
-    args = arguments(2, "BouncingBall", folder, "cs", first) + ["+"] + arguments(2, "BouncingBall", folder, "cs",
-                                                                                    second)[5:]
-    both = ok(run(wine, hosts, platform, 2, args, tmp_path))
-    assert deviation(numbers(both, "instance 1 "), one) == 0.0
-    assert deviation(numbers(both, "instance 2 "), two) == 0.0
-    assert deviation(one, two) > 0.1  # the start values made two different runs
+
+    def single(start: list[str]) -> str:
+        return ok(run(wine, hosts, platform, version, arguments(version, "BouncingBall", folder, method, start),
+                      tmp_path))
+
+    one, two = single(first), single(second)
+    own = 6 if version == 3 else 5  # the arguments before the ARGs
+    args = [*arguments(version, "BouncingBall", folder, method, first), "+",
+            *arguments(version, "BouncingBall", folder, method, second)[own:]]
+    both = ok(run(wine, hosts, platform, version, args, tmp_path))
+    assert deviation(numbers(both, "instance 1 "), numbers(one)) == 0.0
+    assert deviation(numbers(both, "instance 2 "), numbers(two)) == 0.0
+    assert deviation(numbers(one), numbers(two)) > 0.1  # the start values made two different runs
     assert [line for line in both.splitlines() if line.startswith("row")] == []  # every line of an instance prefixed
+    if version == 3:  # and the counts of events, each its own
+        for k, alone in ((1, one), (2, two)):
+            counts = [line for line in alone.splitlines() if line.startswith(("events", "event-it", "derivative"))]
+            assert counts and all(f"instance {k} {line}" in both.splitlines() for line in counts), (counts, both)
 
 
 @pytest.mark.parametrize(("version", "method"), [(2, "cs"), (3, "cs"), (3, "rk4")])
