@@ -9,12 +9,16 @@ import shutil
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 import sanitize
 
 from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.runs.result_cache import CACHE_ENV
+
+if TYPE_CHECKING:
+    from wine import Wine
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO / "data"
@@ -119,6 +123,15 @@ def fmu3_path(built_fmus: list[Path]) -> Path:
     """A freshly built FMI 3.0 DoublePendulum.fmu, Model Exchange and Co-Simulation (built once per session, by
     ``build_all`` into ``fmi3/`` beside the FMI 2.0 one, as ``double-pendulum build`` puts it)."""
     return built_fmus[-1]
+
+
+@pytest.fixture(scope="session")
+def wine(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Wine]:
+    """A private Wine prefix of this test process (tests/wine.py's ``Wine``), to run the C hosts' Windows builds in:
+    made on first use, its processes ended and the prefix removed at the end; skips where wine64 is missing."""
+    from wine import Wine
+
+    yield from Wine.session(tmp_path_factory)
 
 
 @pytest.fixture(scope="session")
