@@ -253,10 +253,10 @@ def quick_scenario(results: Path, name: str) -> tuple[Path, dict]:
 # The rest follow by their number of tests, as pytest-xdist orders them itself, within a module the tests keep
 # their order.
 LONGEST_FIRST = (
-    "test_host_hygiene", "test_loss_noise", "test_reports", "test_guard", "test_loss_identification",
-    "test_python_host", "test_c_host", "test_cli", "test_cross_check", "test_state_matrix", "test_summary_types",
-    "test_app", "test_page", "test_scenario_pool", "test_fmpy_tools", "test_bad_input", "test_chaos",
-    "test_energy_budget", "test_reference_results",
+    "test_host_hygiene", "test_loss_noise", "test_reports", "test_guard", "test_self_contained",
+    "test_loss_identification", "test_python_host", "test_c_host", "test_python_choice", "test_cli",
+    "test_cross_check", "test_state_matrix", "test_summary_types", "test_app", "test_page", "test_scenario_pool",
+    "test_fmpy_tools", "test_wine", "test_bad_input", "test_chaos", "test_energy_budget", "test_reference_results",
 )
 
 

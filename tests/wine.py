@@ -37,11 +37,11 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import os
+import selectors
 import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
@@ -191,24 +191,45 @@ class Wine:
 
     def _wine(self, command: list[str], *, cwd: Path, timeout: float,
               env: dict[str, str]) -> subprocess.CompletedProcess[str]:
-        # stdout and stderr go to (unlinked) files, not pipes: the Windows services a run starts (services.exe,
-        # winedevice.exe, ...) inherit them and live on for a few seconds after the program, and reading a pipe
-        # to its end would wait for them too (about 1.5 s a run, measured; 0.1 s this way)
-        with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
-            process = subprocess.Popen([str(self.wine64), *command], cwd=cwd, env=env, stdout=out, stderr=err,
-                                       stdin=subprocess.DEVNULL, start_new_session=True)
+        # stdout and stderr are pipes, read while the program runs and drained once it has ended: the Windows
+        # services a run starts (services.exe, winedevice.exe, ...) inherit them and live on for a few seconds
+        # after the program, so reading them to their end would wait for those too (about 1.5 s a run). Pipes,
+        # not files: under Wine a Windows program whose standard handle is a regular file cannot use it as a
+        # stream (CPython, starting, stops with "init_sys_streams: OSError: [WinError 6] Invalid handle";
+        # /dev/null, pipes and terminals work)
+        process = subprocess.Popen([str(self.wine64), *command], cwd=cwd, env=env, stdout=subprocess.PIPE,
+                                   stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, start_new_session=True)
+        chunks: dict[int, list[bytes]] = {process.stdout.fileno(): [], process.stderr.fileno(): []}
+        deadline = time.monotonic() + timeout
+        with selectors.DefaultSelector() as selector:
+            for stream in (process.stdout, process.stderr):
+                selector.register(stream, selectors.EVENT_READ)
             try:
-                code = process.wait(timeout=timeout)
+                while selector.get_map():
+                    ended = process.poll() is not None
+                    if not ended and time.monotonic() > deadline:
+                        raise subprocess.TimeoutExpired(command, timeout)
+                    ready = selector.select(timeout=0.05 if ended else 0.1)
+                    if ended and not ready:
+                        break  # the program has ended and written everything; only Wine's services hold the pipes
+                    for key, _ in ready:
+                        data = os.read(key.fd, 1 << 16)
+                        if data:
+                            chunks[key.fd].append(data)
+                        else:
+                            selector.unregister(key.fileobj)
             except subprocess.TimeoutExpired:
                 self.end_processes()
                 with contextlib.suppress(ProcessLookupError):
                     os.killpg(process.pid, signal.SIGKILL)
                 process.wait()
                 raise
-            out.seek(0)
-            err.seek(0)
-            return subprocess.CompletedProcess(process.args, code, out.read().decode("utf-8", "replace"),
-                                               err.read().decode("utf-8", "replace"))
+            finally:
+                process.stdout.close()
+                process.stderr.close()
+        code = process.wait()
+        out, err = (b"".join(chunks[f]).decode("utf-8", "replace") for f in chunks)
+        return subprocess.CompletedProcess(process.args, code, out, err)
 
     def processes(self) -> list[int]:
         """The ids of the live processes of this prefix: those with its WINEPREFIX in their environment (Wine's

@@ -27,7 +27,8 @@
  * prints "CALL failed with status N" on stderr and ends the host (exit status 5). At the end the host
  * prints "startup-cpu-seconds T" (the process's CPU time from loading the library to the end of the
  * first doStep) and "host-unchanged 1" if its environment and its signal handlers (on Windows: its
- * environment, host_common.h) are as they were before it loaded the FMU, else "host-unchanged 0".
+ * environment, host_common.h) are as they were before it loaded the FMU, else "host-unchanged 0"; before
+ * that, "pythons-loaded N": how many CPython libraries the process has loaded (host_common.h).
  * Exit status: 0 on success, 2 bad usage, 3 library not loaded, 4 instantiation failed, 5 a call failed,
  * 9 a crash on Windows (host_common.h; on Linux a crash ends the host by its signal).
  * On Windows the command line is read as UTF-16: DIR, PATH and TEXT may be any Unicode (host_common.h). */
@@ -219,6 +220,7 @@ int main(int argc, char **argv) {
     close_library(library);
     snapshot(&after);
     printf("startup-cpu-seconds %.6f\n", first_step - start);
+    printf("pythons-loaded %d\n", pythons_loaded());
     printf("host-unchanged %d\n", unchanged(&before, &after));
     return 0;
 }

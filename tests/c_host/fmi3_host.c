@@ -38,7 +38,8 @@
  * with "instance 1 " or "instance 2 ", so that a test can compare them with two single runs.
  * Log messages go to stdout as "log STATUS CATEGORY: MESSAGE"; a failed call (status above fmi3Warning)
  * prints "CALL failed with status N" on stderr and ends the host (exit status 5). At the end it prints
- * "events N", "event-iterations N", "derivative-evaluations N" and "host-unchanged 1" if its environment
+ * "events N", "event-iterations N", "derivative-evaluations N", "pythons-loaded N" (how many CPython
+ * libraries the process has loaded, host_common.h) and "host-unchanged 1" if its environment
  * and signal handlers (on Windows: its environment, host_common.h) are as before it loaded the FMU.
  * Exit status: 0 on success, 2 bad usage, 3 library not loaded, 4 instantiation failed, 5 a call failed,
  * 6 an event iteration did not end, 7 the FMU asked to terminate, 9 a crash on Windows (host_common.h;
@@ -372,6 +373,7 @@ int main(int argc, char **argv) {
     for (instance *in = instances; in < instances + n; in++)
         printf("%sevents %ld\n%sevent-iterations %ld\n%sderivative-evaluations %ld\n", in->prefix, in->events,
                in->prefix, in->iterations, in->prefix, in->evaluations);
+    printf("pythons-loaded %d\n", pythons_loaded());
     printf("host-unchanged %d\n", unchanged(&before, &after));
     return 0;
 }

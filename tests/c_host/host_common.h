@@ -265,6 +265,41 @@ static inline long memory_kib(void) {
 #endif
 }
 
+/* How many CPython libraries the process has loaded (a host without Python: 0 before an FMU of this project
+ * starts one, 1 after; never 2): Linux the distinct libpython3* files in /proc/self/maps, Windows the modules
+ * named python3XY.dll (python3.dll, the stable ABI's forwarder, is no interpreter); -1 if unknown. */
+static inline int pythons_loaded(void) {
+#ifdef _WIN32
+    HMODULE modules[1024];
+    DWORD needed = 0;
+    if (!K32EnumProcessModules(GetCurrentProcess(), modules, sizeof modules, &needed)) return -1;
+    int count = 0;
+    for (size_t k = 0; k < needed / sizeof *modules && k < sizeof modules / sizeof *modules; k++) {
+        wchar_t name[MAX_PATH];
+        if (!K32GetModuleBaseNameW(GetCurrentProcess(), modules[k], name, MAX_PATH)) continue;
+        size_t digits = 0;
+        while (name[7 + digits] >= L'0' && name[7 + digits] <= L'9' && _wcsnicmp(name, L"python3", 7) == 0) digits++;
+        if (digits >= 1 && _wcsicmp(name + 7 + digits, L".dll") == 0) count++;
+    }
+    return count;
+#else
+    FILE *maps = fopen("/proc/self/maps", "r");
+    char line[4352], seen[8][4096];
+    int count = 0;
+    while (maps && fgets(line, sizeof line, maps)) {
+        char *path = strchr(line, '/');
+        if (!path || !strstr(path, "/libpython3")) continue;
+        path[strcspn(path, "\n")] = '\0';
+        int known = 0;
+        for (int k = 0; k < count; k++) known |= strcmp(seen[k], path) == 0;
+        if (!known && count < 8) snprintf(seen[count++], sizeof seen[0], "%s", path);
+    }
+    if (!maps) return -1;
+    fclose(maps);
+    return count;
+#endif
+}
+
 /* The environment (and on Linux the handlers of SIGNALS), as one comparable record. Windows has no
  * sigaction: a signal() handler lives in the table of whichever C runtime installed it (the FMU's DLL may
  * have its own) and cannot be read without being replaced, and console control handlers cannot be listed;

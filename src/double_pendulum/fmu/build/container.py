@@ -47,8 +47,10 @@ EXPOSED_PARAMETERS = {
     SUSPENSION: ("M_s", "k_x", "k_y", "c_x", "c_y", "F_static_y"),
 }
 """Parameters the container always exposes (start: the value given, else the component's own start)."""
-CONTAINER_BINARIES = (("x86_64-linux", "linux64", "container_fmu.so"), ("x86_64-windows", "win64", "container_fmu.dll"))
-"""fmpy's container binaries the container may carry: (fmpy's folder, the FMI 2 platform, the file)."""
+CONTAINER_BINARIES = (("x86_64-linux", "linux64", "container_fmu.so"),)
+"""fmpy's container binaries the container may carry: (fmpy's folder, the FMI 2 platform, the file). Not its
+Windows one: it links bcryptprimitives.dll (Rust's random numbers, Windows 10 and newer), which Wine 8 lacks, so
+it could not be run here, and a platform ships only after it ran (its members carry their Windows binaries)."""
 
 
 def _component(fmu: Path) -> Any:
@@ -162,8 +164,8 @@ def write_container(
         write_model_description(config.modelDescription, root / "modelDescription.xml")
         write_configuration(config, root / "resources" / "container.json")
         _fix_connection_types(root / "resources" / "container.json")
-        # fmpy's container binary only for the platforms every member has a binary for (Linux, and Windows for
-        # self-contained members; never macOS): a container claims to run only where all of it can
+        # fmpy's container binary only for the platforms every member has a binary for (never macOS), and where it
+        # ran (CONTAINER_BINARIES): a container claims to run only where all of it can
         for platform_tuple, fmi2_platform, library in CONTAINER_BINARIES:
             if all((root / "resources" / Path(component.filename).stem / "binaries" / fmi2_platform).is_dir()
                    for component in config.components):
