@@ -43,10 +43,12 @@ RESOURCES = Path(ARCHIVE).parent if ARCHIVE else Path(__file__).resolve().parent
 
 
 def _import_private(name: str, *, run_init: bool = True) -> ModuleType:
-    """Import the package ``name`` from the bundle's archive (once per process); ``run_init=False`` registers it
-    without running its ``__init__``, for its submodules alone."""
+    """Import the package ``name`` from the bundle's archive (once per process; through the finder the loader's
+    bootstrap registered for it, archive_import, else zipimport); ``run_init=False`` registers it without running
+    its ``__init__``, for its submodules alone."""
     if name not in sys.modules:
-        spec = zipimport.zipimporter(ARCHIVE).find_spec(name)
+        finder = sys.path_importer_cache.get(ARCHIVE)
+        spec = (finder if hasattr(finder, "find_spec") else zipimport.zipimporter(ARCHIVE)).find_spec(name)
         if spec is None:
             raise ImportError(f"{name} is not in {ARCHIVE}", name=name)
         module = importlib.util.module_from_spec(spec)

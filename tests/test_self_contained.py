@@ -207,15 +207,17 @@ def test_under_wine_the_chaotic_case_follows_linux_over_a_second(wine, windows_h
 
 
 def test_under_wine_a_thousand_instantiate_free_cycles_keep_memory_flat(wine, windows_hosts, built, tmp_path):
-    """1,000 cycles of instantiate, one step, free, in one process with the library loaded once: the private
-    memory of the last 500 cycles grows by less than 0.2 KiB a cycle (the bound of the Linux hosts' soak)."""
-    done = wine.run(windows_hosts[2], [*built["fmi2"].arguments(stop=0.01), "c:1000"], cwd=tmp_path, timeout=600)
+    """1,000 cycles of instantiate, one step, free, after a warm-up of 700, in one process with the library loaded
+    once: the private memory grows by less than 0.2 KiB a cycle (the bound of the Linux hosts' soak). The warm-up:
+    the memory rises over the first 500 cycles and takes one more allocator block of about 400 KiB once, between
+    cycles 500 and 600 in every run seen, then stays flat to the last KiB."""
+    done = wine.run(windows_hosts[2], [*built["fmi2"].arguments(stop=0.01), "c:1700"], cwd=tmp_path, timeout=600)
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     memory = {int(c): int(kib) for _, c, kib in (line.split() for line in done.stdout.splitlines()
                                                    if line.startswith("memory-kib "))}
-    assert sorted(memory) == [1, *range(100, 1001, 100)] and min(memory.values()) > 0, memory
-    print(f"memory under Wine over 1,000 cycles (KiB): {memory}")
-    assert (memory[1000] - memory[500]) / 500 < 0.2, memory
+    assert sorted(memory) == [1, *range(100, 1701, 100)] and min(memory.values()) > 0, memory
+    print(f"memory under Wine over 1,700 cycles (KiB): {memory}")
+    assert (memory[1700] - memory[700]) / 1000 < 0.2, memory
 
 
 def test_under_wine_two_instances_at_once_give_two_single_runs(wine, windows_hosts, built, tmp_path):

@@ -12,22 +12,36 @@
 #define PY_FILE_INPUT 257 /* Py_file_input */
 
 /* Load the FMU's package `package` and its entry module `entry` from the zip resources/<archive> (the FMU's code,
- * fmu/build/bundle.py) under their own (private) names, once per process, and take the entry's bridge.  The
- * folder's path crosses as bytes (os.fsdecode: it names the same folder whatever the file system encoding of a
- * Python host).  Nothing is put on sys.path; the modules stay in sys.modules, so an FMU unloaded and loaded
- * again, or extracted again elsewhere, finds them there.  One thread at a time loads (the lock lives in
- * sys.modules, shared by every FMU of this project): another sees a module only once it is complete. */
+ * fmu/build/bundle.py) under their own (private) names, once per process, and take the entry's bridge.  The zip is
+ * read by the package's archive_import (fmu_src/archive_import.py, itself read with zipimport), registered for the
+ * zip's own paths in sys.path_importer_cache, and so is the zipped standard library of the CPython this FMU carries
+ * where that is the process's Python (`stdlib`: its path, else empty).  The folder's path crosses as bytes
+ * (os.fsdecode: it names the same folder whatever the file system encoding of a Python host).  Nothing is put on
+ * sys.path; the modules stay in sys.modules, so an FMU unloaded and loaded again, or extracted again elsewhere,
+ * finds them there and reads no zip.  One thread at a time loads (the lock lives in sys.modules, shared by every FMU
+ * of this project): another sees a module only once it is complete. */
 static const char BOOTSTRAP[] =
     "import os, sys, threading, types, zipimport\n"
     "resources = os.fsdecode(resources)  # the folder's bytes, whatever the file system encoding\n"
+    "path = os.path.join(resources, archive)\n"
     "loading = sys.modules.setdefault('_dp_fmu_loading', types.ModuleType('_dp_fmu_loading'))\n"
     "with vars(loading).setdefault('lock', threading.RLock()):\n"
-    "    for name in (package, entry):\n"
-    "        if name not in sys.modules:\n"
-    "            import importlib.util\n"
-    "            spec = zipimport.zipimporter(os.path.join(resources, archive)).find_spec(name)\n"
+    "    missing = [name for name in (package, entry) if name not in sys.modules]\n"
+    "    if missing:\n"
+    "        importer = vars(loading).get(package)\n"
+    "        if importer is None:  # archive_import, run from the zip without being imported\n"
+    "            importer = {'__name__': package + '.archive_import'}\n"
+    "            exec(zipimport.zipimporter(os.path.join(path, package)).get_code('archive_import'), importer)\n"
+    "            vars(loading)[package] = importer\n"
+    "        finders = vars(loading).setdefault('finders', {})\n"
+    "        for zip_path in (path, os.fsdecode(stdlib)) if stdlib else (path,):\n"
+    "            if zip_path not in finders:\n"
+    "                finders[zip_path] = importer['install'](zip_path)\n"
+    "        import importlib.util\n"
+    "        for name in missing:\n"
+    "            spec = finders[path].find_spec(name)\n"
     "            if spec is None:\n"
-    "                raise ImportError(f'{name} is not in {os.path.join(resources, archive)}')\n"
+    "                raise ImportError(f'{name} is not in {path}')\n"
     "            module = importlib.util.module_from_spec(spec)\n"
     "            sys.modules[name] = module\n"
     "            try:\n"
@@ -244,11 +258,14 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
     PyObject *entry_text = py->Unicode_FromString(entry);
     PyObject *package_text = py->Unicode_FromString(package);
     PyObject *archive_text = py->Unicode_FromString(archive);
+    const char *carried = python_runtime_stdlib();
+    PyObject *stdlib_text = py->Bytes_FromStringAndSize(carried, (ssize_t)strlen(carried));
     PyObject *code = py->CompileString(BOOTSTRAP, "<double-pendulum-fmu loader>", PY_FILE_INPUT);
     PyObject *bridge = NULL;
-    if (globals && resources_text && entry_text && package_text && archive_text && code &&
+    if (globals && resources_text && entry_text && package_text && archive_text && stdlib_text && code &&
         py->Dict_SetItemString(globals, "resources", resources_text) == 0 &&
         py->Dict_SetItemString(globals, "archive", archive_text) == 0 &&
+        py->Dict_SetItemString(globals, "stdlib", stdlib_text) == 0 &&
         py->Dict_SetItemString(globals, "package", package_text) == 0 &&
         py->Dict_SetItemString(globals, "entry", entry_text) == 0) {
         PyObject *done = py->Eval_EvalCode(code, globals, globals);
@@ -264,6 +281,7 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
     if (entry_text) py->DecRef(entry_text);
     if (package_text) py->DecRef(package_text);
     if (archive_text) py->DecRef(archive_text);
+    if (stdlib_text) py->DecRef(stdlib_text);
     if (resources_text) py->DecRef(resources_text);
     py->GILState_Release(gil);
     if (!bridge) {

@@ -28,6 +28,7 @@ static int api_ready;
 static char chosen[WHY_SIZE + PLATFORM_PATH_MAX]; /* which Python runs, and why */
 static char failure[2048];                        /* why the last search failed ("" if none failed) */
 static char failure_override[PLATFORM_PATH_MAX + 1]; /* DOUBLE_PENDULUM_FMU_PYTHON at that search */
+static char carried_stdlib[PLATFORM_PATH_MAX];      /* the zipped standard library of the CPython this copy started */
 
 /* ---------------------------------------------------------------------------------- helpers */
 
@@ -308,6 +309,8 @@ static int find_and_start_python(const char *resources, char *error, size_t erro
         memset(&python, 0, sizeof python);
         int described = describe_bundled(&python, why, sizeof why);
         ready = try_candidate("the CPython this FMU carries", described, &python, why, tried, sizeof tried, library);
+        if (ready && strstr(chosen, "the CPython this FMU carries") == chosen)  /* started here, not another FMU's */
+            guard_format(carried_stdlib, sizeof carried_stdlib, "%s", python.search_path[0]);
     } else {
         memset(&python, 0, sizeof python);
         int described = read_recorded(resources, &python, why, sizeof why);
@@ -403,4 +406,11 @@ const python_api *python_runtime_start(const char *resources, char *error, size_
     if (said) *said = ready ? chosen : NULL;
     platform_unlock(&load_lock);
     return ready;
+}
+
+const char *python_runtime_stdlib(void) {
+    platform_lock(&load_lock);
+    const char *path = carried_stdlib; /* written once, under the lock, before the API was ready */
+    platform_unlock(&load_lock);
+    return path;
 }

@@ -71,4 +71,9 @@ typedef struct {
  * `error` saying what was looked for, where, and how to point the FMU at a Python. */
 const python_api *python_runtime_start(const char *resources, char *error, size_t error_size, const char **chosen);
 
+/* The path of the zipped standard library of the CPython this copy of the loader started from what the FMU carries
+ * ("" if it started none: the Python is the host's, another FMU's, or one found), for the bootstrap to read it
+ * faster than zipimport (bridge.c). */
+const char *python_runtime_stdlib(void);
+
 #endif

@@ -47,9 +47,9 @@ BUILD_ONLY = ("builder.py", "__main__.py", "csvbuilder.py", "deploy.py")
 # fmu_src's modules each FMI version's FMUs bundle: every FMI 2 FMU carries all FMI 2 adapters, so
 # that DoublePendulum and Suspension bundle the same code (one id, one private package).
 ADAPTERS = {
-    2: ("__init__.py", "fmi_bridge.py", "slave_common.py", "double_pendulum_slave.py",
+    2: ("__init__.py", "fmi_bridge.py", "slave_common.py", "archive_import.py", "double_pendulum_slave.py",
         *(f"{name}.py" for name in INTERFACES)),
-    3: ("__init__.py", "fmi_bridge.py", "slave_common.py", "DoublePendulumFmi3.py"),
+    3: ("__init__.py", "fmi_bridge.py", "slave_common.py", "archive_import.py", "DoublePendulumFmi3.py"),
 }
 ADAPTER_MODULES = {2: {name: name for name in INTERFACES}, 3: {"DoublePendulum": "DoublePendulumFmi3"}}
 

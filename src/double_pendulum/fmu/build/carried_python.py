@@ -17,10 +17,11 @@ Both carry only the part of the standard library the FMU's code imports, as byte
 the imports in the functions of the standard-library modules it imports itself (it calls them: ``uuid.uuid1``
 imports ``random`` where the C library gives no time-based UUID), and from there what runs when a module is
 imported (module and class bodies), not what a standard-library function it never calls would import. Both
-zips are deflated: Windows' ``zlib`` is built into the DLL; on Linux it is an extension module (carried with the
-``libz.so.1`` it needs), which zipimport loads from the binaries folder the first time it inflates a member (the
-zip is stored uncompressed where zlib is not carried). The FMU's own code is compiled by the building CPython,
-whose minor version both carried Pythons share, so its bytecode is the one they run.
+Linux zip is stored uncompressed, read as it is when the CPython starts (its ``zlib`` is an extension module, and
+inflating the modules made the start 17 % slower), and deflated in the FMU's zip instead; the Windows one is
+deflated (its ``zlib`` is built into the DLL). The loader's bootstrap reads both zips once
+(``fmu_src/archive_import.py``). The FMU's own code is compiled by the building CPython, whose minor version both
+carried Pythons share, so its bytecode is the one they run.
 """
 
 from __future__ import annotations
@@ -56,6 +57,10 @@ SYSTEM_LIBRARIES = frozenset({"libc.so.6", "libm.so.6", "libpthread.so.0", "libd
 # Libraries too large to carry for what they give: the modules that need them are left out (hashlib falls back to
 # the hashes built into CPython, and nothing the FMU runs needs TLS).
 NOT_CARRIED = ("libssl", "libcrypto")
+# Extension modules the standard library imports only inside ``try: ... except ImportError``, for what the FMU
+# never does: shutil's and zipfile's bz2 and lzma archives. Left out, with the libraries they need (on Linux
+# preloaded at every start otherwise).
+OPTIONAL = ("_bz2", "_lzma")
 LINUX_LIBRARY_FOLDERS = ("/lib/x86_64-linux-gnu", "/usr/lib/x86_64-linux-gnu", "/lib64", "/usr/lib64", "/lib",
                          "/usr/lib")
 
@@ -202,9 +207,11 @@ def stdlib_modules(code: Mapping[str, bytes]) -> tuple[dict[str, str | None], fr
     return dict(found), missing
 
 
-def _zip(members: Mapping[str, bytes], method: int) -> bytes:
+def _zip(members: Mapping[str, bytes], method: int, version: str, platform: str) -> bytes:
+    """The zipped standard library; its comment says whose (``CPython 3.11.7 x86_64-linux``, for the FMU's page)."""
     buffer = io.BytesIO()
     with zipfile.ZipFile(buffer, "w", method) as archive:
+        archive.comment = f"CPython {version} {platform}: the part of its standard library the FMU imports".encode()
         for name in sorted(members):
             archive.writestr(zipfile.ZipInfo(name, (2020, 1, 1, 0, 0, 0)), members[name], compress_type=method)
     return buffer.getvalue()
@@ -252,8 +259,8 @@ def linux_python(code: Mapping[str, bytes]) -> CarriedPython:
     stdlib_name = f"python3{minor}.zip"
     members, files, preload, left_out = {}, {library.name: _strip(library.read_bytes())}, [], []
     for module, path in found.items():
-        if path is None or module == "__main__":
-            continue  # built into libpython
+        if path is None or module == "__main__" or module in OPTIONAL:
+            continue  # built into libpython, or not needed
         if path.endswith(".py"):
             source = Path(path).read_bytes()
             arcname = _archive_name(module, Path(path).name == "__init__.py")
@@ -272,10 +279,9 @@ def linux_python(code: Mapping[str, bytes]) -> CarriedPython:
             if name not in files:
                 files[name] = _strip(located_path.read_bytes())
                 preload.append(name)
-    # zipimport inflates with the zlib module: deflated only where that extension module is carried
-    zlib_carried = any(name.startswith("zlib.") for name in files)
-    files[stdlib_name] = _zip(members, zipfile.ZIP_DEFLATED if zlib_carried else zipfile.ZIP_STORED)
+    # stored: read as it is at start-up (zlib is an extension module here; inflating the modules cost the start 17 %)
     version = ".".join(map(str, sys.version_info[:3]))
+    files[stdlib_name] = _zip(members, zipfile.ZIP_STORED, version, "x86_64-linux")
     return CarriedPython("x86_64-linux", version, library.name, stdlib_name, files, tuple(preload), tuple(left_out))
 
 
@@ -354,11 +360,12 @@ def windows_python(code: Mapping[str, bytes], minor: int | None = None) -> Carri
                     members[arcname] = stdlib.read(arcname)
                     break
     dlls = {name: data for name, data in package.items() if name.lower().endswith(".dll") and name != library}
-    files = {library: package[library], stdlib_name: _zip(members, zipfile.ZIP_DEFLATED)}
+    version = _dll_version(package[library]) or f"3.{minor}"
+    files = {library: package[library], stdlib_name: _zip(members, zipfile.ZIP_DEFLATED, version, "x86_64-windows")}
     left_out = []
     for module in sorted({*found, *missing}):
         pyd = f"{module}.pyd"
-        if pyd not in package:
+        if pyd not in package or module in OPTIONAL:
             continue
         needed = _needed_dlls(package[pyd], dlls)
         refused = [name for name in needed if name.lower().startswith(NOT_CARRIED)]
@@ -370,7 +377,6 @@ def windows_python(code: Mapping[str, bytes], minor: int | None = None) -> Carri
             files[name] = dlls[name]
     for name in _needed_dlls(package[library], dlls):  # the C runtime
         files[name] = dlls[name]
-    version = _dll_version(package[library]) or f"3.{minor}"
     return CarriedPython("x86_64-windows", version, library, stdlib_name, files, (), tuple(left_out))
 
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib.util
+import io
 import os
 import shutil
 import sys
@@ -148,9 +149,19 @@ def instantiation_token(model_description: bytes) -> str:
 # needsExecutionTool); a lean FMU needs a CPython installed where it runs.
 INTERFACE_ELEMENTS = ("CoSimulation", "ModelExchange")
 # Stored, not deflated: fmpy extracts an FMU anew for each simulate_fmu call, and inflating the carried Pythons'
-# libraries (about 12 MB) would cost every call more than copying them (docs/performance.md); their zipped
-# standard libraries are deflated inside.
-STORED_SUFFIXES = (".dll", ".so.1.0", ".pyd", ".zip")
+# libraries (about 12 MB) would cost every call more than copying them (docs/performance.md); and a zip whose
+# members are deflated already (the Windows standard library).
+STORED_SUFFIXES = (".dll", ".so.1.0", ".pyd")
+
+
+def _stored(name: str, data: bytes) -> bool:
+    """Whether the FMU's zip stores ``name`` as it is (see :data:`STORED_SUFFIXES`)."""
+    if not name.startswith("binaries/"):
+        return False
+    if name.endswith(".zip"):
+        with zipfile.ZipFile(io.BytesIO(data)) as inner:
+            return any(info.compress_type != zipfile.ZIP_STORED for info in inner.infolist())
+    return name.endswith(STORED_SUFFIXES)
 
 
 def mark_execution_tool(model_description: bytes, needed: bool) -> bytes:
@@ -218,8 +229,7 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
     tmp = fmu.with_suffix(".fmu.tmp")
     with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as dst:
         for name, data in files.items():
-            stored = name.startswith("binaries/") and name.endswith(STORED_SUFFIXES)
-            dst.writestr(name, data, compress_type=zipfile.ZIP_STORED if stored else zipfile.ZIP_DEFLATED)
+            dst.writestr(name, data, compress_type=zipfile.ZIP_STORED if _stored(name, data) else zipfile.ZIP_DEFLATED)
     tmp.replace(fmu)
 
 

@@ -11,21 +11,23 @@ from __future__ import annotations
 from pathlib import Path
 
 from ...component.variables import INTERFACES, MODEL_IDENTIFIER
+from .carried_python import PLATFORMS
 from .fmi2 import DEFAULT_FMU_PATH, build_fmu
 
 
-def build_all(dest: str | Path = DEFAULT_FMU_PATH, lean: bool = False) -> list[Path]:
+def build_all(dest: str | Path = DEFAULT_FMU_PATH, lean: bool = False,
+              platforms: tuple[str, ...] = PLATFORMS) -> list[Path]:
     """Build every FMU: ``DoublePendulum`` at ``dest`` (a ``.fmu`` path or a folder), the others next to it,
     then the coupled system (:func:`build_systems`), then the FMI 3.0 ``DoublePendulum`` in the
     subfolder ``fmi3/`` (:func:`double_pendulum.fmu.build.fmi3.build_fmu3`). Self-contained (each carries a CPython
-    for Linux and Windows), or ``lean`` (Linux only, a CPython needed where they run)."""
+    for each of ``platforms``: Linux and Windows), or ``lean`` (Linux only, a CPython needed where they run)."""
     from .fmi3 import build_fmu3
 
     dest = Path(dest)
-    first = build_fmu(dest, MODEL_IDENTIFIER, lean=lean)
-    others = [build_fmu(first.parent / f"{name}.fmu", name, lean=lean) for name in INTERFACES
+    first = build_fmu(dest, MODEL_IDENTIFIER, lean=lean, platforms=platforms)
+    others = [build_fmu(first.parent / f"{name}.fmu", name, lean=lean, platforms=platforms) for name in INTERFACES
               if name != MODEL_IDENTIFIER]
-    fmi3 = build_fmu3(first.parent / "fmi3" / f"{MODEL_IDENTIFIER}.fmu", lean=lean)
+    fmi3 = build_fmu3(first.parent / "fmi3" / f"{MODEL_IDENTIFIER}.fmu", lean=lean, platforms=platforms)
     return [first, *others, *build_systems(first), fmi3]
 
 

@@ -152,17 +152,19 @@ def about_table(root: ET.Element, start_values: Mapping[str, object]) -> str:
     return "<table>\n" + "\n".join(f"<tr><th>{k}</th><td>{v}</td></tr>" for k, v in rows) + "\n</table>"
 
 
-_PY_VERSION = re.compile(rb"\x00(3\.1\d\.\d+)\x00")  # PY_VERSION, a string of its own in libpython's data
-_DLL_VERSION = re.compile(rb"P\x00r\x00o\x00d\x00u\x00c\x00t\x00V\x00e\x00r\x00s\x00i\x00o\x00n\x00\x00\x00"
-                          rb"((?:[0-9.]\x00)+)")  # the DLL's version resource, UTF-16
+_CARRIED = re.compile(rb"CPython (3\.\d+\.\d+) ")  # the comment of a carried standard library's zip
 
 
-def python_version(name: str, data: bytes) -> str:
-    """The full version of the CPython library ``name`` ("3.11.7"), read from its bytes, else from its name."""
-    found = _DLL_VERSION.search(data) if name.endswith(".dll") else _PY_VERSION.search(data)
+def python_version(stdlib: bytes, library: str) -> str:
+    """The full version of a carried CPython ("3.11.7"), from its zipped standard library's comment, else the minor
+    version from the name of its library."""
+    try:
+        found = _CARRIED.match(zipfile.ZipFile(io.BytesIO(stdlib)).comment)
+    except zipfile.BadZipFile:
+        found = None
     if found:
-        return found.group(1).decode("utf-16-le" if name.endswith(".dll") else "ascii")
-    digits = re.search(r"python(\d)\.?(\d+)", name)
+        return found.group(1).decode()
+    digits = re.search(r"python(\d)\.?(\d+)", library)
     return f"{digits.group(1)}.{digits.group(2)}" if digits else "?"
 
 
@@ -187,7 +189,7 @@ def _folder_row(folder: str, files: Mapping[str, bytes]) -> str:
         zipped = [name for name in inside if name.endswith(".zip")]
         modules = sum(1 for n in zipfile.ZipFile(io.BytesIO(inside[zipped[0]])).namelist() if n.endswith(".pyc")) \
             if zipped else 0
-        what.append(f"the CPython {python_version(libraries[0], inside[libraries[0]])} it carries: "
+        what.append(f"the CPython {python_version(inside[zipped[0]] if zipped else b'', libraries[0])} it carries: "
                     f"<code>{html.escape(libraries[0])}</code>, {modules} modules of its standard library in "
                     f"<code>{html.escape(zipped[0] if zipped else '')}</code>, {len(extensions)} extension modules"
                     + (f", and what they need: {', '.join(f'<code>{html.escape(n)}</code>' for n in others)}"
