@@ -41,6 +41,15 @@ def test_build_writes_the_fmu(built_by_the_command):
     assert all(path.is_file() for path in named)
 
 
+def test_build_refuses_lean_with_linux_only_in_one_line(tmp_path, capsys):
+    """A lean FMU carries no CPython at all: --lean with --linux-only (which CPython to carry) is one line, exit 2,
+    nothing written."""
+    assert main(["build", "--lean", "--linux-only", "-o", str(tmp_path / "out" / "DoublePendulum.fmu")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--lean and --linux-only exclude each other" in err
+    assert not (tmp_path / "out").exists()
+
+
 def test_run_free_swing_writes_csv_plots_and_summary(fmu_path, tmp_path):
     assert main(["run", "free_swing", "--quick", "--fmu", str(fmu_path), "--out", str(tmp_path)]) == 0
     out = tmp_path / "free_swing"

@@ -1,6 +1,7 @@
 """What the FMUs' Linux binaries ask of a target machine, read from the built binaries (docs/fmu.md,
-"What a Linux machine needs"): each FMU's one binary is the loader, which asks only for glibc 2.17
-symbol versions and the C libraries (so it loads on older systems and can say what is missing)."""
+"What a target machine needs"): each FMU's loader asks only for glibc 2.17 symbol versions and the C libraries (so
+it loads on older systems and can say what is missing); the CPython it carries asks for what the building one
+was built against."""
 
 from __future__ import annotations
 

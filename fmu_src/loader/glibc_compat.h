@@ -1,5 +1,5 @@
 /* Old glibc symbol versions for the loader, so that the FMU's binary loads on Linux systems older
- * than the one it was built on (docs/fmu.md, "What a Linux machine needs").
+ * than the one it was built on (docs/fmu.md, "What a target machine needs").
  *
  * Built on glibc >= 2.34, a library that calls dlopen asks for dlopen@GLIBC_2.34 (the dl functions
  * moved into libc there), and one that calls stat asks for stat@GLIBC_2.33; on an older system the
