@@ -9,10 +9,12 @@ import re
 import sys
 import zipfile
 from pathlib import Path
+from urllib.parse import urlparse
 from xml.etree import ElementTree as ET
 
 import numpy as np
 import pytest
+from browser import Browser, find_chromium
 from fmpy import read_model_description, simulate_fmu
 
 from double_pendulum.fmu.carries import doc_plot, documentation, terminals
@@ -233,3 +235,33 @@ def test_every_page_links_the_fmus_reference_result_and_licences(contents, name)
     assert any(p.startswith("extra/org.fmi-standard.fmi-ls-ref/") and p.endswith("_out.csv") for p in resolved)
     assert {p for p in resolved if p.startswith("documentation/licenses/")} == {
         p for p in files if p.startswith("documentation/licenses/")}
+
+
+BROWSER = find_chromium()
+
+
+@pytest.mark.skipif(BROWSER is None, reason="no Chromium on PATH (Debian: apt-get install chromium; .ci/run installs "
+                                            "it where it runs as root with apt)")
+def test_each_page_in_a_real_browser_shows_its_plot_and_fits_a_phone_and_a_desktop(contents, tmp_path):
+    """Each FMU's page as a tool's user opens it (unzipped): the result plot loads, nothing is asked of the
+    network, no error is logged, and the page is never wider than a 1280 px window or a 390 px phone: a wide table
+    scrolls on its own, the page does not."""
+    with Browser(BROWSER) as browser:
+        for name in FMUS:
+            folder = tmp_path / name.replace("/", "_")
+            for item, data in contents[name].items():
+                if item.startswith(("documentation/", "extra/")):
+                    (folder / item).parent.mkdir(parents=True, exist_ok=True)
+                    (folder / item).write_bytes(data)
+            browser.open((folder / "documentation" / "index.html").as_uri())
+            images = browser.evaluate("Array.from(document.images).map(i => [i.getAttribute('src'), "
+                                      "i.complete && i.naturalWidth > 0])")
+            assert images and all(loaded for _, loaded in images), (name, images)
+            for width in (1280, 390):
+                browser.emulate(width, 900, mobile=width < 500)
+                wide = browser.evaluate("document.documentElement.scrollWidth")
+                assert wide <= width, f"{name}: the page is {wide} px wide in a {width} px window"
+                browser.screenshot(tmp_path / f"{folder.name}_{width}.png",
+                                   {"x": 0, "y": 0, "width": width, "height": 1500})
+        assert browser.errors() == []
+        assert {urlparse(url).scheme for url in browser.requested_urls()} == {"file"}
