@@ -12,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static void parent_folder(char *path) {
+void platform_parent_folder(char *path) {
     char *slash = NULL;
     for (char *p = path; *p; p++)
         if (platform_is_separator(*p)) slash = p;
@@ -73,7 +73,7 @@ int platform_own_folder(char *folder, size_t size) {
     char resolved[PATH_MAX];
     if (!dladdr((void *)&platform_own_folder, &info) || !info.dli_fname || !realpath(info.dli_fname, resolved))
         return 0;
-    parent_folder(resolved);
+    platform_parent_folder(resolved);
     return text_fits(folder, size, "%s", resolved);
 }
 
@@ -313,7 +313,7 @@ int platform_own_folder(char *folder, size_t size) {
         return 0;
     DWORD n = GetModuleFileNameW(self, path, PLATFORM_PATH_MAX);
     if (n == 0 || n >= PLATFORM_PATH_MAX || !narrow(path, folder, size)) return 0;
-    parent_folder(folder);
+    platform_parent_folder(folder);
     return 1;
 }
 

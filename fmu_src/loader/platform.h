@@ -44,6 +44,8 @@ FILE *platform_open_text(const char *path);  /* opened for reading, not inherite
 /* A file URI's path part as a path of this system, in place (Windows: "/C:/x" is "C:/x"). */
 void platform_uri_path(char *path);
 int platform_is_separator(char c); /* '/', and on Windows '\\' too */
+/* `path` cut at its last separator, in place: its folder ("/a/b" is "/a", "/a" is "/"). */
+void platform_parent_folder(char *path);
 /* The folder of the loader's own binary (binaries/<platform>/ in the extracted FMU); 0 if unknown. */
 int platform_own_folder(char *folder, size_t size);
 /* The environment variable `name` as UTF-8 in `buffer`; NULL if it is unset or does not fit. */

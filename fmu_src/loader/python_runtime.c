@@ -44,14 +44,6 @@ static void appendf(char *buffer, size_t size, const char *format, ...) {
     if (n > 0) guard_format(buffer + used, size - used, "%s", part);
 }
 
-static void parent_folder(char *path) {
-    char *slash = NULL;
-    for (char *p = path; *p; p++)
-        if (platform_is_separator(*p)) slash = p;
-    if (slash == path) slash[1] = '\0';
-    else if (slash) *slash = '\0';
-}
-
 static const char *base_name(const char *path) {
     const char *base = path;
     for (const char *p = path; *p; p++)
@@ -173,7 +165,7 @@ static int describe_library(const char *library, python_install *python, char *w
     char home[PLATFORM_PATH_MAX];
     memcpy(home, python->library, sizeof home);
     for (int up = 0; up < 3; up++) {
-        parent_folder(home);
+        platform_parent_folder(home);
         memcpy(python->home, home, sizeof home);
         if (has_standard_library(python)) {
             if (!text_fits(python->executable, PLATFORM_PATH_MAX, "%s/bin/python%d.%d", home, python->major,

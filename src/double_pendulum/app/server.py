@@ -64,20 +64,12 @@ def app_fmu(args: argparse.Namespace, stack: contextlib.ExitStack) -> Path:
 
     from ..fmu.build.fmi2 import DEFAULT_FMU_PATH, fmu_is_current
     from ..fmu.build.loader import LoaderUnavailable
-    from ..fmu.running.choice import FmuPathError, given_fmu, is_project_folder, read_pendulum_fmu
+    from ..fmu.running.choice import FmuPathError, is_project_folder, option_fmu
     from ..fmu.running.runner import ensure_fmu
 
     if args.fmu is not None:
-        if args.build_dir is not None:
-            raise AppError("--fmu and --build-dir exclude each other: --fmu runs an FMU file you have, as it is; "
-                           "--build-dir DIR builds the project's FMU in DIR")
         try:
-            path = given_fmu(args.fmu)
-        except FmuPathError as error:
-            raise AppError(f"--fmu {error} (--fmu reads an FMU you have and never builds one; --build-dir DIR "
-                           "builds the project's FMU in DIR)") from None
-        try:
-            read_pendulum_fmu(path)
+            path, _ = option_fmu(args.fmu, args.build_dir, builds="FMU")
         except FmuPathError as error:
             raise AppError(str(error)) from None
         return path.resolve()

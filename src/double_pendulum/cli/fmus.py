@@ -15,7 +15,7 @@ from ..fmu.build.carried_python import CarriedPythonUnavailable
 from ..fmu.build.fmi2 import DEFAULT_FMU_PATH
 from ..fmu.build.loader import LoaderUnavailable
 from ..fmu.build.systems import build_all
-from ..fmu.running.choice import FmuPathError, given_fmu, is_project_folder, read_pendulum_fmu
+from ..fmu.running.choice import FmuPathError, is_project_folder, option_fmu
 from .common import CliError
 
 BUILD_DIR_HELP = (f"the folder the project's FMUs are built and kept in, all of them, built there when one is "
@@ -67,19 +67,12 @@ def choose_fmu(args: argparse.Namespace) -> FmuChoice:
             raise CliError("--build-dir needs a folder name (got an empty one); use --build-dir . for the current "
                            "folder")
         return FmuChoice(Path(args.build_dir) / DEFAULT_FMU_PATH.name, given=False)
-    if args.build_dir is not None:
-        raise CliError("--fmu and --build-dir exclude each other: --fmu runs an FMU file you have, as it is; "
-                       "--build-dir DIR builds the project's FMUs in DIR")
-    if args.rebuild:
+    if args.rebuild and args.build_dir is None:
         raise CliError("--rebuild and --fmu exclude each other: --fmu runs an FMU file you have and never builds "
                        "over it (--build-dir DIR --rebuild rebuilds the project's FMUs in DIR)")
     try:
-        path = given_fmu(args.fmu)
-    except FmuPathError as error:
-        raise CliError(f"--fmu {error} (--fmu reads an FMU you have and never builds one; --build-dir DIR "
-                       "builds the project's FMUs in DIR)") from None
-    try:
-        return FmuChoice(path, given=True, description=read_pendulum_fmu(path))
+        path, description = option_fmu(args.fmu, args.build_dir)
+        return FmuChoice(path, given=True, description=description)
     except FmuPathError as error:
         raise CliError(str(error)) from None
 

@@ -71,6 +71,21 @@ def read_pendulum_fmu(path: str | Path) -> Any:
     return md
 
 
+def option_fmu(fmu: str, build_dir: str | None, builds: str = "FMUs") -> tuple[Path, Any]:
+    """The FMU a command's ``--fmu`` names and its model description (:func:`read_pendulum_fmu`), checked against
+    ``--build-dir`` (``build_dir``), which it excludes; every refusal is a :class:`FmuPathError` of one line that
+    says what each option does (``builds``: what ``--build-dir`` builds, "FMUs" or "FMU")."""
+    if build_dir is not None:
+        raise FmuPathError(f"--fmu and --build-dir exclude each other: --fmu runs an FMU file you have, as it is; "
+                           f"--build-dir DIR builds the project's {builds} in DIR")
+    try:
+        path = given_fmu(fmu)
+    except FmuPathError as error:
+        raise FmuPathError(f"--fmu {error} (--fmu reads an FMU you have and never builds one; --build-dir DIR "
+                           f"builds the project's {builds} in DIR)") from None
+    return path, read_pendulum_fmu(path)
+
+
 def fmu_to_run(given: str | Path | None, default: str | Path = DEFAULT_FMU_PATH) -> Path:
     """The FMU a script runs: ``given`` if the user named one (:func:`read_pendulum_fmu`: read, never built or
     written), else ``default``, a place of the project's, built there first when missing or older than the
