@@ -83,7 +83,9 @@ class Browser:
 
         self.process = subprocess.Popen(command, close_fds=False, preexec_fn=on_3_and_4, stdin=subprocess.DEVNULL,
                                         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-                                        env={**os.environ, "TMPDIR": str(self.profile)})  # fmt: skip
+                                        env={**os.environ, "TMPDIR": str(self.profile), "HOME": str(self.profile),
+                                             "XDG_CONFIG_HOME": str(self.profile / "config"),
+                                             "XDG_CACHE_HOME": str(self.profile / "cache")})  # fmt: skip
         os.close(to_browser)
         os.close(from_browser)
         self._messages: queue.Queue[dict] = queue.Queue()

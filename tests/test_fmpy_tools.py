@@ -174,8 +174,11 @@ def test_fmpys_gui_plots_the_default_outputs(tool_fmus, which, tmp_path):
     """``fmpy.gui`` opens the FMU, simulates with its defaults and plots every output: the window's screenshot
     (docs/images/fmpy_gui.png comes from this script) and the plotted names are checked."""
     shot = tmp_path / "gui.png"
+    home = tmp_path / "home"  # FMPy's settings (CATIA-Systems/FMPy.conf), Qt's and Mesa's caches: never the user's
     env = {**os.environ, "QTWEBENGINE_CHROMIUM_FLAGS": "--no-sandbox", "QT_QPA_PLATFORM": "xcb",
-           "TMPDIR": str(tmp_path)}  # the GUI extracts the FMU there
+           "TMPDIR": str(tmp_path),  # the GUI extracts the FMU there
+           "HOME": str(home), "XDG_CONFIG_HOME": str(home / ".config"), "XDG_CACHE_HOME": str(home / ".cache"),
+           "XDG_DATA_HOME": str(home / ".local" / "share")}
     done = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x900x24", sys.executable, str(GUI_SCRIPT),
                            str(tool_fmus[which]), str(shot)], capture_output=True, text=True, timeout=300, env=env)
     assert done.returncode == 0, done.stdout + done.stderr
