@@ -167,6 +167,7 @@ def test_an_interpreter_that_never_answers_is_given_up_in_bounded_time_and_leave
     folder = Path(shutil.copytree(extracted_folder, tmp_path / "fmu"))
     binary = folder / "binaries" / loader.PLATFORMS[2] / "DoublePendulum.so"
     binary.write_bytes(loader.compiled_loader(2, {"MODEL_IDENTIFIER": "DoublePendulum", "FMU_GUID": description.guid,
+                                                  "N_VARIABLES": str(len(description.modelVariables)),
                                                   "QUERY_TIMEOUT_MS": str(QUERY_TIMEOUT_S * 1000)}))
     env = bare_environment(tmp_path, **{loader.OVERRIDE_VARIABLE: str(script)})
     started = time.monotonic()

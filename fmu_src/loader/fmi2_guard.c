@@ -36,6 +36,7 @@
 #include "identity.h"
 
 #define MODEL_IDENTIFIER identity_model_identifier
+#define N_VARIABLES identity_variables
 #define FMU_GUID identity_token /* the guid of the FMU's modelDescription.xml */
 
 /* ----------------------------------------------------------------------------------- states */
@@ -220,9 +221,11 @@ FMI2_Export fmi2Status fmi2Reset(fmi2Component c) {
 /* ------------------------------------------------------------------------ getting and setting */
 
 /* Every variable is a scalar: the values cross as bytes of `nvr` packed values (fmi2Integer and
- * fmi2Boolean are C ints, fmi2Real a double), named by their FMI type. */
+ * fmi2Boolean are C ints, fmi2Real a double), named by their FMI type. `nvr` is checked against the FMU's
+ * variables before any byte length is computed from it (a huge one would wrap). */
 #define ACCESS_CHECKS(F)                                                                                          \
     if (nvr == 0) return fmi2OK;                                                                                  \
+    REQUIRE(nvr <= N_VARIABLES, "fmi2" #F ": nvr = %zu, but this FMU has %zu variables", nvr, N_VARIABLES);      \
     REQUIRE(vr, "fmi2" #F ": vr is NULL with nvr = %zu", nvr);                                                    \
     REQUIRE(value, "fmi2" #F ": value is NULL with nvr = %zu", nvr)
 

@@ -28,6 +28,7 @@
 #define MODEL_IDENTIFIER identity_model_identifier
 #define FMU_GUID identity_token /* the instantiationToken of the FMU's modelDescription.xml */
 #define N_CONTINUOUS_STATES identity_continuous_states
+#define N_VARIABLES identity_variables
 #define N_EVENT_INDICATORS 0 /* a smooth right-hand side (component/model_exchange.py) */
 
 #define MODEL_EXCHANGE "ModelExchange"
@@ -284,10 +285,13 @@ FMI3_Export fmi3Status fmi3ExitConfigurationMode(fmi3Instance instance) {
 
 /* ------------------------------------------------------------------------ getting and setting */
 
-/* Every variable of this FMU is a scalar: nValues must equal nValueReferences. Values cross as bytes of
- * packed values, named by their FMI type. */
+/* Every variable of this FMU is a scalar: nValues must equal nValueReferences, and neither exceeds the FMU's
+ * variables (checked before any byte length is computed from them: a huge count would wrap). Values cross as
+ * bytes of packed values, named by their FMI type. */
 #define CHECK_ARRAYS(F)                                                                                           \
     if (nValueReferences == 0 && nValues == 0) return fmi3OK;                                                     \
+    REQUIRE(nValueReferences <= N_VARIABLES, "fmi3" #F ": nValueReferences = %zu, but this FMU has %zu variables", \
+            nValueReferences, N_VARIABLES);                                                                       \
     REQUIRE(valueReferences, "fmi3" #F ": valueReferences is NULL with nValueReferences = %zu", nValueReferences); \
     REQUIRE(values, "fmi3" #F ": values is NULL with nValues = %zu", nValues);                                    \
     REQUIRE(nValues == nValueReferences,                                                                          \

@@ -7,6 +7,9 @@
 #ifndef MODEL_IDENTIFIER
 #error "the build defines MODEL_IDENTIFIER"
 #endif
+#ifndef N_VARIABLES
+#error "the build defines N_VARIABLES, the number of variables in the FMU's modelDescription.xml"
+#endif
 #ifndef BUNDLED_PYTHON_LIBRARY /* a lean FMU: it finds a Python on the machine */
 #define BUNDLED_PYTHON_LIBRARY ""
 #define BUNDLED_PYTHON_STDLIB ""
@@ -18,6 +21,7 @@
 
 const char identity_model_identifier[] = MODEL_IDENTIFIER;
 const char identity_token[] = FMU_GUID;
+const size_t identity_variables = N_VARIABLES;
 #ifdef N_CONTINUOUS_STATES
 const size_t identity_continuous_states = N_CONTINUOUS_STATES;
 #endif

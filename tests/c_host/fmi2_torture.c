@@ -322,6 +322,22 @@ NULL_ARRAY_PROBE(get_string_null_values, fmi2GetString_(c, vr, 2, NULL))
 NULL_ARRAY_PROBE(set_boolean_null_values, fmi2SetBoolean_(c, vr, 2, NULL))
 NULL_ARRAY_PROBE(set_integer_null_references, fmi2SetInteger_(c, NULL, 1, NULL))
 NULL_ARRAY_PROBE(zero_values_need_no_arrays, fmi2GetReal_(c, NULL, 0, NULL))
+/* Counts beyond the FMU's variables: refused before a byte length is computed from them. 2^62 + 1 values of 8 bytes
+ * wrap to 8 bytes, 2^62 to none: without the check the call answered OK having read or written one value or none. */
+#define HUGE_COUNT (((size_t)1 << 62) + 1)
+NULL_ARRAY_PROBE(get_real_huge_count, fmi2GetReal_(c, vr, HUGE_COUNT, r))
+NULL_ARRAY_PROBE(set_real_huge_count, fmi2SetReal_(c, vr, HUGE_COUNT - 1, r))
+NULL_ARRAY_PROBE(get_integer_huge_count, fmi2GetInteger_(c, vr, HUGE_COUNT, (fmi2Integer[2]){0}))
+NULL_ARRAY_PROBE(get_string_huge_count, fmi2GetString_(c, vr, HUGE_COUNT, (fmi2String[2]){0}))
+static int get_real_more_references_than_variables(void) { /* 1,000 names of one variable: more than it has */
+    FRESH(c);
+    fmi2ValueReference vr[1000];
+    fmi2Real r[1000];
+    for (size_t k = 0; k < 1000; k++) vr[k] = PHI1;
+    int s = fmi2GetReal_(c, vr, 1000, r);
+    fmi2FreeInstance_(c);
+    return s;
+}
 static int set_string_null_element(void) {
     fmi2Component c = instantiate(fmi2False);
     fmi2String v = NULL;
@@ -1137,6 +1153,8 @@ static const struct {
     P(null_logger) P(format_directives_in_a_string) P(get_real_null_references) P(get_real_null_values)
     P(set_real_null_values) P(get_integer_null_values) P(get_boolean_null_references) P(get_string_null_values)
     P(set_boolean_null_values) P(set_integer_null_references) P(zero_values_need_no_arrays)
+    P(get_real_huge_count) P(set_real_huge_count) P(get_integer_huge_count) P(get_string_huge_count)
+    P(get_real_more_references_than_variables)
     P(set_string_null_element) P(set_string_not_utf8) P(debug_logging_null_categories) P(debug_logging_unknown_category)
     P(debug_logging_null_category) P(errors_silenced_by_set_debug_logging) P(get_fmu_state_null)
     P(set_fmu_state_null) P(set_fmu_state_foreign_pointer) P(free_fmu_state_null_pointer)

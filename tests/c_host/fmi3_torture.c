@@ -154,6 +154,15 @@ static int values_count_not_references_count(void) {
 }
 PROBE(get_float64_null_references, stepping(), fmi3GetFloat64_(c, NULL, 2, (fmi3Float64[2]){0}, 2))
 PROBE(get_float64_null_values, stepping(), fmi3GetFloat64_(c, &PHI1, 1, NULL, 1))
+/* Counts beyond the FMU's variables: refused before a byte length is computed from them (2^62 + 1 values of 8 bytes
+ * wrap to 8 bytes: without the check the call answered OK having read or written one value). */
+#define HUGE_COUNT (((size_t)1 << 62) + 1)
+PROBE(get_float64_huge_count, stepping(),
+      fmi3GetFloat64_(c, (fmi3ValueReference[2]){PHI1, PHI1}, HUGE_COUNT, (fmi3Float64[2]){0}, HUGE_COUNT))
+PROBE(set_float64_huge_count, stepping(),
+      fmi3SetFloat64_(c, (fmi3ValueReference[2]){PHI1_0, PHI1_0}, HUGE_COUNT - 1, (fmi3Float64[2]){0}, HUGE_COUNT - 1))
+PROBE(get_boolean_huge_count, stepping(),
+      fmi3GetBoolean_(c, (fmi3ValueReference[2]){PHI1, PHI1}, HUGE_COUNT, (fmi3Boolean[2]){0}, HUGE_COUNT))
 PROBE(get_float32_not_a_type_of_this_fmu, stepping(), fmi3GetFloat32_(c, &PHI1, 1, (fmi3Float32[1]){0}, 1))
 PROBE(get_clock, stepping(), fmi3GetClock_(c, &PHI1, 1, (fmi3Clock[1]){0}))
 static int format_directives_in_a_string(void) {
@@ -531,7 +540,8 @@ static const struct {
     P(model_exchange_function_in_co_simulation) P(do_step_in_model_exchange) P(step_size_zero) P(step_size_nan)
     P(communication_point_not_the_fmus_time) P(do_step_null_out_argument)
     P(start_time_is_the_first_communication_point) P(start_value_nan) P(values_count_not_references_count)
-    P(get_float64_null_references) P(get_float64_null_values) P(get_float32_not_a_type_of_this_fmu) P(get_clock)
+    P(get_float64_null_references) P(get_float64_null_values) P(get_float64_huge_count) P(set_float64_huge_count)
+    P(get_boolean_huge_count) P(get_float32_not_a_type_of_this_fmu) P(get_clock)
     P(format_directives_in_a_string) P(set_string_not_utf8) P(fixed_parameter_after_initialisation) P(wrong_token) P(null_token)
     P(null_resource_path) P(null_instance_name) P(instance_name_not_utf8) P(event_mode_requested) P(scheduled_execution)
     P(null_logger_still_instantiates) P(update_discrete_states_null_out_argument) P(set_continuous_states_wrong_count)

@@ -156,7 +156,7 @@ def _is_gcc(compiler: tuple[str, ...]) -> bool:
 
 
 IDENTITY_SOURCES = ("identity.c",)
-IDENTITY_MACROS = ("MODEL_IDENTIFIER", "FMU_GUID", "N_CONTINUOUS_STATES", "BUNDLED_PYTHON_LIBRARY",
+IDENTITY_MACROS = ("MODEL_IDENTIFIER", "FMU_GUID", "N_VARIABLES", "N_CONTINUOUS_STATES", "BUNDLED_PYTHON_LIBRARY",
                    "BUNDLED_PYTHON_STDLIB", "BUNDLED_PYTHON_MINOR", "BUNDLED_PYTHON_PRELOAD")
 """Only ``identity.c`` takes one FMU's macros (:data:`IDENTITY_MACROS`) and is compiled for each FMU. The others
 take only the other macros (none in a build; the tests shorten ``QUERY_TIMEOUT_MS``) and are compiled once per
@@ -232,9 +232,10 @@ def zig_compiler() -> list[str] | None:
 
 def compiled_loader(fmi_version: int, defines: dict[str, str], target: Target = LINUX) -> bytes:
     """The FMI ``fmi_version`` loader's shared library for ``target`` and one FMU (compiled once per process,
-    compiler, source version and ``defines``: the C string macros ``MODEL_IDENTIFIER`` and ``FMU_GUID``, for FMI 3
-    the number ``N_CONTINUOUS_STATES``, and for a self-contained FMU the ``BUNDLED_PYTHON_*`` names of the CPython
-    it carries). The Linux loader is built with the system's C compiler (else Zig's), the Windows one always with
+    compiler, source version and ``defines``: the C string macros ``MODEL_IDENTIFIER`` and ``FMU_GUID``, the number
+    ``N_VARIABLES`` of the model description's variables, for FMI 3 the number ``N_CONTINUOUS_STATES``, and for a
+    self-contained FMU the ``BUNDLED_PYTHON_*`` names of the CPython it carries).
+    The Linux loader is built with the system's C compiler (else Zig's), the Windows one always with
     Zig's (``x86_64-windows-gnu``: the Universal C Runtime of Windows 10 and newer).
 
     Raises :class:`LoaderUnavailable` where it cannot be built (no C compiler; not Linux), and

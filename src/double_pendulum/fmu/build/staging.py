@@ -139,6 +139,13 @@ def unit_definitions(units: Iterable[str]) -> ET.Element:
     return definitions
 
 
+def variable_count(model_description: bytes) -> int:
+    """The number of variables in a modelDescription (FMI 2's ScalarVariables, FMI 3's typed elements): the loader
+    refuses a get or set call that names more value references (``N_VARIABLES``)."""
+    variables = ET.fromstring(model_description).find("ModelVariables")
+    return 0 if variables is None else len(variables)
+
+
 def instantiation_token(model_description: bytes) -> str:
     """The FMU's GUID (FMI 2) or instantiation token (FMI 3), which the guard checks at instantiation."""
     root = ET.fromstring(model_description)
@@ -221,7 +228,8 @@ def rewrite_fmu(fmu: Path, model_identifier: str, complete: Callable[[bytes], by
     # pythonfmu3's sources/ build its own C++ library, not this binary: an FMU carries no sources that do not
     # build it
     files = {name: data for name, data in files.items() if not name.startswith(("binaries/", "sources/"))}
-    files.update(_binaries(model_identifier, fmi_version, token, defines or {}, code, lean, platforms))
+    defines = {**(defines or {}), "N_VARIABLES": str(variable_count(files["modelDescription.xml"]))}
+    files.update(_binaries(model_identifier, fmi_version, token, defines, code, lean, platforms))
     files[bundle.IDENTITY_FILE] = bundle.identity_record(model_identifier, token, identity)
     from ..carries.presentation import presentation_files  # here: matplotlib and numpy only when building
 
