@@ -201,6 +201,10 @@ class DoublePendulum(ComponentMapping, Fmi3SlaveBase, ModelExchange, CoSimulatio
             self._states.set_state(state["states"], validate=False)
         self._model_exchange_used = bool(state["model_exchange_used"])
 
+    def fmu_state_time(self, state) -> float:
+        """The component's time [s] in a checked ``state`` (the time the loader's state header must hold)."""
+        return state["component"]["time"]
+
     def check_fmu_state(self, state) -> None:
         """Raise (naming what is wrong) unless ``state`` is one :meth:`_get_fmu_state` gives."""
         if not isinstance(state, dict) or set(state) != {"component", "model_exchange_used", "states"}:

@@ -33,8 +33,6 @@ FORMATS = {
     2: {"Real": "d", "Integer": "i", "Boolean": "i"},
     3: {"Float64": "d", "Int32": "i", "Int64": "q", "UInt64": "Q", "Boolean": "?"},
 }
-INTERRUPTED_TEXT = ("interrupted (KeyboardInterrupt, Ctrl-C): the call was not completed; a reset makes the "
-                    "instance usable again")
 
 Answer = tuple[int, Any, tuple]
 DISCARDED = object()  # what a call that was not completed returns (fmi2Discard / fmi3Discard)
@@ -70,7 +68,7 @@ class Bridge:
         try:
             return OK, Instance(self, os.fsdecode(resources), name, interface, bool(visible)), ()
         except KeyboardInterrupt:
-            return INTERRUPTED, None, ((ERROR, "logStatusError", INTERRUPTED_TEXT),)
+            return INTERRUPTED, None, ()  # the loader logs the one text of an interrupt
         except BaseException as error:
             return ERROR, None, ((ERROR, "logStatusError", describe(error)),)
 
@@ -98,7 +96,7 @@ class Instance:
                 return DISCARD, None, self._messages()
             return OK, payload, self._messages()
         except KeyboardInterrupt:
-            return INTERRUPTED, None, self._messages((ERROR, "logStatusError", INTERRUPTED_TEXT))
+            return INTERRUPTED, None, self._messages()  # the loader logs the one text of an interrupt
         except BaseException as error:
             return ERROR, None, self._messages((ERROR, "logStatusError", describe(error)))
 
@@ -209,17 +207,29 @@ class Instance:
                                 f"not a {type_name}")
 
     # ---------------------------------------------------------------- FMU states
+    def _noted(self, answer: Answer, say) -> Answer:
+        """``answer`` with, where it is OK, the debug line (logAll) ``say(payload)``: what a state call did."""
+        status, payload, messages = answer
+        if status != OK:
+            return answer
+        return status, payload, messages + ((OK, "logAll", say(payload)),)
+
     def get_fmu_state(self) -> Answer:
-        return self._run(self.slave._get_fmu_state)
+        return self._noted(self._run(self.slave._get_fmu_state),
+                           lambda state: f"the FMU state at t = {self.slave.fmu_state_time(state)!r} s")
 
     def set_fmu_state(self, state) -> Answer:
-        return self._run(self.slave._set_fmu_state, state)
+        return self._noted(self._run(self.slave._set_fmu_state, state),
+                           lambda _: f"back to the FMU state at t = {self.slave.fmu_state_time(state)!r} s")
 
     def serialize_fmu_state(self, state) -> Answer:
-        return self._run(lambda: json.dumps(state, allow_nan=True).encode("utf-8"))
+        return self._noted(self._run(lambda: json.dumps(state, allow_nan=True).encode("utf-8")),
+                           lambda data: f"the FMU state at t = {self.slave.fmu_state_time(state)!r} s is {len(data)} "
+                           "bytes of JSON")
 
-    def deserialize_fmu_state(self, data: bytes) -> Answer:
-        """The state in ``data``, checked completely before anything uses it."""
+    def deserialize_fmu_state(self, data: bytes, time: float) -> Answer:
+        """The state in ``data``, checked completely before anything uses it; ``time`` [s] is the loader's header's,
+        which must be the state's own time (a tampered time is refused here, not at the next step)."""
         def load():
             try:
                 state = json.loads(data.decode("utf-8"))
@@ -229,8 +239,11 @@ class Instance:
                 self.slave.check_fmu_state(state)
             except (ValueError, TypeError, KeyError, LookupError) as error:
                 raise Refusal(f"the state is malformed: {error}") from None
+            own = self.slave.fmu_state_time(state)
+            if own != time:
+                raise Refusal(f"the state is malformed: its header's time {time!r} s is not its payload's {own!r} s")
             return state
-        return self._run(load)
+        return self._noted(self._run(load), lambda _: f"a serialized FMU state at t = {time!r} s, checked")
 
     # ---------------------------------------------------------------- Model Exchange
     def set_time(self, time: float) -> Answer:

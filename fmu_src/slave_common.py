@@ -150,6 +150,10 @@ class ComponentMapping:
         """Raise (naming what is wrong) unless ``state`` is one :meth:`_get_fmu_state` of this FMU gives."""
         type(self._sim).check_state(state)
 
+    def fmu_state_time(self, state) -> float:
+        """The component's time [s] in a checked ``state`` (the time the loader's state header must hold)."""
+        return state["time"]
+
     def _component_step(self, current_time: float, step_size: float) -> bool:
         """doStep of the component; a failure of the solver is a discarded step (False), logged with the
         Discard status. The component's warnings (``notices``) go to the host's log, once each."""

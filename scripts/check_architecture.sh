@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Check the import contracts in .importlinter (import-linter) on the package as it ships.
+# Check the import contracts in .importlinter (import-linter) on the package as it ships, and the C loader's
+# layers (scripts/check_loader_layers.py).
 #
 # The repository's scenarios/, fmu_src/ and data/ are mapped into double_pendulum by
 # pyproject.toml; an editable install resolves them through an import hook that import-linter's
@@ -9,6 +10,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 python=${1:-.venv/bin/python}
 python="$(cd "$(dirname "$python")" && pwd)/$(basename "$python")"
+# The C loader's units: layered, no circle (as import-linter below for the Python side).
+"$python" scripts/check_loader_layers.py >/dev/null
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 # setuptools reuses build/lib and keeps files deleted since: build from a clean scratch folder

@@ -121,6 +121,12 @@ FMI2_PROBES = {
     "freed_twice": (0, NO_LOG),
     "fmu_state_restores_the_time": (0, "currentCommunicationPoint = 1 s is not the FMU's time 0.5 s"),
     "serialized_state_in_a_new_instance": (0, NO_LOG),
+    "tampered_state_header_time": (3, "the state is malformed: its header's time 1e+308 s is not its payload's "
+                                      "0.125 s"),
+    "tampered_state_last_successful_time": (3, "the state is malformed: its header holds FMI state 4 at t = 0.125 s "
+                                               "(last successful time 1 s)"),
+    "tampered_state_payload_time": (3, "the state is malformed: its header's time 0.125 s is not its payload's "
+                                       "1e+308 s"),
     "discarded_step_then_terminate": (2, "fmi2DoStep: the step was not completed: numerical instability at t = "),
     "do_step_after_discard": (3, "fmi2DoStep: illegal call sequence: not allowed in state Step Failed"),
     # what the FMU leaves to the host (the first instantiation of a process: OWN_PROCESS_PROBES below)
@@ -132,6 +138,12 @@ FMI2_PROBES = {
     "reentrant_logger_frees_during_set_real": (3, "fmi2SetReal: ParameterError: invalid phi1_0 = nan rad"),
     "reentrant_logger_frees_during_illegal_call": (3, "fmi2DoStep: illegal call sequence: not allowed in state "
                                                       "Instantiated"),
+    # a logger that frees the FMU state a call uses, on the call's debug line (ASan's session: no use after free)
+    "logger_frees_the_state_during_serialized_size": (3, "fmi2SerializedFMUstateSize: the FMU state was freed (by "
+                                                         "the host's logger) during this call, which used it"),
+    "logger_frees_the_state_during_get_state": (3, "fmi2GetFMUstate: the FMU state was freed (by the host's logger) "
+                                                   "during this call, which used it"),
+    "logger_frees_the_state_during_set_state": (0, "back to the FMU state at t = 0.125 s"),
     "large_start_time_wrong_point": (3, "fmi2DoStep: currentCommunicationPoint = 1000000000.5 s is not the FMU's "
                                         "time 1000000000 s"),
     "large_start_time_steps": (0, NO_LOG),

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 import random
+import re
 import signal
 import subprocess
 import sys
@@ -91,8 +92,9 @@ def test_ctrl_c_is_the_users_keyboard_interrupt_and_a_reset_recovers(unzipped, t
     """12 trials, 2 at a time: a child simulates a long case (simulate_fmu to 1e4 s with an output every ms,
     or its own doStep loop on an fmpy FMU2Slave) and gets SIGINT after 0.3 to 1.5 s (random): every one
     ends with KeyboardInterrupt (not FMICallException); then in the same child fmi2Reset, initialisation
-    and 10 steps work. (12 trials, 6 of each kind, where there were 20: the defect this found failed 18 of 20,
-    so 12 clean trials leave it a chance of 0.1**12.)"""
+    and 10 steps work; the FMU's log line, where it wrote one, is the one text docs/fmu.md quotes. (12 trials,
+    6 of each kind, where there were 20: the defect this found failed 18 of 20, so 12 clean trials leave it a
+    chance of 0.1**12.)"""
     folder, guid = unzipped
     rng = random.Random(20240917)
     trials = [("simulate" if k % 2 else "step", rng.uniform(0.3, 1.5)) for k in range(12)]
@@ -104,9 +106,14 @@ def test_ctrl_c_is_the_users_keyboard_interrupt_and_a_reset_recovers(unzipped, t
     print("Ctrl-C outcomes:", outcomes)
     wrong = [outcome for outcome in outcomes if outcome[2] != "KeyboardInterrupt"]
     assert not wrong, f"{len(wrong)} of {len(trials)} trials did not end with KeyboardInterrupt: {wrong}"
+    said = ("interrupted (KeyboardInterrupt, Ctrl-C): the call was not completed; a reset makes the instance usable "
+            "again")
     for (mode, delay), (out, err) in zip(trials, results):
         assert any(line.startswith("after reset phi1 ") for line in out.splitlines()), (mode, delay, out, err[-2000:])
         assert "Traceback" not in err, (mode, delay, err[-2000:])
+        # the FMU's log line, wherever the interrupt landed in its call (none where it landed between calls): one text
+        lines = [line for line in (out + err).splitlines() if "KeyboardInterrupt" in line and "caught" not in line]
+        assert all(re.search(rf"fmi2\w+: {re.escape(said)}$", line) for line in lines), (mode, delay, lines)
 
 
 # ----------------------------------------------------------------------------------------------- exiting

@@ -9,6 +9,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "text.h"
+
 #define PY_FILE_INPUT 257 /* Py_file_input */
 
 /* Load the FMU's package `package` and its entry module `entry` from the zip resources/<archive> (the FMU's code,
@@ -73,7 +75,14 @@ static void note_failure(answer_notes *notes, const char *format, ...) {
     va_start(args, format);
     int n = vsnprintf(text, sizeof text, format, args);
     va_end(args);
-    guard_format(notes->failure, sizeof notes->failure, "%s", n >= 0 ? text : "unknown failure");
+    text_format(notes->failure, sizeof notes->failure, "%s", n >= 0 ? text : "unknown failure");
+}
+
+/* A KeyboardInterrupt stopped the call, wherever it landed (in the Python side's code, or before or around it):
+ * one text for every case, which docs/fmu.md quotes, in place of any other failure. */
+static void note_interrupt(answer_notes *notes) {
+    notes->interrupted = 1;
+    text_format(notes->failure, sizeof notes->failure, "%s", BRIDGE_INTERRUPTED_TEXT);
 }
 
 static void add_message(answer_notes *notes, int status, const char *category, const char *text) {
@@ -101,9 +110,9 @@ static void emit_notes(guard_instance *g, answer_notes *notes) {
         char line[4200];
         int status = m->status < STATUS_OK || m->status > STATUS_ERROR ? STATUS_ERROR : m->status;
         if (status >= STATUS_DISCARD)
-            guard_format(line, sizeof line, "%s: %s", g->function ? g->function : "FMU", m->text);
+            text_format(line, sizeof line, "%s: %s", g->function ? g->function : "FMU", m->text);
         else
-            guard_format(line, sizeof line, "%s", m->text);
+            text_format(line, sizeof line, "%s", m->text);
         guard_emit(g, status, m->category, line);
         free(m->category), free(m->text);
     }
@@ -111,7 +120,7 @@ static void emit_notes(guard_instance *g, answer_notes *notes) {
     notes->items = NULL, notes->n = notes->capacity = 0;
     if (notes->failure[0]) {
         char line[sizeof notes->failure + 200];
-        guard_format(line, sizeof line, "%s: %s", g->function ? g->function : "FMU", notes->failure);
+        text_format(line, sizeof line, "%s: %s", g->function ? g->function : "FMU", notes->failure);
         guard_emit(g, STATUS_ERROR, "logStatusError", line);
     }
 }
@@ -128,9 +137,9 @@ static void take_exception(const python_api *py, answer_notes *notes, const char
     const char *name_text = name ? py->Unicode_AsUTF8AndSize(name, NULL) : NULL;
     const char *value_text = text ? py->Unicode_AsUTF8AndSize(text, NULL) : NULL;
     py->Err_Clear(); /* whatever describing it raised */
-    if (name_text && strcmp(name_text, "KeyboardInterrupt") == 0) notes->interrupted = 1;
-    note_failure(notes, "%s raised %s: %s", what, name_text ? name_text : "an exception",
-                 value_text ? value_text : "(no message)");
+    if (name_text && strcmp(name_text, "KeyboardInterrupt") == 0) note_interrupt(notes);
+    else note_failure(notes, "%s raised %s: %s", what, name_text ? name_text : "an exception",
+                      value_text ? value_text : "(no message)");
     if (name) py->DecRef(name);
     if (text) py->DecRef(text);
     if (type) py->DecRef(type);
@@ -169,7 +178,7 @@ static int take_answer(const python_api *py, PyObject *answer, bridge_payload pa
     }
     if (n < 0) py->Err_Clear();
     if (status == BRIDGE_INTERRUPTED) {
-        notes->interrupted = 1;
+        note_interrupt(notes);
         return STATUS_ERROR;
     }
     if (status < STATUS_OK || status > STATUS_ERROR) status = STATUS_ERROR;

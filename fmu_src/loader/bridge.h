@@ -12,7 +12,7 @@
 
 #include <stddef.h>
 
-#include "guard.h"
+#include "guard_base.h"
 #include "python_runtime.h"
 
 /* What a call gives back besides its status. */
@@ -37,6 +37,9 @@ typedef struct {
 /* Python's statuses beyond FMI's: the call was interrupted (KeyboardInterrupt): an error, and the host's
  * own interrupt is raised again once the call returns (a Python host then sees KeyboardInterrupt). */
 #define BRIDGE_INTERRUPTED 5
+/* The one log line of an interrupted call, after the FMI function's name (docs/fmu.md quotes it). */
+#define BRIDGE_INTERRUPTED_TEXT                                                                                   \
+    "interrupted (KeyboardInterrupt, Ctrl-C): the call was not completed; a reset makes the instance usable again"
 
 /* Make the Python instance of g: load the FMU's package `package` and entry module `entry` from the zip
  * `resources`/`archive` (once per process) and call the entry's bridge's instantiate(resources, name, interface,

@@ -31,7 +31,9 @@
 
 #include "bridge.h"
 #include "fmi2Functions.h"
+#include "fmu_state.h"
 #include "guard.h"
+#include "text.h"
 
 #include "identity.h"
 
@@ -120,6 +122,8 @@ static void destroy(guard_instance *common) {
 #define BEGIN_MASKED(F, MASK)                                                                                     \
     guarded *g GUARD_CALL = (guarded *)guard_acquire(c, MODEL_IDENTIFIER, "fmi2" #F);                             \
     if (!g) return fmi2Error;                                                                                     \
+    guard_scope scope GUARD_SCOPE = {&g->common, g->common.function};                                             \
+    (void)scope;                                                                                                  \
     g->common.function = "fmi2" #F;                                                                               \
     if (!(g->common.at.state & (MASK)))                                                                           \
         return (fmi2Status)fail(&g->common, "fmi2" #F ": illegal call sequence: not allowed in state %s",        \
@@ -152,7 +156,7 @@ FMI2_Export fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuT
     g->common.function = "fmi2Instantiate";
     char why[2048] = "", resources[4096];
     if (fmuType != fmi2CoSimulation)
-        guard_format(why, sizeof why, "fmuType = %d: this FMU supports co-simulation (fmi2CoSimulation = %d) only",
+        text_format(why, sizeof why, "fmuType = %d: this FMU supports co-simulation (fmi2CoSimulation = %d) only",
                      (int)fmuType, (int)fmi2CoSimulation);
     else
         guard_check_instantiation(&FMI2, instanceName, fmuGUID, fmuResourceLocation, resources, sizeof resources, why,
@@ -368,7 +372,7 @@ static const char *const STATUS_KINDS[] = {"fmi2DoStepStatus", "fmi2PendingStatu
 
 static fmi2Status not_given(guarded *g, fmi2StatusKind s) {
     char message[256];
-    guard_format(message, sizeof message, "%s: %s is not given by this function%s", g->common.function,
+    text_format(message, sizeof message, "%s: %s is not given by this function%s", g->common.function,
                  STATUS_KINDS[s], s <= fmi2PendingStatus ? " (this FMU never returns fmi2Pending)" : "");
     guard_emit(&g->common, fmi2Discard, "logAll", message); /* informative: debug logging */
     return fmi2Discard;

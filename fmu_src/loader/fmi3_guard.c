@@ -21,7 +21,9 @@
 
 #include "bridge.h"
 #include "fmi3Functions.h"
+#include "fmu_state.h"
 #include "guard.h"
+#include "text.h"
 
 #include "identity.h"
 
@@ -134,6 +136,8 @@ enum { ME = 1, CS = 2, BOTH = 3 };
 #define BEGIN_FOR(F, MASK, INTERFACE)                                                                             \
     guarded *g GUARD_CALL = (guarded *)guard_acquire(instance, MODEL_IDENTIFIER, "fmi3" #F);                      \
     if (!g) return fmi3Error;                                                                                     \
+    guard_scope scope GUARD_SCOPE = {&g->common, g->common.function};                                             \
+    (void)scope;                                                                                                  \
     g->common.function = "fmi3" #F;                                                                               \
     if (!((g->model_exchange ? ME : CS) & (INTERFACE)))                                                           \
         return (fmi3Status)fail(&g->common, "fmi3" #F ": not a function of %s, which this instance was made for", \
@@ -168,7 +172,7 @@ static guarded *instantiate(fmi3String name, fmi3String token, fmi3String resour
     g->host_logger = logger;
     g->common.function = function;
     char why[2048] = "", resources[4096];
-    if (refusal) guard_format(why, sizeof why, "%s", refusal);
+    if (refusal) text_format(why, sizeof why, "%s", refusal);
     else guard_check_instantiation(&FMI3, name, token, resourcePath, resources, sizeof resources, why, sizeof why);
     if (why[0]) fail(&g->common, "%s: %s", function, why);
     if (why[0] || !guard_start_python(&g->common, resources, visible)) {
@@ -454,7 +458,7 @@ FMI3_Export fmi3Status fmi3GetContinuousStateDerivatives(fmi3Instance instance, 
     for (size_t k = 0; status <= fmi3Warning && k < nContinuousStates; k++)
         if (!isfinite(derivatives[k])) { /* the states are outside the model's domain: the host steps back */
             char message[256];
-            guard_format(message, sizeof message, "fmi3GetContinuousStateDerivatives: derivatives[%zu] = %g is not "
+            text_format(message, sizeof message, "fmi3GetContinuousStateDerivatives: derivatives[%zu] = %g is not "
                          "finite at these continuous states (outside the model's domain)", k, derivatives[k]);
             guard_emit(&g->common, fmi3Discard, "logStatusDiscard", message);
             return fmi3Discard;

@@ -4,7 +4,12 @@
  * A state belongs to the instance that made it (or deserialised it): another instance may not set,
  * serialise or free it.  Its serialized form is a header (this FMU's token, the interface it was made
  * for, the FMI state and time) and the Python side's bytes (JSON), and deserialising checks all of it:
- * the header here, the bytes on the Python side (fmu_src/fmi_bridge.py), before anything is changed. */
+ * the header here, the bytes on the Python side (fmu_src/fmi_bridge.py), before anything is changed.
+ *
+ * A call of the Python side may run the host's logger, and the logger may free the state the call uses
+ * (fmi2FreeFMUstate from the callback). A state is therefore held for the call (hold) and looked at again only
+ * through let_go, which frees a state the host freed meanwhile and says so: no state is read after it was
+ * freed. */
 #define _GNU_SOURCE
 #include "glibc_compat.h"
 
@@ -14,7 +19,10 @@
 #include <string.h>
 
 #include "bridge.h"
-#include "guard.h"
+#include "fmu_state.h"
+#include "platform.h"
+#include "pointer_set.h"
+#include "text.h"
 
 #define STATE_MAGIC "DPFMUST2"
 
@@ -36,7 +44,7 @@ static guard_state *known(guard_instance *g, void *s) {
     platform_lock(&fmu_states.lock);
     int live = pointer_set_has_locked(&fmu_states, s);
     int foreign = live && ((guard_state *)s)->owner != g;
-    if (foreign) guard_format(owner, sizeof owner, "%s", ((guard_state *)s)->owner->name);
+    if (foreign) text_format(owner, sizeof owner, "%s", ((guard_state *)s)->owner->name);
     platform_unlock(&fmu_states.lock);
     if (!live)
         return guard_fail(g, "%s: FMU state %p is not a live state of this FMU (freed, or from another FMU)",
@@ -50,7 +58,7 @@ static guard_state *known(guard_instance *g, void *s) {
 static guard_state *new_state(guard_instance *g, PyObject *python, guard_position at) {
     guard_state *s = calloc(1, sizeof *s);
     if (!s) return NULL;
-    *s = (guard_state){g, python, at, NULL, 0, NULL, g->states};
+    *s = (guard_state){g, python, at, NULL, 0, NULL, g->states, 0, 0};
     platform_lock(&fmu_states.lock);
     int added = pointer_set_add_locked(&fmu_states, s);
     if (added) {
@@ -69,9 +77,39 @@ static void replace_python(guard_instance *g, guard_state *s, PyObject *python, 
     s->python = python, s->at = at, s->serialized = NULL, s->serialized_size = 0;
 }
 
-/* Into *FMUstate (a new state if NULL, else a live one of g, overwritten) the Python state `python`. */
-static int deliver(guard_instance *g, void **FMUstate, PyObject *python, guard_position at) {
-    guard_state *s = *FMUstate;
+/* Hold s (NULL: nothing) for a call of the Python side that may run the host's logger. */
+static void hold(guard_state *s) {
+    if (!s) return;
+    platform_lock(&fmu_states.lock);
+    s->busy++;
+    platform_unlock(&fmu_states.lock);
+}
+
+/* End the hold of s after the call: 1 if s is still the host's, 0 (logged) if the host freed it during the
+ * call, which frees it now. */
+static int let_go(guard_instance *g, guard_state *s) {
+    if (!s) return 1;
+    platform_lock(&fmu_states.lock);
+    int freed = --s->busy == 0 && s->doomed;
+    int doomed = s->doomed;
+    platform_unlock(&fmu_states.lock);
+    if (freed) {
+        replace_python(g, s, NULL, s->at);
+        free(s);
+    }
+    if (doomed)
+        guard_fail(g, "%s: the FMU state was freed (by the host's logger) during this call, which used it",
+                   g->function);
+    return !doomed;
+}
+
+/* Into `s` (NULL: a new state; else a live one of g, held for the call that made `python`, overwritten) the
+ * Python state `python`, through the host's *FMUstate. */
+static int deliver(guard_instance *g, void **FMUstate, guard_state *s, PyObject *python, guard_position at) {
+    if (!let_go(g, s)) {
+        bridge_release(g, python);
+        return STATUS_ERROR;
+    }
     if (s) {
         replace_python(g, s, python, at);
         return STATUS_OK;
@@ -86,18 +124,22 @@ static int deliver(guard_instance *g, void **FMUstate, PyObject *python, guard_p
 
 int guard_get_state(guard_instance *g, void **FMUstate) {
     if (!FMUstate) return guard_fail(g, "%s: %s is NULL", g->function, g->version->state_word);
-    if (*FMUstate && !known(g, *FMUstate)) return STATUS_ERROR;
+    guard_state *s = *FMUstate;
+    if (s && !known(g, s)) return STATUS_ERROR;
     PyObject *python = NULL;
     bridge_payload payload = {PAYLOAD_OBJECT, NULL, 0, NULL, NULL, &python};
+    hold(s);
     int status = guard_settle(g, bridge_call(g, payload, "get_fmu_state", "()"));
-    return status > STATUS_WARNING ? status : deliver(g, FMUstate, python, g->at);
+    if (status > STATUS_WARNING) return let_go(g, s), status;
+    return deliver(g, FMUstate, s, python, g->at);
 }
 
 int guard_set_state(guard_instance *g, void *FMUstate) {
     guard_state *s = known(g, FMUstate);
     if (!s) return STATUS_ERROR;
+    guard_position at = s->at; /* read before the call: the host's logger may free s during it */
     int status = guard_settle(g, bridge_call(g, NO_PAYLOAD, "set_fmu_state", "(O)", s->python));
-    if (status <= STATUS_WARNING) g->at = s->at;
+    if (status <= STATUS_WARNING) g->at = at;
     return status;
 }
 
@@ -111,10 +153,13 @@ int guard_free_state(guard_instance *g, void **FMUstate) {
     if (s->previous) s->previous->next = s->next;
     else g->states = s->next;
     if (s->next) s->next->previous = s->previous;
+    int busy = s->busy;
+    if (busy) s->doomed = 1, s->previous = s->next = NULL; /* a call in progress uses it: let_go frees it */
     platform_unlock(&fmu_states.lock);
+    *FMUstate = NULL;
+    if (busy) return STATUS_OK;
     replace_python(g, s, NULL, s->at);
     free(s);
-    *FMUstate = NULL;
     return STATUS_OK;
 }
 
@@ -125,11 +170,18 @@ static int serialized(guard_instance *g, guard_state *s) {
     return guard_settle(g, bridge_call(g, payload, "serialize_fmu_state", "(O)", s->python));
 }
 
+/* serialized(g, s) with s held for the call: STATUS_ERROR (logged) if the host freed s during it. */
+static int serialized_held(guard_instance *g, guard_state *s) {
+    hold(s);
+    int status = serialized(g, s);
+    return let_go(g, s) ? status : STATUS_ERROR;
+}
+
 int guard_serialized_size(guard_instance *g, void *FMUstate, size_t *size) {
     if (!size) return guard_fail(g, "%s: size is NULL", g->function);
     guard_state *s = known(g, FMUstate);
     if (!s) return STATUS_ERROR;
-    int status = serialized(g, s);
+    int status = serialized_held(g, s);
     if (status <= STATUS_WARNING) *size = sizeof(state_header) + s->serialized_size;
     return status;
 }
@@ -138,7 +190,7 @@ int guard_serialize_state(guard_instance *g, void *FMUstate, unsigned char *byte
     if (!bytes) return guard_fail(g, "%s: serializedState is NULL", g->function);
     guard_state *s = known(g, FMUstate);
     if (!s) return STATUS_ERROR;
-    int status = serialized(g, s);
+    int status = serialized_held(g, s);
     if (status > STATUS_WARNING) return status;
     size_t needed = sizeof(state_header) + s->serialized_size;
     if (size != needed)
@@ -147,8 +199,8 @@ int guard_serialize_state(guard_instance *g, void *FMUstate, unsigned char *byte
     state_header header;
     memset(&header, 0, sizeof header);
     memcpy(header.magic, STATE_MAGIC, sizeof header.magic);
-    guard_format(header.token, sizeof header.token, "%s", g->version->token);
-    guard_format(header.interface, sizeof header.interface, "%s", g->interface);
+    text_format(header.token, sizeof header.token, "%s", g->version->token);
+    text_format(header.interface, sizeof header.interface, "%s", g->interface);
     header.state = s->at.state, header.wants_to_terminate = s->at.wants_to_terminate;
     header.time = s->at.time, header.last_successful_time = s->at.last_successful_time;
     header.payload_size = s->serialized_size;
@@ -161,7 +213,8 @@ int guard_deserialize_state(guard_instance *g, const unsigned char *bytes, size_
     const guard_version *v = g->version;
     if (!bytes) return guard_fail(g, "%s: serializedState is NULL", g->function);
     if (!FMUstate) return guard_fail(g, "%s: %s is NULL", g->function, v->state_word);
-    if (*FMUstate && !known(g, *FMUstate)) return STATUS_ERROR;
+    guard_state *s = *FMUstate;
+    if (s && !known(g, s)) return STATUS_ERROR;
     state_header header;
     if (size < sizeof header || memcmp(bytes, STATE_MAGIC, sizeof header.magic) != 0)
         return guard_fail(g, "%s: the %zu bytes are not a serialized state of this FMU (no header)", g->function, size);
@@ -174,9 +227,11 @@ int guard_deserialize_state(guard_instance *g, const unsigned char *bytes, size_
         return guard_fail(g, "%s: the bytes are a %s state; this instance is %s", g->function, header.interface,
                           g->interface);
     if (!(header.state & v->any_state) || (header.state & (header.state - 1)) || !isfinite(header.time) ||
-        !isfinite(header.last_successful_time) || (header.wants_to_terminate & ~1))
-        return guard_fail(g, "%s: the state is malformed: its header holds FMI state %d at t = %g s", g->function,
-                          (int)header.state, header.time);
+        !isfinite(header.last_successful_time) || header.last_successful_time > header.time ||
+        (header.wants_to_terminate & ~1))
+        return guard_fail(g, "%s: the state is malformed: its header holds FMI state %d at t = %.17g s (last "
+                          "successful time %.17g s)", g->function, (int)header.state, header.time,
+                          header.last_successful_time);
     if (header.payload_size != size - sizeof header)
         return guard_fail(g, "%s: the state is malformed: %zu bytes, but its header counts %llu", g->function, size,
                           (unsigned long long)(sizeof header + header.payload_size));
@@ -185,9 +240,11 @@ int guard_deserialize_state(guard_instance *g, const unsigned char *bytes, size_
                           v->state_name(header.state), g->interface);
     PyObject *python = NULL;
     bridge_payload payload = {PAYLOAD_OBJECT, NULL, 0, NULL, NULL, &python};
-    int status = guard_settle(g, bridge_call(g, payload, "deserialize_fmu_state", "(y#)",
-                                             (const char *)bytes + sizeof header, (ssize_t)header.payload_size));
-    if (status > STATUS_WARNING) return status;
+    hold(s);
+    int status = guard_settle(g, bridge_call(g, payload, "deserialize_fmu_state", "(y#d)",
+                                             (const char *)bytes + sizeof header, (ssize_t)header.payload_size,
+                                             header.time));
+    if (status > STATUS_WARNING) return let_go(g, s), status;
     guard_position at = {header.state, header.time, header.last_successful_time, header.wants_to_terminate};
-    return deliver(g, FMUstate, python, at);
+    return deliver(g, FMUstate, s, python, at);
 }

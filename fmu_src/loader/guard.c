@@ -11,6 +11,10 @@
 #include <string.h>
 
 #include "bridge.h"
+#include "fmu_state.h"
+#include "platform.h"
+#include "pointer_set.h"
+#include "python_runtime.h"
 #include "text.h"
 
 #define IDENTITY_FILE "identity.cfg" /* in resources/, written by the build: model, token, archive, entry */
@@ -55,6 +59,10 @@ void guard_release(guard_instance *g) {
     if (last) g->destroy(g);
 }
 
+void guard_scope_end(guard_scope *scope) {
+    if (scope->g) scope->g->function = scope->function;
+}
+
 void guard_release_variable(void *variable) {
     guard_instance *g = *(guard_instance **)variable;
     if (g) guard_release(g);
@@ -72,7 +80,7 @@ int guard_init_instance(guard_instance *g, const guard_version *version, const c
                         const char *name, int logging_on,
                         void (*log)(guard_instance *, int, const char *, const char *),
                         void (*destroy)(guard_instance *)) {
-    g->name = strdup(name && name[0] && guard_utf8_error(name) < 0 ? name : "?");
+    g->name = strdup(name && name[0] && text_utf8_error(name) < 0 ? name : "?");
     g->at = (guard_position){version->instantiated_state, 0.0, 0.0, 0};
     g->version = version;
     g->interface = interface;
@@ -115,7 +123,7 @@ static int read_identity(const char *resources, identity *id) {
         char *field = strcmp(line, "model") == 0 ? id->model : strcmp(line, "token") == 0 ? id->token
                       : strcmp(line, "entry") == 0 ? id->entry : strcmp(line, "package") == 0 ? id->package
                       : strcmp(line, "archive") == 0 ? id->archive : NULL;
-        if (field) guard_format(field, sizeof id->model, "%s", value);
+        if (field) text_format(field, sizeof id->model, "%s", value);
     }
     fclose(file);
     return id->model[0] && id->token[0] && id->archive[0] && id->package[0] && id->entry[0];
@@ -125,34 +133,34 @@ int guard_check_instantiation(const guard_version *v, const char *name, const ch
                               char *resources, size_t size, char *why, size_t why_size) {
     long bad;
     identity id;
-    if (!name || !name[0]) guard_format(why, why_size, "instanceName is %s", name ? "empty" : "NULL");
-    else if ((bad = guard_utf8_error(name)) >= 0)
-        guard_format(why, why_size, "instanceName is not UTF-8 (byte %ld is 0x%02x; an %sString is UTF-8 encoded)",
+    if (!name || !name[0]) text_format(why, why_size, "instanceName is %s", name ? "empty" : "NULL");
+    else if ((bad = text_utf8_error(name)) >= 0)
+        text_format(why, why_size, "instanceName is not UTF-8 (byte %ld is 0x%02x; an %sString is UTF-8 encoded)",
                      bad, (unsigned char)name[bad], v->prefix);
     else if (!token || strcmp(token, v->token) != 0)
-        guard_format(why, why_size, "%s %s%.100s%s is not this FMU's %s: the binary and its modelDescription.xml "
+        text_format(why, why_size, "%s %s%.100s%s is not this FMU's %s: the binary and its modelDescription.xml "
                      "come from different builds", v->token_name, token ? "\"" : "", token ? token : "NULL",
                      token ? "\"" : "", v->token);
     else if (!location || !location[0])
-        guard_format(why, why_size, "%s is %s: the FMU needs its resources folder", v->resources_name,
+        text_format(why, why_size, "%s is %s: the FMU needs its resources folder", v->resources_name,
                      location ? "empty" : "NULL");
-    else if ((bad = guard_utf8_error(location)) >= 0)
-        guard_format(why, why_size, "%s \"%.1000s\" is not UTF-8 (byte %ld; an %sString is UTF-8 encoded)",
+    else if ((bad = text_utf8_error(location)) >= 0)
+        text_format(why, why_size, "%s \"%.1000s\" is not UTF-8 (byte %ld; an %sString is UTF-8 encoded)",
                      v->resources_name, location, bad, v->prefix);
     else if (!guard_uri_to_path(location, resources, size))
-        guard_format(why, why_size, "%s \"%.1000s\" is not a file URI or path of this machine", v->resources_name,
+        text_format(why, why_size, "%s \"%.1000s\" is not a file URI or path of this machine", v->resources_name,
                      location);
-    else if ((bad = guard_utf8_error(resources)) >= 0)
-        guard_format(why, why_size, "%s \"%.1000s\": the folder's path is not UTF-8 (byte %ld), which the FMU's "
+    else if ((bad = text_utf8_error(resources)) >= 0)
+        text_format(why, why_size, "%s \"%.1000s\": the folder's path is not UTF-8 (byte %ld), which the FMU's "
                      "Python side cannot take", v->resources_name, location, bad);
     else if (!platform_is_directory(resources))
-        guard_format(why, why_size, "%s \"%.1000s\": there is no folder %.1000s", v->resources_name, location,
+        text_format(why, why_size, "%s \"%.1000s\": there is no folder %.1000s", v->resources_name, location,
                      resources);
     else if (!read_identity(resources, &id))
-        guard_format(why, why_size, "%s \"%.1000s\" is not this FMU's resources folder (no %s in %.1000s)",
+        text_format(why, why_size, "%s \"%.1000s\" is not this FMU's resources folder (no %s in %.1000s)",
                      v->resources_name, location, IDENTITY_FILE, resources);
     else if (strcmp(id.model, v->model_identifier) != 0 || strcmp(id.token, v->token) != 0)
-        guard_format(why, why_size, "%s \"%.1000s\" is the resources folder of another FMU (%.100s, %s %.100s), "
+        text_format(why, why_size, "%s \"%.1000s\" is the resources folder of another FMU (%.100s, %s %.100s), "
                      "not of %s (%s %s)", v->resources_name, location, id.model, v->token_name, id.token,
                      v->model_identifier, v->token_name, v->token);
     else
@@ -168,7 +176,7 @@ int guard_start_python(guard_instance *g, const char *resources, int visible) {
     if (!py) return guard_fail(g, "%s: %s", g->function, why), 0;
     if (chosen) { /* with debug logging on: which Python runs the FMU, and why that one */
         char line[sizeof why + 64];
-        guard_format(line, sizeof line, "%s: the FMU's Python side runs in %s", g->function, chosen);
+        text_format(line, sizeof line, "%s: the FMU's Python side runs in %s", g->function, chosen);
         guard_emit(g, STATUS_OK, "logAll", line);
     }
     if (!read_identity(resources, &id))
@@ -201,35 +209,6 @@ void guard_orphan(const char *model_identifier, const char *function, const char
     if (n < 0) message[0] = '\0';
     fprintf(stderr, "[%s] %s: %s\n", model_identifier, function, message);
     fflush(stderr);
-}
-
-void guard_emit(guard_instance *g, int status, const char *category, const char *message) {
-    int bit = guard_category_bit(category);
-    if (!bit) {
-        bit = guard_category_bit_of(status);
-        category = guard_category_of(status);
-    }
-    if (g->categories & bit) g->log(g, status, category, message);
-}
-
-int guard_fail(guard_instance *g, const char *format, ...) {
-    char message[2048];
-    va_list args;
-    va_start(args, format);
-    int n = vsnprintf(message, sizeof message, format, args);
-    va_end(args);
-    if (n < 0) message[0] = '\0';
-    guard_emit(g, STATUS_ERROR, "logStatusError", message);
-    g->at.state = g->version->error_state;
-    return STATUS_ERROR;
-}
-
-int guard_settle(guard_instance *g, int status) {
-    if (status >= STATUS_ERROR) {
-        g->at.state = g->version->error_state;
-        return STATUS_ERROR;
-    }
-    return status;
 }
 
 int guard_set_debug_logging(guard_instance *g, int on, size_t n, const char *const categories[]) {
@@ -275,7 +254,7 @@ int guard_set_strings(guard_instance *g, const unsigned int vr[], size_t n, cons
         if (!values[k])
             return guard_fail(g, "%s: %s[%zu] (%s %u) is NULL", g->function, v->values_word, k, v->reference_word,
                               vr[k]);
-        long bad = guard_utf8_error(values[k]);
+        long bad = text_utf8_error(values[k]);
         if (bad >= 0)
             return guard_fail(g, "%s: %s[%zu] (%s %u) is not UTF-8 (byte %ld is 0x%02x; an %sString is UTF-8 "
                               "encoded)", g->function, v->values_word, k, v->reference_word, vr[k], bad,
@@ -306,83 +285,6 @@ int guard_check_step(guard_instance *g, double current, double step) {
         return guard_fail(g, "%s: currentCommunicationPoint = %.17g s is not the FMU's time %.17g s (the end of the "
                           "last step, or of the FMU state set)", g->function, current, t), 0;
     return 1;
-}
-
-/* ---------------------------------------------------------------------------- messages */
-
-static const struct {
-    const char *name;
-    int bit;
-} CATEGORIES[] = {{"logAll", CATEGORY_ALL},
-                  {"logStatusWarning", CATEGORY_WARNING},
-                  {"logStatusDiscard", CATEGORY_DISCARD},
-                  {"logStatusError", CATEGORY_ERROR},
-                  {"logStatusFatal", CATEGORY_FATAL}};
-#define N_CATEGORIES (sizeof CATEGORIES / sizeof CATEGORIES[0])
-
-int guard_category_bit(const char *name) {
-    for (size_t k = 0; name && k < N_CATEGORIES; k++)
-        if (strcmp(name, CATEGORIES[k].name) == 0) return CATEGORIES[k].bit;
-    return 0;
-}
-
-const char *guard_category_of(int status) {
-    return status >= 0 && status < (int)N_CATEGORIES ? CATEGORIES[status].name : "logStatusError";
-}
-
-int guard_category_bit_of(int status) {
-    return status >= 0 && status < (int)N_CATEGORIES ? CATEGORIES[status].bit : CATEGORY_ERROR;
-}
-
-int guard_debug_categories(int *mask, int on, size_t n, const char *const categories[], char *why, size_t size) {
-    if (n == 0) {
-        *mask = on ? CATEGORIES_EVERY : 0;
-        return 1;
-    }
-    if (!categories) {
-        guard_format(why, size, "categories is NULL with nCategories = %zu", n);
-        return 0;
-    }
-    int bits = 0;
-    for (size_t k = 0; k < n; k++) {
-        int bit = guard_category_bit(categories[k]);
-        if (!categories[k]) {
-            guard_format(why, size, "categories[%zu] is NULL", k);
-            return 0;
-        }
-        if (!bit) {
-            guard_format(why, size, "unknown log category \"%.200s\" (this FMU's: %s)", categories[k], CATEGORY_NAMES);
-            return 0;
-        }
-        bits |= bit;
-    }
-    *mask = on ? (*mask | bits) : (*mask & ~bits);
-    return 1;
-}
-
-void guard_format(char *out, size_t size, const char *format, ...) {
-    va_list args;
-    va_start(args, format);
-    text_vformat(out, size, format, args);
-    va_end(args);
-}
-
-long guard_utf8_error(const char *text) {
-    const unsigned char *s = (const unsigned char *)text;
-    for (long k = 0; s[k];) {
-        unsigned char b = s[k];
-        int n = b < 0x80 ? 0 : b >= 0xC2 && b <= 0xDF ? 1 : b >= 0xE0 && b <= 0xEF ? 2 : b >= 0xF0 && b <= 0xF4 ? 3 : -1;
-        if (n < 0) return k;
-        /* the second byte's range rules out overlong forms, surrogates and code points above U+10FFFF */
-        unsigned char low = b == 0xE0 ? 0xA0 : b == 0xF0 ? 0x90 : 0x80;
-        unsigned char high = b == 0xED ? 0x9F : b == 0xF4 ? 0x8F : 0xBF;
-        for (int j = 1; j <= n; j++) {
-            unsigned char next = s[k + j];
-            if (next < (j == 1 ? low : 0x80) || next > (j == 1 ? high : 0xBF)) return k;
-        }
-        k += n + 1;
-    }
-    return -1;
 }
 
 /* ------------------------------------------------------------------------------- paths */

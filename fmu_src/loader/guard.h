@@ -14,82 +14,9 @@
 
 #include <stddef.h>
 
-#include "platform.h"
-#include "python_runtime.h"
-
-/* ------------------------------------------------------------------------- live pointers */
-
-/* A set of pointers (an open-addressing hash set under a mutex), for the instances and FMU states
- * this binary handed out: a pointer the host passes is dereferenced only if it is in the set. */
-typedef struct {
-    platform_mutex lock;
-    void **slots;
-    size_t capacity, count, used; /* used: live entries and tombstones */
-} pointer_set;
-
-#define POINTER_SET_INIT {PLATFORM_MUTEX_INIT, NULL, 0, 0, 0}
-
-int pointer_set_add(pointer_set *set, void *pointer);    /* 0 if out of memory */
-int pointer_set_remove(pointer_set *set, void *pointer); /* 1 if it was in the set */
-int pointer_set_has(pointer_set *set, void *pointer);
-/* The same with set->lock held by the caller. */
-int pointer_set_add_locked(pointer_set *set, void *pointer);
-int pointer_set_remove_locked(pointer_set *set, void *pointer);
-int pointer_set_has_locked(pointer_set *set, void *pointer);
-
-/* ------------------------------------------------------------------------------- versions */
-
-/* FMI 2 and FMI 3 number their statuses alike: OK 0, Warning 1, Discard 2, Error 3, Fatal 4. */
-enum { STATUS_OK = 0, STATUS_WARNING = 1, STATUS_DISCARD = 2, STATUS_ERROR = 3, STATUS_FATAL = 4 };
-
-/* What differs between the FMI versions in the shared logic. */
-typedef struct {
-    const char *prefix;           /* "fmi2", "fmi3" */
-    const char *model_identifier; /* MODEL_IDENTIFIER */
-    const char *token;            /* FMU_GUID: the GUID (FMI 2) or instantiationToken (FMI 3) */
-    const char *token_name;       /* "fmuGUID", "instantiationToken" */
-    const char *resources_name;   /* "fmuResourceLocation", "resourcePath" */
-    int any_state;                /* the bits of every state */
-    int error_state;              /* the bit of the Error state */
-    int instantiated_state;       /* the bit of Instantiated (after a reset) */
-    const char *state_word;       /* "FMUstate", "FMUState": as the version spells it */
-    const char *values_word;      /* "value", "values": the name of a get/set function's values */
-    const char *reference_word;   /* "vr", "valueReference": what a value reference is called in messages */
-    const char *(*state_name)(int state);
-    int (*state_allowed)(const char *interface, int state); /* can an instance of `interface` be in it? */
-} guard_version;
+#include "guard_base.h"
 
 /* ------------------------------------------------------------------------------- instances */
-
-typedef struct guard_instance guard_instance;
-typedef struct guard_state guard_state;
-
-/* Where an instance is: what an FMU state restores besides the Python side's own state. */
-typedef struct {
-    int state;                   /* one bit of the FMI version's states */
-    double time;                 /* the FMU's time: where the next doStep starts [s] */
-    double last_successful_time; /* the end of the last step that succeeded [s] */
-    int wants_to_terminate;      /* a step was discarded: the FMU cannot go on from there */
-} guard_position;
-
-/* What every instance has, first in the FMI version's own struct. */
-struct guard_instance {
-    guard_position at;
-    const guard_version *version;
-    const char *interface; /* "CoSimulation" or "ModelExchange": what it was made for */
-    int categories;        /* the log categories that reach the host's logger */
-    const char *function;  /* the FMI function being run, for messages */
-    char *name;
-    guard_state *states;   /* the FMU states it made */
-    int references;        /* the host's (until it frees the instance) and one per call running */
-    const python_api *api; /* the process's Python */
-    PyObject *python;      /* the instance's Python object (fmu_src/fmi_bridge.py) */
-    int interrupted;       /* a Ctrl-C stopped a call: raised again for the host when the FMI function returns */
-    char *strings;         /* the values of the last get of Strings (valid until the next one) */
-    /* give one message to the host's logger, or stderr if it has none */
-    void (*log)(guard_instance *g, int status, const char *category, const char *message);
-    void (*destroy)(guard_instance *g); /* free the version's struct (its Python object is released) */
-};
 
 /* Register a new instance with the host's reference (0 if out of memory). */
 int guard_register(guard_instance *g);
@@ -102,6 +29,14 @@ void guard_release(guard_instance *g);
 /* For __attribute__((cleanup)): release the instance a variable holds (if any) when it goes out of scope. */
 void guard_release_variable(void *variable);
 #define GUARD_CALL __attribute__((cleanup(guard_release_variable)))
+/* The FMI function an instance is in, given back when a call ends: a call the host's logger makes from inside
+ * another (fmi2FreeFMUstate during fmi2GetFMUstate) leaves the outer call's name for its later log lines. */
+typedef struct {
+    guard_instance *g;
+    const char *function;
+} guard_scope;
+void guard_scope_end(guard_scope *scope);
+#define GUARD_SCOPE __attribute__((cleanup(guard_scope_end)))
 
 /* If a Ctrl-C stopped a call of g, raise it again for the host (a Python host then sees KeyboardInterrupt):
  * the last thing an FMI function does, after every message has been logged (a Python logger would
@@ -125,12 +60,6 @@ void guard_free_common(guard_instance *g);
 /* fmiXReset: the Python object made anew, the FMU states kept. */
 int guard_reset(guard_instance *g);
 
-/* Give `message` to the host's logger if its category is on (the status's category if NULL). */
-void guard_emit(guard_instance *g, int status, const char *category, const char *message);
-/* Log an error, put the instance into its Error state, return STATUS_ERROR. */
-int guard_fail(guard_instance *g, const char *format, ...) __attribute__((format(printf, 2, 3)));
-/* A status of the Python side as the host gets it: an error puts the instance into its Error state. */
-int guard_settle(guard_instance *g, int status);
 /* fmiXSetDebugLogging as specified; STATUS_OK or a failure. */
 int guard_set_debug_logging(guard_instance *g, int on, size_t n, const char *const categories[]);
 /* One line on stderr for a call that has no instance to log through. */
@@ -141,59 +70,6 @@ int guard_get_strings(guard_instance *g, const unsigned int vr[], size_t n, cons
 int guard_set_strings(guard_instance *g, const unsigned int vr[], size_t n, const char *const values[]);
 /* doStep's currentCommunicationPoint and communicationStepSize: 1 if they are right, else logged. */
 int guard_check_step(guard_instance *g, double current, double step);
-
-/* ------------------------------------------------------------------------------ FMU states */
-
-/* An FMU state as the host holds it: the Python side's state and the instance's position. */
-struct guard_state {
-    guard_instance *owner; /* the instance that made it: the only one that may use or free it */
-    PyObject *python;
-    guard_position at;
-    char *serialized; /* the serialized form, once asked for (its size first, then the bytes) */
-    size_t serialized_size;
-    guard_state *previous, *next; /* the owner's states */
-};
-
-/* The FMU-state functions of both versions (FMUstate is the host's fmiXFMUState*). */
-int guard_get_state(guard_instance *g, void **FMUstate);
-int guard_set_state(guard_instance *g, void *FMUstate);
-int guard_free_state(guard_instance *g, void **FMUstate);
-int guard_serialized_size(guard_instance *g, void *FMUstate, size_t *size);
-int guard_serialize_state(guard_instance *g, void *FMUstate, unsigned char *bytes, size_t size);
-int guard_deserialize_state(guard_instance *g, const unsigned char *bytes, size_t size, void **FMUstate);
-
-/* ---------------------------------------------------------------------------- messages */
-
-/* The log categories of the FMUs' modelDescription, as bits. */
-enum {
-    CATEGORY_ALL = 1 << 0,     /* logAll: messages with status OK */
-    CATEGORY_WARNING = 1 << 1, /* logStatusWarning */
-    CATEGORY_DISCARD = 1 << 2, /* logStatusDiscard */
-    CATEGORY_ERROR = 1 << 3,   /* logStatusError */
-    CATEGORY_FATAL = 1 << 4,   /* logStatusFatal */
-};
-#define CATEGORIES_EVERY (CATEGORY_ALL | CATEGORY_WARNING | CATEGORY_DISCARD | CATEGORY_ERROR | CATEGORY_FATAL)
-/* logged from instantiation on: why a step was discarded, and every error */
-#define CATEGORIES_DEFAULT (CATEGORY_DISCARD | CATEGORY_ERROR | CATEGORY_FATAL)
-#define CATEGORY_NAMES "logAll, logStatusWarning, logStatusDiscard, logStatusError, logStatusFatal"
-
-/* The bit of category `name`, 0 if it is not one of this FMU's. */
-int guard_category_bit(const char *name);
-/* The category of a message with FMI status `status` (0 OK ... 4 Fatal, as in FMI 2 and FMI 3). */
-const char *guard_category_of(int status);
-int guard_category_bit_of(int status);
-
-/* Parse fmi2/fmi3SetDebugLogging's categories into `mask` (`on` sets, else clears, their bits;
- * none named: all of them).  Returns 0 and writes why to `why` if an argument is wrong. */
-int guard_debug_categories(int *mask, int on, size_t n, const char *const categories[], char *why, size_t size);
-
-/* Like snprintf, never fails: a message cut at `size` ends in "...". */
-void guard_format(char *out, size_t size, const char *format, ...) __attribute__((format(printf, 3, 4)));
-
-/* The offset of the first byte of `text` that is not strict UTF-8 (what CPython's decoder accepts: no
- * overlong forms, no surrogates, nothing above U+10FFFF), or -1 if all of it is.  FMI strings are UTF-8
- * (fmi2TypesPlatform.h, fmi3PlatformTypes.h), and the Python side decodes them as such. */
-long guard_utf8_error(const char *text);
 
 /* ------------------------------------------------------------------------------- paths */
 

@@ -2,7 +2,7 @@
 #define _GNU_SOURCE
 #include "glibc_compat.h"
 
-#include "guard.h"
+#include "pointer_set.h"
 
 #include <stdint.h>
 #include <stdlib.h>

@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "guard.h"
 #include "identity.h"
 #include "platform.h"
 #include "text.h"
@@ -41,7 +40,7 @@ static void appendf(char *buffer, size_t size, const char *format, ...) {
     char part[WHY_SIZE + PLATFORM_PATH_MAX];
     int n = vsnprintf(part, sizeof part, format, args);
     va_end(args);
-    if (n > 0) guard_format(buffer + used, size - used, "%s", part);
+    if (n > 0) text_format(buffer + used, size - used, "%s", part);
 }
 
 static const char *base_name(const char *path) {
@@ -70,25 +69,25 @@ static in_process python_in_process(void **library, char *why, size_t size) {
     int major = 0, minor = 0;
     const char *where = path[0] ? path : "the host's executable";
     if (!parse_version(version, &major, &minor)) {
-        guard_format(why, size, "the Python in this process (%s) does not say its version: it is not a CPython",
+        text_format(why, size, "the Python in this process (%s) does not say its version: it is not a CPython",
                      where);
         return REFUSED_HERE;
     }
     char short_version[32];
-    guard_format(short_version, sizeof short_version, "%.*s", (int)strcspn(version, " "), version);
+    text_format(short_version, sizeof short_version, "%.*s", (int)strcspn(version, " "), version);
     if (major != 3 || minor < PYTHON_MIN_MINOR) {
-        guard_format(why, size, "this process runs CPython %s (%s), older than the 3.%d the FMU's Python side "
+        text_format(why, size, "this process runs CPython %s (%s), older than the 3.%d the FMU's Python side "
                      "needs; the FMU uses the Python of its host and never loads a second one beside it: run it "
                      "from CPython >= 3.%d, or from a host without Python%s", short_version, where, PYTHON_MIN_MINOR,
                      PYTHON_MIN_MINOR, identity_python_library[0] ? " (it carries its own)" : "");
         return REFUSED_HERE;
     }
     if (!initialized || !initialized()) {
-        guard_format(why, size, "a CPython %s is loaded in this process (%s) but was not started by its owner; "
+        text_format(why, size, "a CPython %s is loaded in this process (%s) but was not started by its owner; "
                      "the FMU does not start it, nor load a second Python beside it", short_version, where);
         return REFUSED_HERE;
     }
-    guard_format(chosen, sizeof chosen, "CPython %s already running in this process (%s): the FMU uses the Python "
+    text_format(chosen, sizeof chosen, "CPython %s already running in this process (%s): the FMU uses the Python "
                  "of its host, or the one an earlier FMU started", short_version, where);
     return USABLE_HERE;
 }
@@ -110,25 +109,25 @@ static int query_interpreter(const char *interpreter, python_install *python, ch
     char implementation[32] = "";
     char *line = strchr(output, '\n');
     if (!line || sscanf(output, "%31s %d %d", implementation, &python->major, &python->minor) != 3) {
-        guard_format(why, size, "did not answer as a Python does");
+        text_format(why, size, "did not answer as a Python does");
         return 0;
     }
     char *fields[3] = {python->library, python->home, python->executable};
     for (int k = 0; k < 3; k++) {
         char *begin = line + 1, *end = strchr(begin, '\n');
         if (!end) {
-            guard_format(why, size, "did not answer as a Python does");
+            text_format(why, size, "did not answer as a Python does");
             return 0;
         }
         *end = '\0';
         if (!text_fits(fields[k], PLATFORM_PATH_MAX, "%s", begin)) {
-            guard_format(why, size, "answered with a path longer than %d bytes", PLATFORM_PATH_MAX - 1);
+            text_format(why, size, "answered with a path longer than %d bytes", PLATFORM_PATH_MAX - 1);
             return 0;
         }
         line = end;
     }
     if (strcmp(implementation, "cpython") != 0) {
-        guard_format(why, size, "is %s, not CPython", implementation);
+        text_format(why, size, "is %s, not CPython", implementation);
         return 0;
     }
     return 1;
@@ -153,13 +152,13 @@ static int describe_library(const char *library, python_install *python, char *w
     if (sscanf(name, "libpython%d.%d", &python->major, &python->minor) != 2) {
         int digits = 0;
         if (sscanf(name, "python%d.dll", &digits) != 1 || digits < 30) {
-            guard_format(why, size, "is neither a python3 interpreter nor a libpython3.X.so or python3X.dll");
+            text_format(why, size, "is neither a python3 interpreter nor a libpython3.X.so or python3X.dll");
             return 0;
         }
         python->major = 3, python->minor = digits >= 300 ? digits - 300 : digits - 30; /* python311.dll: 3.11 */
     }
     if (!platform_is_file(library) || !text_fits(python->library, PLATFORM_PATH_MAX, "%s", library)) {
-        guard_format(why, size, "does not exist");
+        text_format(why, size, "does not exist");
         return 0;
     }
     char home[PLATFORM_PATH_MAX];
@@ -175,7 +174,7 @@ static int describe_library(const char *library, python_install *python, char *w
             return 1;
         }
     }
-    guard_format(why, size, "has no standard library beside it (lib/python%d.%d/encodings, Lib/encodings or "
+    text_format(why, size, "has no standard library beside it (lib/python%d.%d/encodings, Lib/encodings or "
                  "python%d%d.zip)", python->major, python->minor, python->major, python->minor);
     return 0;
 }
@@ -184,12 +183,12 @@ static int describe_library(const char *library, python_install *python, char *w
 static int read_recorded(const char *resources, python_install *python, char *why, size_t size) {
     char path[PLATFORM_PATH_MAX];
     if (!text_fits(path, sizeof path, "%s/%s", resources, CONFIG_FILE)) {
-        guard_format(why, size, "none recorded (the resources folder's path is too long)");
+        text_format(why, size, "none recorded (the resources folder's path is too long)");
         return 0;
     }
     FILE *file = platform_open_text(path);
     if (!file) {
-        guard_format(why, size, "none recorded (%s missing)", path);
+        text_format(why, size, "none recorded (%s missing)", path);
         return 0;
     }
     char line[PLATFORM_PATH_MAX + 32];
@@ -206,11 +205,11 @@ static int read_recorded(const char *resources, python_install *python, char *wh
     }
     fclose(file);
     if (!complete) {
-        guard_format(why, size, "recorded in %s, which is malformed", path);
+        text_format(why, size, "recorded in %s, which is malformed", path);
         return 0;
     }
     if (!platform_is_file(python->library) && python->executable[0] && !platform_is_file(python->executable)) {
-        guard_format(why, size, "not found (%s and %s are gone)", python->executable,
+        text_format(why, size, "not found (%s and %s are gone)", python->executable,
                      python->library[0] ? python->library : "its libpython");
         return 0;
     }
@@ -221,7 +220,7 @@ static int read_recorded(const char *resources, python_install *python, char *wh
 static int describe_bundled(python_install *python, char *why, size_t size) {
     char folder[PLATFORM_PATH_MAX];
     if (!platform_own_folder(folder, sizeof folder)) {
-        guard_format(why, size, "cannot be found (the folder of the FMU's binary is unknown)");
+        text_format(why, size, "cannot be found (the folder of the FMU's binary is unknown)");
         return 0;
     }
     python->major = 3, python->minor = identity_python_minor;
@@ -232,11 +231,11 @@ static int describe_bundled(python_install *python, char *why, size_t size) {
                              identity_python_stdlib) &&
                    text_fits(python->search_path[1], PLATFORM_PATH_MAX, "%s", folder) &&
                    text_fits(python->preload, PLATFORM_PATH_MAX, "%s", identity_python_preload);
-    if (!complete) guard_format(why, size, "cannot be found (the path of the FMU's binaries folder is too long)");
+    if (!complete) text_format(why, size, "cannot be found (the path of the FMU's binaries folder is too long)");
     else if (!platform_is_file(python->library))
-        guard_format(why, size, "is damaged: %s is missing (extract the whole FMU again)", python->library);
+        text_format(why, size, "is damaged: %s is missing (extract the whole FMU again)", python->library);
     else if (!platform_is_file(python->search_path[0]))
-        guard_format(why, size, "is damaged: %s is missing (extract the whole FMU again)", python->search_path[0]);
+        text_format(why, size, "is damaged: %s is missing (extract the whole FMU again)", python->search_path[0]);
     else
         return 1;
     return 0;
@@ -245,12 +244,12 @@ static int describe_bundled(python_install *python, char *why, size_t size) {
 /* Can `python` run the FMU: CPython >= 3.11 with a shared libpython and its standard library? */
 static int usable(const python_install *python, char *why, size_t size) {
     if (python->major != 3 || python->minor < PYTHON_MIN_MINOR)
-        guard_format(why, size, "is Python %d.%d, older than 3.%d", python->major, python->minor, PYTHON_MIN_MINOR);
+        text_format(why, size, "is Python %d.%d, older than 3.%d", python->major, python->minor, PYTHON_MIN_MINOR);
     else if (!python->library[0] || !platform_is_file(python->library))
-        guard_format(why, size, "is Python %d.%d without a shared libpython (%s missing)", python->major,
+        text_format(why, size, "is Python %d.%d without a shared libpython (%s missing)", python->major,
                      python->minor, python->library[0] ? python->library : "libpython3.X.so");
     else if (!python->search_path[0][0] && !has_standard_library(python))
-        guard_format(why, size, "has no standard library at %s", python->home);
+        text_format(why, size, "has no standard library at %s", python->home);
     else
         return 1;
     return 0;
@@ -267,11 +266,11 @@ static int try_candidate(const char *label, int described, const python_install 
         if (here == NONE_HERE) ready = (*library = python_start(python, why, WHY_SIZE)) != NULL;
         platform_unlock_process();
         if (here == USABLE_HERE) return 1;
-        if (here == REFUSED_HERE) guard_format(why, WHY_SIZE, "%s", refused);
+        if (here == REFUSED_HERE) text_format(why, WHY_SIZE, "%s", refused);
         if (ready) {
             const char *(*get_version)(void) = (const char *(*)(void))platform_symbol(*library, "Py_GetVersion");
             const char *version = get_version ? get_version() : "";
-            guard_format(chosen, sizeof chosen, "%s: CPython %.*s (%s)", label, (int)strcspn(version, " "), version,
+            text_format(chosen, sizeof chosen, "%s: CPython %.*s (%s)", label, (int)strcspn(version, " "), version,
                          python->library);
         }
     }
@@ -288,13 +287,13 @@ static int find_and_start_python(const char *resources, char *error, size_t erro
     const char *override = platform_getenv(PYTHON_OVERRIDE_VARIABLE, override_buffer, sizeof override_buffer);
     if (override && override[0]) {
         memset(&python, 0, sizeof python);
-        guard_format(label, sizeof label, "%s=%s", PYTHON_OVERRIDE_VARIABLE, override);
+        text_format(label, sizeof label, "%s=%s", PYTHON_OVERRIDE_VARIABLE, override);
         int described;
         const char *name = base_name(override);
         if (strstr(name, "libpython") || (strncmp(name, "python", 6) == 0 && strstr(name, ".dll")))
             described = describe_library(override, &python, why, sizeof why);
         else if (!platform_which(override, interpreter, sizeof interpreter))
-            described = (guard_format(why, sizeof why, "is not an executable file"), 0);
+            described = (text_format(why, sizeof why, "is not an executable file"), 0);
         else described = query_interpreter(interpreter, &python, why, sizeof why);
         ready = try_candidate(label, described, &python, why, tried, sizeof tried, library);
     } else if (identity_python_library[0]) {
@@ -302,11 +301,11 @@ static int find_and_start_python(const char *resources, char *error, size_t erro
         int described = describe_bundled(&python, why, sizeof why);
         ready = try_candidate("the CPython this FMU carries", described, &python, why, tried, sizeof tried, library);
         if (ready && strstr(chosen, "the CPython this FMU carries") == chosen)  /* started here, not another FMU's */
-            guard_format(carried_stdlib, sizeof carried_stdlib, "%s", python.search_path[0]);
+            text_format(carried_stdlib, sizeof carried_stdlib, "%s", python.search_path[0]);
     } else {
         memset(&python, 0, sizeof python);
         int described = read_recorded(resources, &python, why, sizeof why);
-        guard_format(label, sizeof label, "the build's Python%s%s", described ? " " : "",
+        text_format(label, sizeof label, "the build's Python%s%s", described ? " " : "",
                      described ? python.executable : "");
         ready = try_candidate(label, described, &python, why, tried, sizeof tried, library);
         if (!ready) {
@@ -314,17 +313,17 @@ static int find_and_start_python(const char *resources, char *error, size_t erro
             char path_buffer[PLATFORM_PATH_MAX];
             const char *path = platform_getenv("PATH", path_buffer, sizeof path_buffer);
             if (platform_which("python3", interpreter, sizeof interpreter)) {
-                guard_format(label, sizeof label, "python3 on PATH (%s)", interpreter);
+                text_format(label, sizeof label, "python3 on PATH (%s)", interpreter);
                 described = query_interpreter(interpreter, &python, why, sizeof why);
             } else {
-                guard_format(label, sizeof label, "python3 on PATH (%s)", path ? path : "PATH unset");
-                described = (guard_format(why, sizeof why, "not found"), 0);
+                text_format(label, sizeof label, "python3 on PATH (%s)", path ? path : "PATH unset");
+                described = (text_format(why, sizeof why, "not found"), 0);
             }
             ready = try_candidate(label, described, &python, why, tried, sizeof tried, library);
         }
     }
     if (!ready)
-        guard_format(error, error_size,
+        text_format(error, error_size,
                      "no usable Python to run this FMU (it needs CPython >= 3.%d with a shared libpython, standard "
                      "library only): %s. Set %s to such a python3 or to its libpython3.X.so%s", PYTHON_MIN_MINOR,
                      tried, PYTHON_OVERRIDE_VARIABLE, identity_python_library[0] ? " (or python3X.dll), or extract "
@@ -367,7 +366,7 @@ static int resolve_api(void *library, char *error, size_t error_size) {
     *(void **)&api.VaBuildValue = platform_symbol(library, "_Py_VaBuildValue_SizeT");
     if (!api.VaBuildValue) *(void **)&api.VaBuildValue = platform_symbol(library, "Py_VaBuildValue");
     if (!missing && !api.VaBuildValue) missing = "Py_VaBuildValue";
-    if (missing) guard_format(error, error_size, "the process's Python lacks %s: it is not a CPython >= 3.%d", missing,
+    if (missing) text_format(error, error_size, "the process's Python lacks %s: it is not a CPython >= 3.%d", missing,
                               PYTHON_MIN_MINOR);
     return !missing;
 }
@@ -380,7 +379,7 @@ const python_api *python_runtime_start(const char *resources, char *error, size_
         char buffer[PLATFORM_PATH_MAX];
         const char *override = platform_getenv(PYTHON_OVERRIDE_VARIABLE, buffer, sizeof buffer);
         if (failure[0] && strcmp(failure_override, override ? override : "") == 0) {
-            guard_format(error, error_size, "%s", failure); /* the same search would fail the same way */
+            text_format(error, error_size, "%s", failure); /* the same search would fail the same way */
         } else {
             failure[0] = '\0';
             void *library = NULL;
@@ -389,8 +388,8 @@ const python_api *python_runtime_start(const char *resources, char *error, size_
                         (here == NONE_HERE && find_and_start_python(resources, error, error_size, &library));
             if (ready) api_ready = resolve_api(library, error, error_size);
             if (!api_ready) {
-                guard_format(failure, sizeof failure, "%s", error);
-                guard_format(failure_override, sizeof failure_override, "%s", override ? override : "");
+                text_format(failure, sizeof failure, "%s", error);
+                text_format(failure_override, sizeof failure_override, "%s", override ? override : "");
             }
         }
     }

@@ -25,3 +25,21 @@ void text_format(char *out, size_t size, const char *format, ...) {
     text_vformat(out, size, format, args);
     va_end(args);
 }
+
+long text_utf8_error(const char *text) {
+    const unsigned char *s = (const unsigned char *)text;
+    for (long k = 0; s[k];) {
+        unsigned char b = s[k];
+        int n = b < 0x80 ? 0 : b >= 0xC2 && b <= 0xDF ? 1 : b >= 0xE0 && b <= 0xEF ? 2 : b >= 0xF0 && b <= 0xF4 ? 3 : -1;
+        if (n < 0) return k;
+        /* the second byte's range rules out overlong forms, surrogates and code points above U+10FFFF */
+        unsigned char low = b == 0xE0 ? 0xA0 : b == 0xF0 ? 0x90 : 0x80;
+        unsigned char high = b == 0xED ? 0x9F : b == 0xF4 ? 0x8F : 0xBF;
+        for (int j = 1; j <= n; j++) {
+            unsigned char next = s[k + j];
+            if (next < (j == 1 ? low : 0x80) || next > (j == 1 ? high : 0xBF)) return k;
+        }
+        k += n + 1;
+    }
+    return -1;
+}

@@ -496,6 +496,48 @@ static int serialized_state_in_a_new_instance(void) {
     fmi2FreeInstance_(b);
     return ok && pa == pb ? 0 : -2;
 }
+/* A state serialized after a step of 0.125 s, changed by `tamper`, deserialized in a fresh instance: the status.
+ * The header (fmu_state.c) holds the time at byte 96 and the last successful time at byte 104; the payload is
+ * the Python side's JSON, with "time": 0.125. */
+static int deserialize_tampered(void (*tamper)(fmi2Byte *bytes, size_t size)) {
+    FRESH(a);
+    fmi2DoStep_(a, 0.0, 0.125, fmi2True);
+    fmi2FMUstate state = NULL;
+    size_t size = 0;
+    fmi2GetFMUstate_(a, &state);
+    fmi2SerializedFMUstateSize_(a, state, &size);
+    fmi2Byte *bytes = malloc(size);
+    fmi2SerializeFMUstate_(a, state, bytes, size);
+    fmi2FreeInstance_(a);
+    tamper(bytes, size);
+    fmi2Component b = instantiate(fmi2False);
+    fmi2FMUstate copy = NULL;
+    int s = fmi2DeSerializeFMUstate_(b, bytes, size, &copy);
+    free(bytes);
+    fmi2FreeInstance_(b);
+    return s;
+}
+static void header_time_huge(fmi2Byte *bytes, size_t size) {
+    double huge = 1e308;
+    (void)size;
+    memcpy(bytes + 96, &huge, sizeof huge);
+}
+static void last_successful_time_after_time(fmi2Byte *bytes, size_t size) {
+    double later = 1.0;
+    (void)size;
+    memcpy(bytes + 104, &later, sizeof later);
+}
+static void payload_time_huge(fmi2Byte *bytes, size_t size) {
+    static const char key[] = "\"time\": 0.125";
+    for (size_t k = 120; k + sizeof key - 1 <= size; k++)
+        if (memcmp(bytes + k, key, sizeof key - 1) == 0) {
+            memcpy(bytes + k + 8, "1e308", 5); /* as long as 0.125: the sizes still agree */
+            return;
+        }
+}
+static int tampered_state_header_time(void) { return deserialize_tampered(header_time_huge); }
+static int tampered_state_last_successful_time(void) { return deserialize_tampered(last_successful_time_after_time); }
+static int tampered_state_payload_time(void) { return deserialize_tampered(payload_time_huge); }
 /* An instance whose solver gives up within 100 s (euler, h = 0.5 s, fast start): the status of the
  * step that failed, and where it failed (t). */
 static int step_until_discard(fmi2Component c, double *t) {
@@ -857,6 +899,56 @@ static int reentrant_logger_frees_during_illegal_call(void) {
     return freed_by_logger == 1 ? s : -2;
 }
 
+/* A logger that frees an FMU state when the FMU's debug line about a state arrives (logAll): the call that
+ * uses the state must not read it afterwards (ASan's session checks that), and must say it was freed. */
+static fmi2Component state_owner;
+static fmi2FMUstate state_to_free;
+static int states_freed_by_logger;
+static void state_freeing_logger(fmi2ComponentEnvironment env, fmi2String instance, fmi2Status status,
+                                 fmi2String category, fmi2String message, ...) {
+    (void)env, (void)instance, (void)category;
+    FORMAT_MESSAGE(text);
+    record_log((int)status, text);
+    if (status == fmi2OK && state_to_free && strstr(text, "FMU state")) {
+        fmi2FMUstate s = state_to_free;
+        state_to_free = NULL;
+        if (fmi2FreeFMUstate_(state_owner, &s) == fmi2OK && !s) states_freed_by_logger++;
+    }
+}
+static const fmi2CallbackFunctions state_freeing_callbacks = {state_freeing_logger, calloc, free, NULL, NULL};
+/* An instance logging everything, stepped to 0.125 s, its state in *state: NULL if it cannot be made. */
+static fmi2Component logging_everything(fmi2FMUstate *state) {
+    fmi2Component c = fmi2Instantiate_("states", fmi2CoSimulation, guid, resources, &state_freeing_callbacks, 0, 1);
+    if (!c) return NULL;
+    fmi2String all[] = {"logAll"};
+    fmi2SetDebugLogging_(c, fmi2True, 1, all);
+    fmi2SetupExperiment_(c, fmi2False, 0.0, 0.0, fmi2False, 0.0);
+    fmi2EnterInitializationMode_(c);
+    fmi2ExitInitializationMode_(c);
+    fmi2DoStep_(c, 0.0, 0.125, fmi2True);
+    *state = NULL;
+    if (fmi2GetFMUstate_(c, state) != fmi2OK) return fmi2FreeInstance_(c), NULL;
+    return c;
+}
+/* The status of `call` on a state the logger frees during it; -2 unless the logger freed it exactly once. */
+#define STATE_FREED_DURING(name, call)                                                                            \
+    static int name(void) {                                                                                       \
+        fmi2FMUstate state;                                                                                       \
+        fmi2Component c = logging_everything(&state);                                                            \
+        if (!c) return -1;                                                                                        \
+        size_t size = 0;                                                                                          \
+        fmi2Byte bytes[64];                                                                                       \
+        (void)size, (void)bytes;                                                                                  \
+        state_owner = c, state_to_free = state, states_freed_by_logger = 0;                                       \
+        int s = call;                                                                                             \
+        state_to_free = NULL;                                                                                     \
+        fmi2FreeInstance_(c);                                                                                     \
+        return states_freed_by_logger == 1 ? s : -2;                                                              \
+    }
+STATE_FREED_DURING(logger_frees_the_state_during_serialized_size, fmi2SerializedFMUstateSize_(c, state, &size))
+STATE_FREED_DURING(logger_frees_the_state_during_get_state, fmi2GetFMUstate_(c, &state))
+STATE_FREED_DURING(logger_frees_the_state_during_set_state, fmi2SetFMUstate_(c, state))
+
 /* ---------------------------------------------------------------------------------- large times */
 
 /* Start time 1e9 s: a doStep half a second off is refused, with both times in full. */
@@ -1162,11 +1254,13 @@ static const struct {
     P(real_status_null_value) P(real_status_unknown_kind) P(status_kind_not_given) P(last_successful_time)
     P(directional_derivative) P(input_derivatives) P(output_derivatives) P(cancel_step) P(null_instance_do_step)
     P(null_instance_set_real) P(null_instance_free) P(freed_instance_used) P(freed_twice)
-    P(fmu_state_restores_the_time) P(serialized_state_in_a_new_instance) P(discarded_step_then_terminate) P(do_step_after_discard)
+    P(fmu_state_restores_the_time) P(serialized_state_in_a_new_instance) P(tampered_state_header_time) P(tampered_state_last_successful_time)
+    P(tampered_state_payload_time) P(discarded_step_then_terminate) P(do_step_after_discard)
     P(locale_unchanged) P(host_state_unchanged) P(stdio_unlocked_after_instantiate)
     OWN(stderr_writable_while_instantiating) P(non_ascii_folder) OWN(foreign_resources)
     OWN(foreign_resources_reverse) P(reentrant_logger_instantiates) P(reentrant_logger_frees_during_set_real)
-    P(reentrant_logger_frees_during_illegal_call) P(large_start_time_wrong_point) P(large_start_time_steps)
+    P(reentrant_logger_frees_during_illegal_call) P(logger_frees_the_state_during_serialized_size)
+    P(logger_frees_the_state_during_get_state) P(logger_frees_the_state_during_set_state) P(large_start_time_wrong_point) P(large_start_time_steps)
     P(tampered_state_payload) P(tampered_state_wrong_type) P(tampered_state_truncated)
     P(tampered_state_truncated_header) P(state_of_another_instance_set) P(state_of_another_instance_free)
     P(state_of_another_instance_size)

@@ -55,11 +55,11 @@ from dataclasses import dataclass
 from pathlib import Path
 
 LOADER_FOLDER = "loader"  # in fmu_src/ (installed as double_pendulum.adapters)
-_SHARED_SOURCES = ("text.c", "platform.c", "python_start.c", "python_runtime.c", "pointer_set.c", "guard.c",
-                   "fmu_state.c", "bridge.c")
+_SHARED_SOURCES = ("text.c", "platform.c", "python_start.c", "python_runtime.c", "pointer_set.c", "guard_base.c",
+                   "guard.c", "fmu_state.c", "bridge.c")
 LOADER_SOURCES = {version: (*_SHARED_SOURCES, f"fmi{version}_guard.c", "identity.c") for version in (2, 3)}
-LOADER_HEADERS = ("text.h", "platform.h", "python_config.h", "python_start.h", "python_runtime.h", "guard.h",
-                  "bridge.h", "identity.h", "glibc_compat.h")
+LOADER_HEADERS = ("text.h", "platform.h", "python_config.h", "python_start.h", "python_runtime.h", "pointer_set.h",
+                  "guard_base.h", "guard.h", "fmu_state.h", "bridge.h", "identity.h", "glibc_compat.h")
 
 
 @dataclass(frozen=True)
