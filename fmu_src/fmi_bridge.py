@@ -6,8 +6,10 @@ stands between them. Every method the loader calls answers ``(status, payload, m
 raises:
 
 * ``status``: FMI's number (0 OK, 1 Warning, 2 Discard, 3 Error), or :data:`INTERRUPTED` when a
-  Ctrl-C (``KeyboardInterrupt``) stopped the call: the loader answers fmi2Error / fmi3Error and
-  raises the interrupt again for a Python host once the call has returned;
+  Ctrl-C (``KeyboardInterrupt``) stopped the call, or :data:`HOST` when another exception of the host's
+  stopped it (:func:`host_exception`: one its signal handler raised, ``SystemExit``, any ``BaseException``
+  that is not an ``Exception``): the loader answers fmi2Error / fmi3Error and raises the interrupt, or the
+  host's own exception object, again in the host's thread once the call has returned;
 * ``payload``: bytes of packed values (``struct``'s native formats, :data:`FORMATS`), UTF-8 strings
   each ended by NUL, or an object (a slave, an FMU state) the loader keeps;
 * ``messages``: what the slave logged during the call, then why it failed, as
@@ -24,10 +26,12 @@ from __future__ import annotations
 import json
 import os
 import struct
+import sys
 from typing import Any
 
 OK, WARNING, DISCARD, ERROR = 0, 1, 2, 3
 INTERRUPTED = 5  # a KeyboardInterrupt stopped the call (loader/bridge.h, BRIDGE_INTERRUPTED)
+HOST = 6  # another exception of the host's stopped it; the payload: its redelivery (bridge.h, BRIDGE_HOST)
 # The FMI types' values as the C side packs them (fmi2Boolean is an int, fmi3Boolean a C bool).
 FORMATS = {
     2: {"Real": "d", "Integer": "i", "Boolean": "i"},
@@ -50,12 +54,69 @@ def describe(error: BaseException) -> str:
     return f"{type(error).__name__}: {text}" if text else type(error).__name__
 
 
+def host_exception(error: BaseException) -> bool:
+    """Whether ``error`` is the host's own, not a failure of the model: a ``BaseException`` that is not an
+    ``Exception`` (``SystemExit``, ``KeyboardInterrupt``, ``GeneratorExit``, ...), or an exception raised by one
+    of the host's Python signal handlers (the ``signal.alarm`` pattern, pytest-timeout's signal method) while the
+    FMU ran: one of its traceback's frames runs a handler's code."""
+    if not isinstance(error, Exception):
+        return True
+    # Python signal handlers exist only where the host imported the signal module: never import it here (its
+    # first import installs CPython's SIGINT handler, which a C host's process must not get from the FMU)
+    _signal = sys.modules.get("_signal")
+    if _signal is None:
+        return False
+    handlers = set()
+    for number in _signal.valid_signals():
+        try:
+            handler = _signal.getsignal(number)
+        except (OSError, ValueError):
+            continue
+        code = getattr(getattr(handler, "__func__", handler), "__code__", None)
+        if code is not None:
+            handlers.add(code)
+    frame = error.__traceback__
+    while frame is not None:
+        if frame.tb_frame.f_code in handlers:
+            return True
+        frame = frame.tb_next
+    return False
+
+
+def redelivery(error: BaseException) -> type:
+    """A class whose call gives back ``error`` itself: what the loader raises again in the host's thread
+    (``PyThreadState_SetAsyncExc`` takes a class, and CPython makes the exception by calling it), so that the
+    host catches its own exception object, with its traceback through the FMU."""
+
+    class HostException(BaseException):
+        def __new__(cls, *args):
+            return error
+
+    return HostException
+
+
+def host_redelivery(error: BaseException) -> type | None:
+    """For an exception that escaped a call before its answer was made (a signal handler runs as a Python function
+    starts, before its ``try``): its redelivery if it is the host's own (:func:`host_exception`), else None. The
+    loader asks it of the object it called (:class:`Bridge`, :class:`Instance`)."""
+    return redelivery(error) if host_exception(error) else None
+
+
+def host_answer(error: BaseException, messages: tuple) -> Answer:
+    """The answer of a call the host's own exception stopped: Error with its line, and its redelivery."""
+    said = (ERROR, "logStatusError", f"the host's own {describe(error)} stopped the call, which was not completed; "
+            "it is raised again in the host, and a reset makes the instance usable again")
+    return HOST, redelivery(error), messages + (said,)
+
+
 def _unpack(code: str, data: bytes) -> list:
     return list(struct.unpack(f"={len(data) // struct.calcsize(code)}{code}", data))
 
 
 class Bridge:
     """What an FMU's entry module exposes as ``fmi_bridge``: its slave class and FMI version."""
+
+    host_redelivery = staticmethod(host_redelivery)
 
     def __init__(self, model_class: type, fmi_version: int) -> None:
         self.model_class = model_class
@@ -70,11 +131,15 @@ class Bridge:
         except KeyboardInterrupt:
             return INTERRUPTED, None, ()  # the loader logs the one text of an interrupt
         except BaseException as error:
+            if host_exception(error):
+                return host_answer(error, ())
             return ERROR, None, ((ERROR, "logStatusError", describe(error)),)
 
 
 class Instance:
     """One FMI instance: its slave, and every call the loader makes on it."""
+
+    host_redelivery = staticmethod(host_redelivery)
 
     def __init__(self, bridge: Bridge, resources: str, name: str, interface: str, visible: bool) -> None:
         self.bridge, self.resources, self.name, self.visible = bridge, resources, name, visible
@@ -98,7 +163,11 @@ class Instance:
         except KeyboardInterrupt:
             return INTERRUPTED, None, self._messages()  # the loader logs the one text of an interrupt
         except BaseException as error:
+            if host_exception(error):
+                return host_answer(error, self._messages())
             return ERROR, None, self._messages((ERROR, "logStatusError", describe(error)))
+
+
 
     def _messages(self, *last: tuple) -> tuple:
         """What the slave logged since the last call, then ``last``."""

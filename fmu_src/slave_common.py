@@ -31,6 +31,8 @@ import zipimport
 from pathlib import Path
 from types import ModuleType
 
+from .fmi_bridge import host_exception
+
 PRESET_FILE = "start_values.json"  # start values baked in by the build (double_pendulum.fmu.presets)
 PRIVATE_MARK = "_dp_fmu_"  # every private module name starts with it
 ADAPTERS_SUFFIX = "_adapters"
@@ -161,6 +163,8 @@ class ComponentMapping:
         try:
             sim.do_step(current_time, step_size)
         except Exception as error:
+            if host_exception(error):  # the host's signal handler, not the solver: no Discard
+                raise
             self.log(f"the step was not completed: {error}", self.discard_status)
             return False
         if sim.notices:

@@ -116,6 +116,85 @@ def test_ctrl_c_is_the_users_keyboard_interrupt_and_a_reset_recovers(unzipped, t
         assert all(re.search(rf"fmi2\w+: {re.escape(said)}$", line) for line in lines), (mode, delay, lines)
 
 
+# ------------------------------------------------------------------------------------ the host's own exceptions
+
+HOST_EXCEPTIONS = SLAVE + textwrap.dedent("""
+    import json, random, signal, sys
+    import pytest
+    folder, guid, kind, trials = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+
+    class HostTimeout(Exception):
+        pass
+
+    raised = []
+    def on_alarm(signum, frame):  # the signal.alarm pattern, and pytest-timeout's signal method (pytest.fail)
+        error = HostTimeout("the host's time is up") if kind == "exception" else None
+        if kind == "exception":
+            raised.append(error)
+            raise error
+        if kind == "exit":
+            sys.exit(7)
+        pytest.fail("Timeout >0.1s")
+
+    signal.signal(signal.SIGALRM, on_alarm)
+    fmu, refs = slave(folder, guid)
+    fmu.instantiate()
+    rng = random.Random(20261207)
+    outcomes = []
+    for trial in range(trials):
+        fmu.reset()
+        fmu.setReal([refs["omega2_0"]], [8.0])  # a fast, chaotic start: the solver works hard inside doStep
+        initialise(fmu, refs)
+        signal.setitimer(signal.ITIMER_REAL, rng.uniform(0.02, 0.25))
+        try:
+            t = 0.0
+            while True:
+                fmu.doStep(currentCommunicationPoint=t, communicationStepSize=0.5)
+                t += 0.5
+        except HostTimeout as error:
+            outcomes.append("HostTimeout, the host's own object" if error is raised[-1] else "a HostTimeout copy")
+        except BaseException as error:
+            if kind == "exit":
+                raise  # the host's sys.exit(7): the process ends with it
+            outcomes.append(f"{type(error).__name__}: {error}")
+        signal.setitimer(signal.ITIMER_REAL, 0)
+    print(json.dumps(outcomes), flush=True)
+""")
+
+
+def host_exception_trials(unzipped, tmp_path: Path, kind: str, trials: int) -> subprocess.CompletedProcess:
+    folder, guid = unzipped
+    return subprocess.run([sys.executable, "-c", HOST_EXCEPTIONS, str(folder), guid, kind, str(trials)],
+                          capture_output=True, text=True, timeout=300, cwd=tmp_path)
+
+
+def test_an_exception_the_hosts_signal_handler_raises_during_dostep_reaches_the_host_every_time(unzipped, tmp_path):
+    """20 trials: a SIGALRM handler raises the host's own HostTimeout (an Exception) 0.02 to 0.25 s into a doStep
+    loop, landing inside the FMU's solver or before its call's try: every one reaches the host as that very object
+    (not FMICallException, not a Discard), the FMU's log line says so, and a reset makes the instance usable."""
+    done = host_exception_trials(unzipped, tmp_path, "exception", 20)
+    assert done.returncode == 0, done.stderr[-3000:]
+    outcomes = json.loads(done.stdout.splitlines()[-1])
+    assert outcomes == ["HostTimeout, the host's own object"] * 20, outcomes
+    lines = [line for line in done.stdout.splitlines() if "HostTimeout" in line and not line.startswith("[")]
+    assert "Traceback" not in done.stderr and "Exception ignored" not in done.stderr, done.stderr[-3000:]
+    said = [line for line in done.stdout.splitlines() if "the host's own HostTimeout" in line]
+    assert said and all("stopped the call, which was not completed; it is raised again in the host" in line
+                        for line in said), (said, lines)
+    assert "the step was not completed" not in done.stdout  # not the solver's Discard
+
+
+def test_pytest_timeouts_signal_method_and_system_exit_from_a_handler_reach_the_host(unzipped, tmp_path):
+    """pytest-timeout's signal method (pytest.fail from a SIGALRM handler: a BaseException) ends the run as
+    pytest's Failed, 5 of 5; a handler's sys.exit(7) ends the host's process with status 7."""
+    done = host_exception_trials(unzipped, tmp_path, "fail", 5)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert json.loads(done.stdout.splitlines()[-1]) == ["Failed: Timeout >0.1s"] * 5
+    exited = host_exception_trials(unzipped, tmp_path, "exit", 1)
+    assert exited.returncode == 7, (exited.stdout[-2000:], exited.stderr[-2000:])
+    assert "Traceback" not in exited.stderr, exited.stderr[-3000:]
+
+
 # ----------------------------------------------------------------------------------------------- exiting
 
 EXITING = SLAVE + textwrap.dedent("""

@@ -65,6 +65,7 @@ typedef struct {
     size_t n, capacity;
     char failure[1024]; /* what went wrong in the bridge itself ("" if nothing) */
     int interrupted;
+    PyObject *host; /* the redelivery of the host's own exception that stopped the call (a reference), or NULL */
 } answer_notes;
 
 static void note_failure(answer_notes *notes, const char *format, ...) __attribute__((format(printf, 2, 3)));
@@ -127,19 +128,52 @@ static void emit_notes(guard_instance *g, answer_notes *notes) {
 
 /* ----------------------------------------------------------------------------- with the GIL */
 
-/* The pending Python exception in words ("ValueError: ..."), cleared; notes a KeyboardInterrupt. */
-static void take_exception(const python_api *py, answer_notes *notes, const char *what) {
+/* Python's Py_BuildValue through the API table. */
+static PyObject *build(const python_api *py, const char *format, ...) {
+    va_list args;
+    va_start(args, format);
+    PyObject *built = py->VaBuildValue(format, args);
+    va_end(args);
+    return built;
+}
+
+/* The redelivery of exception `value` if it is the host's own (target.host_redelivery: fmi_bridge.py), else NULL. */
+static PyObject *host_redelivery(const python_api *py, PyObject *target, PyObject *value) {
+    PyObject *ask = target && value ? py->Object_GetAttrString(target, "host_redelivery") : NULL;
+    PyObject *arguments = ask ? build(py, "(O)", value) : NULL;
+    PyObject *answer = arguments ? py->Object_Call(ask, arguments, NULL) : NULL;
+    if (arguments) py->DecRef(arguments);
+    if (ask) py->DecRef(ask);
+    py->Err_Clear(); /* a failure to ask: the exception is said as the FMU's */
+    if (answer && answer == py->None) py->DecRef(answer), answer = NULL;
+    return answer;
+}
+
+/* The pending Python exception in words ("ValueError: ..."), cleared; notes a KeyboardInterrupt, and the host's own
+ * exception (asked of `target`, NULL: none is) with its redelivery. An exception escapes a call of the Python side
+ * only before its answer is made: a signal handler of the host runs as a Python function starts. */
+static void take_exception(const python_api *py, answer_notes *notes, const char *what, PyObject *target) {
     if (!py->Err_Occurred()) return note_failure(notes, "%s failed without saying why", what);
     PyObject *type = NULL, *value = NULL, *traceback = NULL;
     py->Err_Fetch(&type, &value, &traceback);
+    py->Err_NormalizeException(&type, &value, &traceback);
+    if (value && traceback) py->Exception_SetTraceback(value, traceback);
+    py->Err_Clear();
     PyObject *name = type ? py->Object_GetAttrString(type, "__name__") : NULL;
     PyObject *text = value ? py->Object_Str(value) : NULL;
     const char *name_text = name ? py->Unicode_AsUTF8AndSize(name, NULL) : NULL;
     const char *value_text = text ? py->Unicode_AsUTF8AndSize(text, NULL) : NULL;
     py->Err_Clear(); /* whatever describing it raised */
-    if (name_text && strcmp(name_text, "KeyboardInterrupt") == 0) note_interrupt(notes);
-    else note_failure(notes, "%s raised %s: %s", what, name_text ? name_text : "an exception",
-                      value_text ? value_text : "(no message)");
+    int interrupt = name_text && strcmp(name_text, "KeyboardInterrupt") == 0;
+    PyObject *host = interrupt ? NULL : host_redelivery(py, target, value);
+    if (interrupt) note_interrupt(notes);
+    else if (host) {
+        notes->host = host;
+        note_failure(notes, "the host's own %s%s%s stopped the call, which was not completed; it is raised again in "
+                     "the host, and a reset makes the instance usable again", name_text ? name_text : "exception",
+                     value_text && value_text[0] ? ": " : "", value_text ? value_text : "");
+    } else note_failure(notes, "%s raised %s: %s", what, name_text ? name_text : "an exception",
+                        value_text && value_text[0] ? value_text : "(no message)");
     if (name) py->DecRef(name);
     if (text) py->DecRef(text);
     if (type) py->DecRef(type);
@@ -179,6 +213,12 @@ static int take_answer(const python_api *py, PyObject *answer, bridge_payload pa
     if (n < 0) py->Err_Clear();
     if (status == BRIDGE_INTERRUPTED) {
         note_interrupt(notes);
+        return STATUS_ERROR;
+    }
+    if (status == BRIDGE_HOST) { /* its line is among the messages */
+        PyObject *redelivery = py->Tuple_GetItem(answer, 1);
+        if (redelivery) py->IncRef(redelivery), notes->host = redelivery;
+        else py->Err_Clear();
         return STATUS_ERROR;
     }
     if (status < STATUS_OK || status > STATUS_ERROR) status = STATUS_ERROR;
@@ -227,10 +267,14 @@ static int call_object(guard_instance *g, PyObject *target, bridge_payload paylo
     PyObject *answer = callable ? py->Object_Call(callable, arguments, NULL) : NULL;
     int status = STATUS_ERROR;
     if (answer) status = take_answer(py, answer, payload, &notes, method);
-    else take_exception(py, &notes, method);
+    else take_exception(py, &notes, method, target);
     if (answer) py->DecRef(answer);
     if (callable) py->DecRef(callable);
     if (arguments) py->DecRef(arguments);
+    if (notes.host) { /* the latest one is raised again (a call the logger makes may have stopped one before) */
+        if (g->host_exception) py->DecRef(g->host_exception);
+        g->host_exception = notes.host, status = STATUS_ERROR;
+    }
     py->GILState_Release(gil);
     if (notes.interrupted) {
         g->interrupted = 1; /* raised again for the host when the FMI function returns (guard_deliver_interrupt) */
@@ -284,7 +328,7 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
             if (bridge) py->IncRef(bridge);
         }
     }
-    if (!bridge) take_exception(py, &notes, "loading the FMU's Python code");
+    if (!bridge) take_exception(py, &notes, "loading the FMU's Python code", NULL);
     if (globals) py->Dict_Clear(globals), py->DecRef(globals); /* no cycle through the module's namespace */
     if (code) py->DecRef(code);
     if (entry_text) py->DecRef(entry_text);
@@ -309,4 +353,16 @@ void bridge_release(guard_instance *g, PyObject *object) {
     int gil = g->api->GILState_Ensure();
     g->api->DecRef(object);
     g->api->GILState_Release(gil);
+}
+
+void bridge_deliver_host_exception(guard_instance *g) {
+    PyObject *redelivery = g->host_exception;
+    if (!redelivery) return;
+    g->host_exception = NULL;
+    const python_api *py = g->api;
+    int python_thread = py->GILState_GetThisThreadState() != NULL; /* before Ensure, which makes one */
+    int gil = py->GILState_Ensure();
+    if (python_thread) py->ThreadState_SetAsyncExc(py->Thread_get_thread_ident(), redelivery);
+    py->DecRef(redelivery);
+    py->GILState_Release(gil);
 }

@@ -37,6 +37,9 @@ typedef struct {
 /* Python's statuses beyond FMI's: the call was interrupted (KeyboardInterrupt): an error, and the host's
  * own interrupt is raised again once the call returns (a Python host then sees KeyboardInterrupt). */
 #define BRIDGE_INTERRUPTED 5
+/* Another exception of the host's stopped the call (fmi_bridge.py, host_exception): an error; the answer's payload
+ * is the exception's redelivery, which bridge_deliver_host_exception raises in the host's thread. */
+#define BRIDGE_HOST 6
 /* The one log line of an interrupted call, after the FMI function's name (docs/fmu.md quotes it). */
 #define BRIDGE_INTERRUPTED_TEXT                                                                                   \
     "interrupted (KeyboardInterrupt, Ctrl-C): the call was not completed; a reset makes the instance usable again"
@@ -55,5 +58,10 @@ int bridge_call(guard_instance *g, bridge_payload payload, const char *method, c
 
 /* Release a Python object (an FMU state, an instance) of g's Python. */
 void bridge_release(guard_instance *g, PyObject *object);
+
+/* Raise the host's own exception that stopped a call of g (g->host_exception) again in this thread, where a Python
+ * host runs (a C host has no Python exception to get back: it is dropped). The last thing the outermost FMI call
+ * does, after every message has been logged. */
+void bridge_deliver_host_exception(guard_instance *g);
 
 #endif

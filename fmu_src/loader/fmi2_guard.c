@@ -122,7 +122,7 @@ static void destroy(guard_instance *common) {
 #define BEGIN_MASKED(F, MASK)                                                                                     \
     guarded *g GUARD_CALL = (guarded *)guard_acquire(c, MODEL_IDENTIFIER, "fmi2" #F);                             \
     if (!g) return fmi2Error;                                                                                     \
-    guard_scope scope GUARD_SCOPE = {&g->common, g->common.function};                                             \
+    guard_scope scope GUARD_SCOPE = guard_scope_begin(&g->common);                                                \
     (void)scope;                                                                                                  \
     g->common.function = "fmi2" #F;                                                                               \
     if (!(g->common.at.state & (MASK)))                                                                           \

@@ -136,7 +136,7 @@ enum { ME = 1, CS = 2, BOTH = 3 };
 #define BEGIN_FOR(F, MASK, INTERFACE)                                                                             \
     guarded *g GUARD_CALL = (guarded *)guard_acquire(instance, MODEL_IDENTIFIER, "fmi3" #F);                      \
     if (!g) return fmi3Error;                                                                                     \
-    guard_scope scope GUARD_SCOPE = {&g->common, g->common.function};                                             \
+    guard_scope scope GUARD_SCOPE = guard_scope_begin(&g->common);                                                \
     (void)scope;                                                                                                  \
     g->common.function = "fmi3" #F;                                                                               \
     if (!((g->model_exchange ? ME : CS) & (INTERFACE)))                                                           \

@@ -59,8 +59,16 @@ void guard_release(guard_instance *g) {
     if (last) g->destroy(g);
 }
 
+guard_scope guard_scope_begin(guard_instance *g) {
+    g->depth++;
+    return (guard_scope){g, g->function};
+}
+
 void guard_scope_end(guard_scope *scope) {
-    if (scope->g) scope->g->function = scope->function;
+    guard_instance *g = scope->g;
+    if (!g) return;
+    g->function = scope->function;
+    if (--g->depth == 0 && g->host_exception) bridge_deliver_host_exception(g);
 }
 
 void guard_release_variable(void *variable) {
@@ -95,6 +103,7 @@ void guard_free_common(guard_instance *g) {
     while (g->states) guard_free_state(g, (void **)&(void *){g->states}); /* the ones the host did not free */
     if (g->python) bridge_call(g, NO_PAYLOAD, "release", "()"), bridge_release(g, g->python);
     if (g->python) guard_deliver_interrupt(g);
+    if (g->host_exception) bridge_release(g, g->host_exception), g->host_exception = NULL; /* never delivered */
     g->python = NULL;
     free(g->name);
     free(g->strings);
@@ -185,8 +194,10 @@ int guard_start_python(guard_instance *g, const char *resources, int visible) {
     int status = bridge_instantiate(g, py, resources, id.archive, id.package, id.entry, g->interface, visible, &python);
     if (status > STATUS_WARNING || !python) {
         if (python) bridge_release(g, python);
-        return guard_fail(g, "%s: the FMU's Python side could not be instantiated (the message before says why)",
-                          g->function), 0;
+        guard_fail(g, "%s: the FMU's Python side could not be instantiated (the message before says why)",
+                   g->function);
+        bridge_deliver_host_exception(g); /* the host's own exception that stopped it, after every line */
+        return 0;
     }
     g->python = python;
     return 1;

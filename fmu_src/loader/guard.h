@@ -29,12 +29,15 @@ void guard_release(guard_instance *g);
 /* For __attribute__((cleanup)): release the instance a variable holds (if any) when it goes out of scope. */
 void guard_release_variable(void *variable);
 #define GUARD_CALL __attribute__((cleanup(guard_release_variable)))
-/* The FMI function an instance is in, given back when a call ends: a call the host's logger makes from inside
- * another (fmi2FreeFMUstate during fmi2GetFMUstate) leaves the outer call's name for its later log lines. */
+/* An FMI call of an instance, from its start (guard_scope_begin, after guard_acquire) to its end: the function it
+ * is in is given back when it ends, so that a call the host's logger makes from inside another (fmi2FreeFMUstate
+ * during fmi2GetFMUstate) leaves the outer call's name for its later lines; and when the outermost call ends,
+ * the host's own exception that stopped it is raised again (bridge_deliver_host_exception). */
 typedef struct {
     guard_instance *g;
     const char *function;
 } guard_scope;
+guard_scope guard_scope_begin(guard_instance *g);
 void guard_scope_end(guard_scope *scope);
 #define GUARD_SCOPE __attribute__((cleanup(guard_scope_end)))
 

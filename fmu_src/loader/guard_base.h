@@ -57,6 +57,9 @@ struct guard_instance {
     const python_api *api; /* the process's Python */
     PyObject *python;      /* the instance's Python object (fmu_src/fmi_bridge.py) */
     int interrupted;       /* a Ctrl-C stopped a call: raised again for the host when the FMI function returns */
+    PyObject *host_exception; /* another exception of the host's stopped a call: its redelivery (fmi_bridge.py), raised
+                               * again in the host's thread when the outermost FMI call of the instance returns */
+    int depth;             /* FMI calls of the instance in progress (the host's logger may call in: nested) */
     char *strings;         /* the values of the last get of Strings (valid until the next one) */
     /* give one message to the host's logger, or stderr if it has none */
     void (*log)(guard_instance *g, int status, const char *category, const char *message);

@@ -361,6 +361,12 @@ static int resolve_api(void *library, char *error, size_t error_size) {
     RESOLVE(Err_Fetch, "PyErr_Fetch")
     RESOLVE(Err_Clear, "PyErr_Clear")
     RESOLVE(Err_SetInterrupt, "PyErr_SetInterrupt")
+    RESOLVE(Err_NormalizeException, "PyErr_NormalizeException")
+    RESOLVE(Exception_SetTraceback, "PyException_SetTraceback")
+    RESOLVE(GILState_GetThisThreadState, "PyGILState_GetThisThreadState")
+    RESOLVE(Thread_get_thread_ident, "PyThread_get_thread_ident")
+    RESOLVE(ThreadState_SetAsyncExc, "PyThreadState_SetAsyncExc")
+    RESOLVE(None, "_Py_NoneStruct")
 #undef RESOLVE
     /* '#' formats take a Py_ssize_t length: the _SizeT variant where it still exists (3.11, 3.12) */
     *(void **)&api.VaBuildValue = platform_symbol(library, "_Py_VaBuildValue_SizeT");

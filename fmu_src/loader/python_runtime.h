@@ -63,6 +63,12 @@ typedef struct {
     void (*Err_Fetch)(PyObject **, PyObject **, PyObject **);
     void (*Err_Clear)(void);
     void (*Err_SetInterrupt)(void);
+    void (*Err_NormalizeException)(PyObject **, PyObject **, PyObject **);
+    int (*Exception_SetTraceback)(PyObject *, PyObject *);
+    void *(*GILState_GetThisThreadState)(void); /* a PyThreadState *, NULL in a thread Python does not know */
+    unsigned long (*Thread_get_thread_ident)(void);
+    int (*ThreadState_SetAsyncExc)(unsigned long, PyObject *);
+    PyObject *None; /* Py_None (_Py_NoneStruct) */
 } python_api;
 
 /* Make a CPython available (see above) and return its C API; `resources` is the FMU's resources folder
