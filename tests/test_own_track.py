@@ -25,7 +25,7 @@ from double_pendulum.analysis.losses.fitting import fit_models, problem_from_tra
 from double_pendulum.analysis.losses.identification import measured
 from double_pendulum.analysis.track.measurement import load_track
 from double_pendulum.analysis.track.synthetic import MadeTrack, write_pendulum, write_track
-from double_pendulum.analysis.track.user_track import read_record, read_track
+from double_pendulum.analysis.track.user_track import TrackFileError, parse_columns, read_record, read_track
 from double_pendulum.cli import main
 
 PENDULUM = {"m1": 0.25, "m2": 0.20, "l1": 0.30, "l2": 0.22}
@@ -246,3 +246,17 @@ def test_a_bad_pendulum_or_option_is_one_line_and_nothing_is_written(case, recor
     assert code == 2 and err.count("\n") == 1 and err.startswith("double-pendulum: error: "), err
     assert expected in err, err
     assert not out.exists()
+
+
+def test_a_tracker_export_with_its_two_header_rows_reads_by_position(records, tmp_path):
+    """Tracker's export of two point masses: their names in a row above ``t,x,y,x,y``; the names repeat, so the
+    columns are given by position. The same track as the file it was made from."""
+    rows = (records / "my_track.csv").read_text().splitlines()[1:]
+    lines = [",mass A,,mass B,", "t,x,y,x,y", *(",".join(r.split(",")[1:]) for r in rows)]
+    (tmp_path / "tracker.csv").write_text("\n".join(lines) + "\n")
+    tracker = read_track(tmp_path / "tracker.csv", columns=parse_columns("t=1,x1=2,y1=3,x2=4,y2=5")).track
+    plain = read_track(records / "my_track.csv").track
+    for k in ("t", "x1", "y1", "x2", "y2", "valid"):
+        assert np.array_equal(getattr(tracker, k), getattr(plain, k)), k
+    with pytest.raises(TrackFileError, match=r"column 'x' \(x1\) appears more than once \(give its position"):
+        read_track(tmp_path / "tracker.csv", columns=parse_columns("t=t,x1=x"))
