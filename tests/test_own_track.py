@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -22,7 +23,7 @@ from double_pendulum.analysis.decay.fit import fit_model
 from double_pendulum.analysis.losses import claims
 from double_pendulum.analysis.losses.comparison import common_factor, comparison_rows
 from double_pendulum.analysis.losses.fitting import fit_models, problem_from_track
-from double_pendulum.analysis.losses.identification import measured
+from double_pendulum.analysis.losses.identification import measured, seed_reconstruction
 from double_pendulum.analysis.track.measurement import load_track
 from double_pendulum.analysis.track.synthetic import MadeTrack, write_pendulum, write_track
 from double_pendulum.analysis.track.user_track import TrackFileError, parse_columns, read_record, read_track
@@ -148,6 +149,10 @@ def test_the_loss_model_that_made_the_track_is_among_those_that_fit(records):
     assert abs(b_v["value"] - B_V) < 3 * b_v["stderr"], b_v
     assert set(supported) == {"viscous"}  # the others miss by far: delta AIC above 10
     assert min(r["delta_aic"] for r in rows if r["model"] != "viscous") > 10
+    # the fits' cache (runs.result_cache) keys on the record: its energies and its frame interval
+    seed_rec = seed_reconstruction()
+    assert problem.digest() != problem_from_track(seed_rec, measured(seed_rec), quick=True).digest()
+    assert replace(problem, dt=0.04).digest() != problem.digest()
 
 
 def test_the_seed_table_read_as_a_users_track_is_the_seeds_track():
