@@ -196,6 +196,15 @@ def _round_times(lines: list[str]) -> list[str]:
     return out
 
 
+def _y_down(lines: list[str]) -> list[str]:
+    out = lines[:1]
+    for line in lines[1:]:
+        cells = line.split(",")
+        cells[3], cells[5] = (f"{-float(cells[k]):.4f}" for k in (3, 5))  # image coordinates: y down
+        out.append(",".join(cells))
+    return out
+
+
 BAD_TRACKS = {
     "missing column": (lambda ls: [ls[0].replace("x2_m", "x2"), *ls[1:]],
                        "column 'x2_m' (x2) is missing; columns present: frame, t_s, x1_m, y1_m, x2, y2_m"),
@@ -203,6 +212,7 @@ BAD_TRACKS = {
     "too many lost frames": (_blank_lower_bob, "90 of 600 frames lack a bob's position"),
     "too few frames": (lambda ls: ls[:60], "59 frames over 1.94 s; at least 100 frames over 8 s are needed"),
     "not a rigid rod": (_swap_lower_bob_axes, "the distance between the bobs scatters by"),
+    "y pointing down": (_y_down, "the upper bob is above the fitted pivot in 100% of the frames: y points down"),
     "uneven times": (_round_times, "the time steps are uneven: 0.03 to 0.04 s"),
     "not a number": (lambda ls: [*ls[:5], ",".join([*ls[5].split(",")[:2], "abc", *ls[5].split(",")[3:]]), *ls[6:]],
                      "row 6: x1_m = 'abc' is not a number"),

@@ -1,7 +1,7 @@
 r"""A user's own record: their camera track (CSV) and their pendulum (TOML), checked and read into a :class:`Track`.
 
-**The track file** is a CSV file with a header row: the time and both bobs' x and y (y up or down: the angles are
-taken from the fitted pivot, so only the sense of rotation changes). By default the seed table's names
+**The track file** is a CSV file with a header row: the time and both bobs' x and y, y pointing up (the angles
+are measured from the downward vertical). By default the seed table's names
 (:data:`DEFAULT_COLUMNS`: ``t_s, x1_m, y1_m, x2_m, y2_m``; a ``frame`` column may be there and is not needed), or
 the user's names given as ``t=time,x1=xA,y1=yA,x2=xB,y2=yB`` (:func:`parse_columns`), where a whole number is a
 column's position (1 = the first), for a file whose names repeat (Tracker's ``t,x,y,x,y``). Rows above the header
@@ -23,7 +23,8 @@ cells are numbers; the time increases; the steps are even; at least :data:`MIN_F
 record, the loss fits start from a state fitted to 10 frames after the release); each bob stays at a near-constant
 distance: the robust scatter (1.4826 MAD) of the upper bob's distance from the fitted pivot and of the distance
 between the bobs at most :data:`MAX_LENGTH_SPREAD` of that distance (rigid rods: the seed's record 0.2 % and 2 %);
-at most :data:`MAX_FLAGGED_FRACTION` of the frames flagged.
+at most :data:`MAX_FLAGGED_FRACTION` of the frames flagged; the upper bob below the pivot in most frames (else y
+points down, as in image coordinates).
 
 **The pendulum file** (TOML, :func:`read_pendulum`) holds the fields of
 :class:`~double_pendulum.model.parameters.PendulumParameters` that are known: the masses ``m1``, ``m2`` [kg] are
@@ -252,13 +253,18 @@ def read_track(path: str | Path, *, columns: Mapping[str, str | int] | None = No
 
 def _check_rigid(path: Path, x1: np.ndarray, y1: np.ndarray, x2: np.ndarray, y2: np.ndarray,
                  valid: np.ndarray) -> None:  # fmt: skip
-    """Raise if a bob's distance (from the fitted pivot, from the other bob) scatters beyond
-    :data:`MAX_LENGTH_SPREAD` (module docstring)."""
+    """Raise if the upper bob is above the pivot in most frames (y down) or a bob's distance (from the fitted pivot,
+    from the other bob) scatters beyond :data:`MAX_LENGTH_SPREAD` (module docstring)."""
     finite = np.isfinite(x1) & np.isfinite(y1) & np.isfinite(x2) & np.isfinite(y2)
     use = valid if valid.sum() >= 4 else finite
     geo = fit_geometry(Track(np.arange(len(x1)), np.arange(len(x1)), x1, y1, x2, y2, use))
     r1 = np.hypot(x1[finite] - geo.pivot.xc, y1[finite] - geo.pivot.yc)
     r2 = np.hypot(x2[finite] - x1[finite], y2[finite] - y1[finite])
+    above = float(np.mean(y1[finite] > geo.pivot.yc))
+    if above > 0.5:
+        raise TrackFileError(f"{path}: the upper bob is above the fitted pivot in {above:.0%} of the frames: y points "
+                             "down (image coordinates?); give y pointing up (Tracker's default axes) or negate y1 "
+                             "and y2")
     for what, r in (("the upper bob's distance from the fitted pivot", r1), ("the distance between the bobs", r2)):
         median, spread = float(np.median(r)), robust_sigma(r)
         if not spread <= MAX_LENGTH_SPREAD * median:
