@@ -42,12 +42,13 @@ SEED_FIGURES = ("0.0252", "0.301", "0.297", "0.813", "-0.024 ", "Table 1", "seed
 
 
 @pytest.fixture(scope="session")
-def records(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """The records, made once: ``my_track.csv`` (seed's column names, metres, 29.97 fps) with ``my_pendulum.toml``
-    (the masses); ``cm_track.csv`` (renamed columns, cm to 0.1 mm, 25 fps, three frames without the lower bob, the
-    pivot far from the origin) with ``cm_pendulum.toml`` (the masses and l1)."""
+def records(tmp_path_factory: pytest.TempPathFactory, runner) -> Path:
+    """The records, made once: ``my_track.csv`` (made by the FMU through fmpy; seed's column names, metres,
+    29.97 fps) with ``my_pendulum.toml`` (the masses); ``cm_track.csv`` (made by the FMU's component in this process;
+    renamed columns, cm to 0.1 mm, 25 fps, three frames without the lower bob, the pivot far from the origin) with
+    ``cm_pendulum.toml`` (the masses and l1)."""
     folder = tmp_path_factory.mktemp("own_track")
-    write_track(folder / "my_track.csv", MADE.positions(), frame_column=True)
+    write_track(folder / "my_track.csv", MADE.positions(runner), frame_column=True)
     write_pendulum(folder / "my_pendulum.toml", {"m1": PENDULUM["m1"], "m2": PENDULUM["m2"]})
     table = AT_25_FPS.positions()
     table[[100, 101, 300], 3:5] = np.nan  # the tracker lost the lower bob
