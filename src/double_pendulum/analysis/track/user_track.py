@@ -157,9 +157,9 @@ def _read_table(path: Path, columns: Mapping[str, str | int]) -> tuple[dict[str,
     for line, row in enumerate(rows[first:], start=first + 1):
         values = _numbers(row, index)
         if values is None:
-            bad = next(names[k] for k, i in zip(columns, index) if not _is_number(row[i] if i < len(row) else ""))
-            raise TrackFileError(f"{path}: row {line}: {bad} = {row[index[list(names.values()).index(bad)]]!r} is "
-                                 "not a number (decimal point, comma between columns)")
+            key, i = next((k, i) for k, i in zip(names, index) if not _is_number(row[i] if i < len(row) else ""))
+            raise TrackFileError(f"{path}: row {line}: {names[key]} = {row[i]!r} is not a number (decimal point, "
+                                 "comma between columns)")
         data.append(values)
     return names, np.array(data, dtype=float).reshape(-1, 5), first + 1
 
@@ -184,8 +184,7 @@ def _frame_numbers(path: Path, t: np.ndarray, first_line: int, fps: float | None
     if len(bad):
         i = int(bad[0])
         raise TrackFileError(f"{path}: the time does not increase at row {first_line + i + 1} "
-                             f"(t = {t[i + 1]:g} s after "
-                             f"{t[i]:g} s)")
+                             f"(t = {t[i + 1]:g} s after {t[i]:g} s)")
     if fps is not None:
         dt, source = 1.0 / fps, f"given: {fps:g} fps"
         n = np.rint((t - t[0]) / dt)
