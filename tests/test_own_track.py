@@ -240,6 +240,8 @@ BAD_RUNS = {
                       "invalid m1 = -0.3 kg: must be > 0"),
     "unknown key": (["--pendulum", "{folder}/bad.toml"], "m1 = 0.3\nm2 = 0.2\nmass3 = 1\n", "unknown key(s) mass3"),
     "no pendulum": ([], "", "--track needs --pendulum FILE.toml"),
+    "a length in cm": (["--pendulum", "{folder}/bad.toml"], "m1 = 0.3\nm2 = 0.2\nl1 = 30\n",
+                       "l1 = 30 m, but the track gives 0.3"),
     "a scenario without a track": (["--pendulum", "{folder}/bad.toml", "chaos"], "m1 = 0.3\nm2 = 0.2\n",
                                    "--track: chaos does not analyse a camera track"),
     "measured_vs_sim": (["--pendulum", "{folder}/bad.toml", "measured_vs_sim"], "m1 = 0.3\nm2 = 0.2\n",

@@ -63,6 +63,9 @@ MAX_FLAGGED_FRACTION = 0.2
 """Largest share of frames flagged as tracker jumps or missing."""
 MAX_LENGTH_SPREAD = 0.05
 """Largest robust scatter of a rod's length from frame to frame, relative to the length."""
+MAX_LENGTH_MISMATCH = 0.2
+"""Largest relative difference between a length the pendulum file gives and the track's (the markers may sit off
+the bobs' centres of mass, by far less than this)."""
 PENDULUM_FIELDS = ("m1", "m2", "l1", "l2", "g", "m_rod1", "m_rod2", "L_rod1", "L_rod2")
 """The keys a pendulum file may hold (fields of :class:`PendulumParameters`); ``m1``, ``m2`` required."""
 
@@ -365,5 +368,14 @@ class UserRecord:
 
 def read_record(track: str | Path, pendulum: str | Path, *, columns: str | None = None, scale: float = 1.0,
                 fps: float | None = None) -> UserRecord:  # fmt: skip
-    """Read and check a user's track and pendulum file (:func:`read_track`, :func:`read_pendulum`)."""
-    return UserRecord(read_track(track, columns=parse_columns(columns), scale=scale, fps=fps), read_pendulum(pendulum))
+    """Read and check a user's track and pendulum file (:func:`read_track`, :func:`read_pendulum`); a length the
+    pendulum file gives must be within :data:`MAX_LENGTH_MISMATCH` of the track's (else a unit or a rod is wrong)."""
+    record = UserRecord(read_track(track, columns=parse_columns(columns), scale=scale, fps=fps),
+                        read_pendulum(pendulum))  # fmt: skip
+    fitted = record.fitted_lengths()
+    for k, given in record.pendulum.lengths.items():
+        if abs(given - fitted[k]) > MAX_LENGTH_MISMATCH * fitted[k]:
+            raise TrackFileError(f"{record.pendulum.path}: {k} = {given:g} m, but the track gives {fitted[k]:.4f} m; "
+                                 f"they must agree within {MAX_LENGTH_MISMATCH:.0%} (a length in m, the track's "
+                                 "scale right?)")
+    return record
