@@ -215,6 +215,8 @@ BAD_TRACKS = {
     "not a rigid rod": (_swap_lower_bob_axes, "the distance between the bobs scatters by"),
     "y pointing down": (_y_down, "the upper bob is above the fitted pivot in 100% of the frames: y points down"),
     "uneven times": (_round_times, "the time steps are uneven: 0.03 to 0.04 s"),
+    "semicolons": (lambda ls: [line.replace(",", ";") for line in ls],
+                   "its columns are separated by semicolons; export with commas"),
     "not a number": (lambda ls: [*ls[:5], ",".join([*ls[5].split(",")[:2], "abc", *ls[5].split(",")[3:]]), *ls[6:]],
                      "row 6: x1_m = 'abc' is not a number"),
 }
@@ -246,6 +248,9 @@ BAD_RUNS = {
                                    "--track: chaos does not analyse a camera track"),
     "measured_vs_sim": (["--pendulum", "{folder}/bad.toml", "measured_vs_sim"], "m1 = 0.3\nm2 = 0.2\n",
                         "measured_vs_sim does not take --track yet"),
+    "all": (["--pendulum", "{folder}/bad.toml", "all"], "m1 = 0.3\nm2 = 0.2\n",
+            "--track: 'all' runs every scenario; the ones that analyse a camera track: energy_decay, "
+            "loss_identification"),
     "columns without a track": (["--no-track", "--columns", "t=time"], "", "--columns describe(s) your own track"),
 }
 
@@ -255,7 +260,7 @@ def test_a_bad_pendulum_or_option_is_one_line_and_nothing_is_written(case, recor
     extra, toml, expected = BAD_RUNS[case]
     (tmp_path / "bad.toml").write_text(toml)
     extra = [a.format(folder=tmp_path) for a in extra]
-    scenarios = [a for a in extra if a in ("chaos", "measured_vs_sim")] or ["energy_decay"]
+    scenarios = [a for a in extra if a in ("chaos", "measured_vs_sim", "all")] or ["energy_decay"]
     options = [a for a in extra if a not in scenarios and a != "--no-track"]
     track = [] if "--no-track" in extra else ["--track", str(records / "my_track.csv")]
     out = tmp_path / "results"

@@ -47,6 +47,9 @@ def read_record(args: argparse.Namespace, names: tuple[str, ...]) -> Any:
         if extra:
             raise CliError(f"{', '.join(extra)} describe(s) your own track: give it with --track FILE.csv")
         return None
+    if "all" in args.scenarios:
+        raise CliError(f"--track: 'all' runs every scenario; the ones that analyse a camera track: "
+                       f"{', '.join(TRACK_SCENARIOS)}")
     for name in names:
         if name in NOT_YET:
             raise CliError(NOT_YET[name])

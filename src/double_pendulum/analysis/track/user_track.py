@@ -140,7 +140,11 @@ def _read_table(path: Path, columns: Mapping[str, str | int]) -> tuple[dict[str,
     numeric = [all(_is_number(c) for c in r if c.strip()) and sum(1 for c in r if c.strip()) >= 3 for r in rows]
     first = next((i for i, n in enumerate(numeric) if n), None)
     if first is None or first == 0:
-        raise TrackFileError(f"{path}: needs a header row of column names above rows of numbers (comma-separated)")
+        text = "".join("".join(r) for r in rows[:5])
+        other = next((name for sep, name in ((";", "semicolons"), ("\t", "tabs")) if sep in text), None)
+        raise TrackFileError(f"{path}: " + (f"its columns are separated by {other}; export with commas (and a decimal "
+                                            "point)" if other else "needs a header row of column names above rows of "
+                                            "numbers, separated by commas"))
     header = [h.strip() for h in rows[first - 1]]
     index, names = [], {}
     for key, col in columns.items():
