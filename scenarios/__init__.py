@@ -249,7 +249,18 @@ ANIMATIONS: dict[str, tuple[Animation, ...]] = {
 (:class:`~double_pendulum.runs.player.Animation`), with play, pause, step, speed and a time slider."""
 
 
-def page(name: str, description: str) -> ScenarioPage:
-    """What the run's page shows of scenario ``name`` (``description``: its one line)."""
+OWN_RECORD_DESCRIPTIONS: dict[str, str] = {
+    "energy_decay": "energy decay of your pendulum from your camera track {record}, decay models compared",
+    "loss_identification": "loss mechanisms of your pendulum identified from its measured energy in {record} "
+                           "(AIC/BIC, shares)",
+}
+"""The one line of a scenario that ran on a user's own record (``run --track``), in place of its description."""
+
+
+def page(name: str, description: str, record: str = "") -> ScenarioPage:
+    """What the run's page shows of scenario ``name`` (``description``: its one line; ``record``: the file name of a
+    user's own track it analysed, "" for the seed's)."""
+    if record and name in OWN_RECORD_DESCRIPTIONS:
+        description = OWN_RECORD_DESCRIPTIONS[name].format(record=record)
     return ScenarioPage(name, description, HEADLINES.get(name, ()), FIGURES.get(name, ()),
                         conclusion=CONCLUSIONS.get(name, ""), animations=ANIMATIONS.get(name, ()))

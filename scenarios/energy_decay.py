@@ -17,6 +17,11 @@ section 4.2, with the package's own energy function. Outputs in ``results/energy
   against the energy; :mod:`double_pendulum.analysis.decay.stationarity`);
 - ``report.md``: the figures and why they differ from the seed's a = 0.813 J, b = -0.024 1/s.
 
+With a user's own record (``double-pendulum run energy_decay --track FILE.csv --pendulum FILE.toml``,
+:mod:`double_pendulum.analysis.track.user_track`) the same analysis runs on it: its summary names the record
+(``record``), holds no seed numbers, and its report is
+:func:`~double_pendulum.analysis.decay.own_report.own_report_text`.
+
 The runner argument of :func:`run` is not used, nor is ``quick`` (the analysis takes about a second).
 """
 
@@ -37,6 +42,7 @@ from double_pendulum.analysis.decay.fit import (
     fit_all,
     record_correlation_factor,
 )
+from double_pendulum.analysis.decay.own_report import own_report_text
 from double_pendulum.analysis.decay.report import report_text
 from double_pendulum.analysis.decay.summary import (
     TRACK_CSV_UNITS,
@@ -52,6 +58,7 @@ from double_pendulum.analysis.decay.summary import (
     weighting_variants,
 )
 from double_pendulum.analysis.track.measurement import SEED_TOTAL_MASS_KG, Reconstruction, load_track, reconstruct
+from double_pendulum.analysis.track.user_track import UserRecord
 from double_pendulum.runs.results_io import write_json, write_results_csv, write_text
 
 __all__ = ["DESCRIPTION", "SEED_FIT", "SEED_TOTAL_MASS_KG", "report_text", "run"]
@@ -60,10 +67,11 @@ __all__ = ["DESCRIPTION", "SEED_FIT", "SEED_TOTAL_MASS_KG", "report_text", "run"
 DESCRIPTION = "energy decay of the real pendulum from the seed's camera track (Table 1), decay models compared"
 
 
-def _plots(rec: Reconstruction, m: np.ndarray, sigma: np.ndarray, fits: list[FitResult], out_dir: Path) -> None:
-    """``energy_decay.png`` (energy with errors ``sigma`` on the fitted frames ``m``, fitted curves) and
-    ``circle_fit.png``."""
-    t_curve, curves, best_label = decay_curves(fits, float(rec.t[-1]))
+def _plots(rec: Reconstruction, m: np.ndarray, sigma: np.ndarray, fits: list[FitResult], out_dir: Path,
+           seed: bool = True) -> None:  # fmt: skip
+    """``energy_decay.png`` (energy with errors ``sigma`` on the fitted frames ``m``, fitted curves; the seed's
+    curve on the seed's record) and ``circle_fit.png``."""
+    t_curve, curves, best_label = decay_curves(fits, float(rec.t[-1]), seed)
     plots.plot_energy_decay(
         rec.t,
         rec.energy,
@@ -80,10 +88,12 @@ def _plots(rec: Reconstruction, m: np.ndarray, sigma: np.ndarray, fits: list[Fit
     )
 
 
-def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
-    """Analyse the seed's track and write CSV, plots, summary and report (``runner``, ``quick`` unused)."""
+def run(runner: Any, out_dir: Path, *, quick: bool = False, record: UserRecord | None = None) -> dict:
+    """Analyse the seed's track, or a user's ``record`` (:mod:`double_pendulum.analysis.track.user_track`: no
+    comparison with the seed), and write CSV, plots, summary and report (``runner``, ``quick`` unused)."""
     out_dir = Path(out_dir)
-    rec = reconstruct(load_track())
+    seed = record is None
+    rec = reconstruct(load_track()) if seed else record.reconstruction()
     m = rec.free_motion
     t, e = rec.t[m], rec.energy[m]
     errors = calibrate_error_model(t, e, rec.sigma_energy[m], rec.momentum[m])
@@ -93,7 +103,8 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
     exp_fit = next(f for f in fits if f.model == "exponential")
     summary: dict[str, Any] = {
         "scenario": "energy_decay",
-        "source": "seed Table 1 (data/seed_table1.csv)",
+        "source": "seed Table 1 (data/seed_table1.csv)" if seed else f"{record.name}: a user's own record",
+        **({} if seed else {"record": record.describe()}),
         "n_frames": len(rec.t),
         "n_flagged": int(np.count_nonzero(~rec.track.valid)),
         "release_frame": rec.release_frame,
@@ -101,19 +112,20 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False) -> dict:
         "n_fit": int(np.count_nonzero(m)),
         "masses_kg": {"m1": rec.params.m1, "m2": rec.params.m2},
         **geometry_summary(rec),
-        "derivative_filters": filter_summary(),
-        "error_model": error_model_summary(rec, m, errors),
+        **({} if seed else {"lengths_fitted_m": record.fitted_lengths()}),
+        "derivative_filters": filter_summary(dt=rec.track.dt),
+        "error_model": {k: v for k, v in error_model_summary(rec, m, errors).items() if seed or "seed" not in k},
         "scatter": scatter_summary(rec, m, exp_fit),
         **main,
         "model_comparison": comparison_table(fits),
         "weighting_variants": weighting_variants(rec, m),
-        "seed": seed_comparison(main),
+        **({"seed": seed_comparison(main)} if seed else {}),
         "null_means": {"chi2_red": "not defined for this fit: its errors are relative weights (scaled to the "
                                    "scatter), not absolute errors"},
-        "error_budget": error_budget(rec, errors.sigma),
+        "error_budget": error_budget(rec, errors.sigma, seed=seed),
     }
     write_results_csv(out_dir / "track.csv", track_table(rec, on_all_frames(errors.sigma, m)), TRACK_CSV_UNITS)
-    _plots(rec, m, errors.sigma, fits, out_dir)
+    _plots(rec, m, errors.sigma, fits, out_dir, seed)
     write_json(out_dir / "summary.json", summary)
-    write_text(out_dir / "report.md", report_text(summary))
+    write_text(out_dir / "report.md", report_text(summary) if seed else own_report_text(summary))
     return summary

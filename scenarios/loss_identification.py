@@ -30,6 +30,10 @@ their parent's optimum, so they change no figure of the default run, and the pro
 the curvature errors). ``quick``: air+drag alone in this process, one Gauss-Newton step (6 runs) at
 rtol 1e-5, no comparison, no profile likelihood (a smoke run; the fit is the one ``measured_vs_sim``
 reads from the cache).
+
+With a user's own record (``--track FILE.csv --pendulum FILE.toml``, :mod:`double_pendulum.analysis.track.user_track`)
+the same identification runs on it, without the seed's friction estimates, and the report is
+:func:`~double_pendulum.analysis.losses.own_report.own_report_text`.
 """
 
 from __future__ import annotations
@@ -41,16 +45,21 @@ from double_pendulum import plots
 from double_pendulum.analysis.losses.claims import SUPPORTED_DAIC
 from double_pendulum.analysis.losses.identification import identify_losses
 from double_pendulum.analysis.losses.mechanisms import model_title, parameters_of
+from double_pendulum.analysis.losses.own_report import own_report_text
 from double_pendulum.analysis.losses.report import report_text
+from double_pendulum.analysis.track.user_track import UserRecord
 from double_pendulum.runs.results_io import table_from_columns, write_json, write_results_csv, write_text
 
 DESCRIPTION = "loss mechanisms of the real pendulum identified from its measured energy (AIC/BIC, shares)"
 
 
-def run(runner: Any, out_dir: Path, *, quick: bool = False, thorough: bool = False) -> dict:
-    """Identify the losses, run the best model through the FMU and write CSV, plots, summary, report."""
+def run(runner: Any, out_dir: Path, *, quick: bool = False, thorough: bool = False,
+        record: UserRecord | None = None) -> dict:  # fmt: skip
+    """Identify the losses of the seed's record, or of a user's ``record``
+    (:mod:`double_pendulum.analysis.track.user_track`: no comparison with the seed), run the best model through the
+    FMU and write CSV, plots, summary, report."""
     out_dir = Path(out_dir)
-    ident = identify_losses(runner, quick=quick, thorough=thorough)
+    ident = identify_losses(runner, quick=quick, thorough=thorough, record=record)
     s = ident.summary
     table = table_from_columns(t=ident.t, E_measured=ident.e_measured, sigma_E=ident.sigma,
                                E_simulated=ident.e_sim, **ident.works)  # fmt: skip
@@ -59,7 +68,10 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False, thorough: bool = Fal
     best = s["top_model"]
     tied = len(s["supported_models"]["models"]) if s["supported_models"] else 1
     label = model_title(best) + (f" (the lowest AIC of {tied} models that tie)" if tied > 1 else "")
-    plots.plot_energy_fit(ident.t, ident.e_measured, ident.sigma, ident.e_sim, label, out_dir / "energy_fit.png")
+    whose = {} if record is None else {"whose": f"the pendulum of {record.name}",
+                                       "swing_frames": max(3, round(1.3 / record.track.track.dt))}  # fmt: skip
+    plots.plot_energy_fit(ident.t, ident.e_measured, ident.sigma, ident.e_sim, label, out_dir / "energy_fit.png",
+                          **whose)  # fmt: skip
     plots.plot_loss_shares(s["models"], out_dir / "loss_shares.png", supported_daic=SUPPORTED_DAIC)
     oos = s["out_of_sample"]
     if oos:
@@ -69,5 +81,5 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False, thorough: bool = Fal
         labels = {p.name: f"{p.name}: {p.description} [{p.unit}]" for p in parameters_of(best)}
         plots.plot_profiles(s["profile_likelihood"], labels, out_dir / "profiles.png")
     write_json(out_dir / "summary.json", s)
-    write_text(out_dir / "report.md", report_text(s))
+    write_text(out_dir / "report.md", report_text(s) if record is None else own_report_text(s))
     return s

@@ -12,6 +12,7 @@ import shutil
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 from .. import __version__
 from ..runs.interrupts import acknowledge, interrupted
@@ -19,6 +20,7 @@ from ..runs.lines import failed_line, header_line, wrote_line
 from .catalogue import check_scenarios, scenario_description, scenario_listing
 from .common import PROG, CliError, private_tempdir, writable_folder
 from .fmus import FmuChoice, add_fmu_options, choose_fmu, load_fmu
+from .track import add_track_options, read_record, record_line, track_flags
 
 
 def _indices(index: str | None, count: int) -> list[str]:
@@ -48,13 +50,14 @@ def accepts_thorough(module) -> bool:
     return "thorough" in inspect.signature(module.run).parameters
 
 
-def run_scenario(module, name: str, runner, out: Path, quick: bool, thorough: bool = False) -> None:
+def run_scenario(module, name: str, runner, out: Path, quick: bool, thorough: bool = False,
+                 record: Any = None) -> None:  # fmt: skip
     """Run one scenario into a fresh folder that replaces ``out/name`` only once it has finished (figures of
     quick runs at :data:`~double_pendulum.plots.style.DRAFT_DPI`).
 
     No stale file from an earlier run and no half-written folder survive: an interrupted run
     leaves the earlier results as they were; a failed one also keeps what it wrote, in
-    ``out/name.failed/``, for diagnosis.
+    ``out/name.failed/``, for diagnosis. ``record``: a user's own record (``--track``), passed to the scenario.
     """
     final = out / name
     staging = out / f".{name}.incomplete"
@@ -63,7 +66,9 @@ def run_scenario(module, name: str, runner, out: Path, quick: bool, thorough: bo
     from ..plots.style import draft_figures  # here, not at the top: matplotlib would slow down `list`
 
     try:
-        options = {"thorough": True} if thorough and accepts_thorough(module) else {}
+        options: dict[str, Any] = {"thorough": True} if thorough and accepts_thorough(module) else {}
+        if record is not None:
+            options["record"] = record
         with draft_figures(quick):  # quick runs draw their figures at a lower resolution
             module.run(runner, staging, quick=quick, **options)
         _mark_quick(staging, quick)
@@ -103,21 +108,29 @@ def _cpu_seconds() -> float:
     return total + children.ru_utime + children.ru_stime
 
 
-def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: Path, fmu: FmuChoice) -> list[str]:
-    """Run the scenarios one after another in this process through the FMU ``fmu``, in the order given; return
-    the names of those that failed."""
+def _description(name: str, record: Any) -> str:
+    """The scenario's one line: its own, or the one of a run on a user's ``record``."""
+    from ..scenarios import page  # noqa: PLC0415 - the registry, on demand as in write_run_page
+
+    return page(name, scenario_description(name), record.name if record is not None else "").description
+
+
+def _run_in_this_process(names: tuple[str, ...], args: argparse.Namespace, out: Path, fmu: FmuChoice,
+                         record: Any = None) -> list[str]:  # fmt: skip
+    """Run the scenarios one after another in this process through the FMU ``fmu``, in the order given (on a user's
+    ``record`` if given); return the names of those that failed."""
     failed = []
     order = list(names)
     indices = _indices(args.index, len(order))
     with load_fmu(fmu, args.rebuild) as runner:
         for index, name in zip(indices, order):
-            print(header_line(index, name, scenario_description(name)), flush=True)
+            print(header_line(index, name, _description(name, record)), flush=True)
             module = importlib.import_module(f"double_pendulum.scenarios.{name}")
             start, cpu_start = time.perf_counter(), _cpu_seconds()
             if args.thorough and not accepts_thorough(module):
                 print(f"  ({name} has no --thorough setting: its normal run)", flush=True)
             try:
-                run_scenario(module, name, runner, out, args.quick, args.thorough)
+                run_scenario(module, name, runner, out, args.quick, args.thorough, record)
             except KeyboardInterrupt:
                 raise
             except Exception as error:  # report, keep what was written, go on with the next
@@ -150,7 +163,7 @@ def _run_in_children(names: tuple[str, ...], args: argparse.Namespace, out: Path
 def _run_command(args: argparse.Namespace) -> str:
     """The ``run`` command line as the page shows it."""
     flags = [flag for flag, on in (("--quick", args.quick), ("--thorough", args.thorough)) if on]
-    return " ".join([PROG, "run", *args.scenarios, *flags, "--out", args.out])
+    return " ".join([PROG, "run", *args.scenarios, *flags, *track_flags(args), "--out", args.out])
 
 
 def write_run_page(out: Path, args: argparse.Namespace, names: tuple[str, ...], failed: list[str],
@@ -160,8 +173,10 @@ def write_run_page(out: Path, args: argparse.Namespace, names: tuple[str, ...], 
     from ..scenarios import READING_ORDER, page
 
     mode = "quick" if args.quick else "thorough" if args.thorough else "default"
-    run = RunInfo(started, __version__, mode, wall_s, cpu_s, _run_command(args), names, tuple(failed))
-    return write_index(out, run, [page(name, scenario_description(name)) for name in READING_ORDER])
+    record = Path(args.track).name if args.track else ""
+    run = RunInfo(started, __version__, mode, wall_s, cpu_s, _run_command(args), names, tuple(failed), record)
+    return write_index(out, run, [page(name, scenario_description(name), record if name in names else "")
+                                  for name in READING_ORDER])
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -170,15 +185,18 @@ def cmd_run(args: argparse.Namespace) -> int:
         raise CliError("--quick and --thorough exclude each other")
     if args.jobs is not None and args.jobs < 1:
         raise CliError(f"--jobs must be at least 1, got {args.jobs}")
+    record = read_record(args, names)  # a user's track, checked before anything is built or written
     fmu = choose_fmu(args)  # before --out is made: a given FMU that is missing or unusable changes nothing
     out = writable_folder(args.out)
     from ..runs.workers import default_workers  # one scenario per core this process may use
 
-    jobs = min(len(names), args.jobs or default_workers())
+    jobs = 1 if record is not None else min(len(names), args.jobs or default_workers())
+    if record is not None:  # its scenarios in this process, one after another (loss_identification has its workers)
+        print(record_line(record), flush=True)
     started, start, cpu_start = datetime.datetime.now(datetime.UTC), time.perf_counter(), _cpu_seconds()
     with private_tempdir():
         failed = (_run_in_children(names, args, out, fmu, jobs) if jobs > 1
-                  else _run_in_this_process(names, args, out, fmu))
+                  else _run_in_this_process(names, args, out, fmu, record))
     wall_s, cpu_s = time.perf_counter() - start, _cpu_seconds() - cpu_start
     if len(names) > 1 and args.index is None:  # a child of run_in_children leaves the sum to its parent
         print(f"{len(names) - len(failed)} of {len(names)} scenarios wrote {out} in "
@@ -216,6 +234,7 @@ def add_run_parser(sub: argparse._SubParsersAction) -> None:
                        help="heavier, publication-grade settings where a scenario has them (chaos, "
                        "work_precision, loss_identification, suspension_transfer, measured_vs_sim); the others "
                        "run as usual")
+    add_track_options(p_run)
     p_run.add_argument("--jobs", type=int, default=None, metavar="N",
                        help="child processes at a time (default: one per core): each runs one scenario, "
                        "or with --quick its share of them one after another; 1 runs them all one after "

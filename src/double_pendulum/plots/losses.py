@@ -13,18 +13,20 @@ from .style import legend_below, running_mean, save
 
 
 def plot_energy_fit(
-    t: np.ndarray, e_measured: np.ndarray, sigma: np.ndarray, e_sim: np.ndarray, model: str, path: str | Path
+    t: np.ndarray, e_measured: np.ndarray, sigma: np.ndarray, e_sim: np.ndarray, model: str, path: str | Path,
+    whose: str = "the seed's pendulum", swing_frames: int = 39,
 ) -> Path:
-    """Measured energy [J] with errors and a model's simulated energy over time [s] (``model``: its label in words);
-    below, the residual E_measured - E_simulated [mJ] per frame and its running mean over one swing (39 frames)."""
+    """Measured energy [J] with errors and a model's simulated energy over time [s] (``model``: its label in words,
+    ``whose``: the record's in words); below, the residual E_measured - E_simulated [mJ] per frame and its running
+    mean over one swing (``swing_frames``: 39 at the seed's 29.97 fps)."""
     fig, (ax, ax_r) = plt.subplots(2, 1, figsize=(10, 6.5), sharex=True, height_ratios=(2, 1))
     ax.errorbar(t, e_measured, yerr=sigma, fmt=".", ms=2, lw=0.4, alpha=0.5, color="C0", label="measured (camera)")
     ax.plot(t, e_sim, color="C3", lw=1.6, label=f"simulated: {model}")
-    ax.set(ylabel="pendulum energy E [J]", title="Energy of the seed's pendulum: measured and simulated (FMU)")
+    ax.set(ylabel="pendulum energy E [J]", title=f"Energy of {whose}: measured and simulated (FMU)")
     ax.grid(alpha=0.3)
     d = (e_measured - e_sim) * 1e3
     ax_r.plot(t, d, ".", ms=2, color="C0", alpha=0.5, label="measured - simulated, per frame")
-    ax_r.plot(t, running_mean(d, 39), color="k", lw=1.2, label="its running mean over one swing (1.3 s)")
+    ax_r.plot(t, running_mean(d, swing_frames), color="k", lw=1.2, label="its running mean over about one swing")
     ax_r.axhline(0.0, color="C3", lw=0.8)
     ax_r.set(xlabel="time after the start of the track t [s]", ylabel="measured - simulated [mJ]",
              title="Residuals: measured minus simulated energy")  # fmt: skip

@@ -67,8 +67,8 @@ class ScenarioPage:
 @dataclass(frozen=True)
 class RunInfo:
     """The run the page is about: when it ``started``, the package ``version``, its ``mode`` (quick, default or
-    thorough), its wall and CPU time [s], the ``command``, the scenarios it ran (in the order given) and those of
-    them that ``failed``."""
+    thorough), its wall and CPU time [s], the ``command``, the scenarios it ran (in the order given), those of
+    them that ``failed`` and the user's ``record`` if it analysed one."""
 
     started: datetime
     version: str
@@ -78,6 +78,8 @@ class RunInfo:
     command: str
     ran: Sequence[str]
     failed: Sequence[str] = field(default_factory=tuple)
+    record: str = ""
+    """The file name of a user's own camera track the run analysed (``--track``); "" for the seed's."""
 
 
 _PART = re.compile(r"(?<! )/(?! )")
@@ -293,6 +295,10 @@ def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
     summary_path = folder / "summary.json"
     written = datetime.fromtimestamp(summary_path.stat().st_mtime).strftime("%Y-%m-%d %H:%M")
     parts = [head, f'<p class="mode">{_mode(summary)}, written {written}</p>']
+    record = summary.get("record")
+    if isinstance(record, dict) and "file" in record:  # a user's own track (run --track)
+        parts.append(f'<p class="record">Record: <strong>{html.escape(str(record["file"]))}</strong>, '
+                     f'{html.escape(str(record.get("whose", "")))}</p>')
     text = in_short(folder, summary)
     if text:
         parts.append(f'<p class="short">{_inline(text)}</p>')
@@ -368,6 +374,9 @@ def page_html(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> str:
             f'<p class="run">{html.escape(when)} &middot; double-pendulum-fmu {html.escape(run.version)} &middot; '
             f"{html.escape(run.mode)} run &middot; {run.wall_s:.0f} s (CPU {run.cpu_s:.0f} s) &middot; "
             f"<code>{html.escape(run.command)}</code><br>{status}.</p>"]
+    if run.record:
+        head.append(f'<p class="record">Record analysed: <strong>{html.escape(run.record)}</strong>, your own camera '
+                    "track (not the seed's); every figure of its scenarios is computed from it.</p>")
     found = _conclusions(out, ran, failed)
     if found:
         head += ['<section id="conclusions"><h2>What this run found</h2><ul class="conclusions">', *found,

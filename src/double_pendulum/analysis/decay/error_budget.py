@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 
 from ...model.parameters import SEED_RIGID_LINKS
-from ..track.measurement import Geometry, Reconstruction, Track, reconstruct
+from ..track.measurement import Geometry, Reconstruction, Track, reconstruct, same_pendulum
 from .fit import (
     SEED_FIT,
     calibrate_error_model,
@@ -71,13 +71,20 @@ def _shifted_pivot(geometry: Geometry, dx: float, dy: float) -> Geometry:
     return dataclasses.replace(geometry, pivot=pivot)
 
 
+ROD_ROW = "rod mass (point masses vs rigid links)"
+"""The row of the seed's rods (none on a user's record)."""
+
+
 def _row(name: str, shift: tuple[float, float], how: str) -> dict[str, Any]:
     return {"source": name, "a_J": abs(shift[0]), "b_per_s": abs(shift[1]),
             "a_shift_J": shift[0], "b_shift_per_s": shift[1], "how": how}  # fmt: skip
 
 
-def systematic_rows(track: Track, rec: Reconstruction, main: tuple[float, float], sigma: np.ndarray) -> list[dict]:
-    """The systematic rows (module docstring) for the main fit ``main`` = (a, b) with errors ``sigma``."""
+def systematic_rows(track: Track, rec: Reconstruction, main: tuple[float, float], sigma: np.ndarray,
+                    rods: Mapping[str, float] | None = SEED_RIGID_LINKS) -> list[dict]:  # fmt: skip
+    """The systematic rows (module docstring) for the main fit ``main`` = (a, b) with errors ``sigma``; the rod
+    mass rows with the rods ``rods`` (the seed's members; None: a pendulum whose energy already holds its rods, or
+    has none: no rod rows)."""
     m = rec.free_motion
     t = rec.t[m]
     a0, b0 = main
@@ -96,13 +103,14 @@ def systematic_rows(track: Track, rec: Reconstruction, main: tuple[float, float]
     fits = [exp_fit(t[s], rec.energy[m][s], sigma[s]) for s in (slice(None, half), slice(half, None))]
     rows.append(_row("first vs second half", (0.5 * (fits[1][0] - fits[0][0]), 0.5 * (fits[1][1] - fits[0][1])),
                      f"half the difference of the halves' fits (b: {fits[0][1]:.5f} and {fits[1][1]:.5f} 1/s)"))
-    rows.append(_row("rod mass (point masses vs rigid links)", shift(_recipe(track, rec, rods=SEED_RIGID_LINKS)),
-                     "energies with the seed's 70 g acrylic members (a bias of the point-mass energy)"))
-    m_rod, dm = SEED_RIGID_LINKS["m_rod1"], ROD_MASS_UNCERTAINTY_KG
-    lo, hi = (_recipe(track, rec, rods={**SEED_RIGID_LINKS, "m_rod1": mr, "m_rod2": mr})
-              for mr in (m_rod - dm, m_rod + dm))  # fmt: skip
-    rows.append(_row("rod mass +-0.03 kg", (0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1])),
-                     "half the difference between 40 g and 100 g members"))
+    if rods is not None:
+        rows.append(_row(ROD_ROW, shift(_recipe(track, rec, rods=rods)),
+                         "energies with the seed's 70 g acrylic members (a bias of the point-mass energy)"))
+        m_rod, dm = rods["m_rod1"], ROD_MASS_UNCERTAINTY_KG
+        lo, hi = (_recipe(track, rec, rods={**rods, "m_rod1": mr, "m_rod2": mr})
+                  for mr in (m_rod - dm, m_rod + dm))  # fmt: skip
+        rows.append(_row("rod mass +-0.03 kg", (0.5 * (hi[0] - lo[0]), 0.5 * (hi[1] - lo[1])),
+                         "half the difference between 40 g and 100 g members"))
     g = rec.geometry
     sx = shift(_recipe(track, rec, geometry=_shifted_pivot(g, g.pivot.sigma_xc, 0.0)))
     sy = shift(_recipe(track, rec, geometry=_shifted_pivot(g, 0.0, g.pivot.sigma_yc)))
@@ -114,7 +122,7 @@ def systematic_rows(track: Track, rec: Reconstruction, main: tuple[float, float]
 
 def _recipe(track: Track, rec: Reconstruction, **kwargs: Any) -> tuple[float, float]:
     """The main recipe on the track reconstructed with other ``rods`` or ``geometry`` (same frames)."""
-    other = reconstruct(track, **{"geometry": rec.geometry, **kwargs})
+    other = reconstruct(track, **{"geometry": rec.geometry, **same_pendulum(rec), **kwargs})
     return _calibrated(other, rec.free_motion & other.energy_valid)
 
 
@@ -140,7 +148,7 @@ def _variant_b(rec: Reconstruction, sigma: np.ndarray, gls_b: float, rows: list[
         "window": {f"first {TRIM_S} s left out": b_of(t >= t[0] + TRIM_S, sigma),
                    f"last {TRIM_S} s left out": b_of(t <= t[-1] - TRIM_S, sigma)},
         "energy": {"central differences": b_of(every, sigma, rec.energy_cd[m]),
-                   "rigid links (70 g members)": b0 + shifts["rod mass (point masses vs rigid links)"],
+                   **({"rigid links (70 g members)": b0 + shifts[ROD_ROW]} if ROD_ROW in shifts else {}),
                    "pivot moved by its errors": b0 + shifts["pivot position"]},
     }  # fmt: skip
 
@@ -194,12 +202,14 @@ def b_statement(noise: dict[str, Any], variants: dict[str, dict], halves_fit: di
     }  # fmt: skip
 
 
-def error_budget(rec: Reconstruction, sigma: np.ndarray) -> dict[str, Any]:
+def error_budget(rec: Reconstruction, sigma: np.ndarray, *, seed: bool = True) -> dict[str, Any]:
     """The whole budget: main a, b, statistical errors, systematic rows, totals, the seed's for comparison;
     the statement of b (:func:`b_statement`) and the non-stationarity study
     (:func:`~double_pendulum.analysis.decay.stationarity.stationarity`).
 
-    ``sigma`` [J]: the main fit's calibrated errors on ``rec.free_motion``.
+    ``sigma`` [J]: the main fit's calibrated errors on ``rec.free_motion``. ``seed``: the seed's record (its rod
+    rows and its fit for comparison); False: a user's record (:mod:`~double_pendulum.analysis.track.user_track`),
+    whose energy holds the rods its pendulum file gives, without the seed's rod rows or numbers.
     """
     m = rec.free_motion
     t, e = rec.t[m], rec.energy[m]
@@ -211,7 +221,7 @@ def error_budget(rec: Reconstruction, sigma: np.ndarray) -> dict[str, Any]:
              "a_shift_J": None, "b_shift_per_s": None,
              "how": f"AR(1) residuals, rho = {noise['rho']:.2f} (block bootstrap: "
                     f"{noise['bootstrap']['b_per_s_stderr'] * 1e4:.2f}e-4 1/s)"}]  # fmt: skip
-    rows += systematic_rows(rec.track, rec, (a, b), sigma)
+    rows += systematic_rows(rec.track, rec, (a, b), sigma, SEED_RIGID_LINKS if seed else None)
     total_a = math.sqrt(sum(r["a_J"] ** 2 for r in rows))
     total_b = math.sqrt(sum(r["b_per_s"] ** 2 for r in rows))
     halves_fit = halves(t, e, sigma)
@@ -220,7 +230,8 @@ def error_budget(rec: Reconstruction, sigma: np.ndarray) -> dict[str, Any]:
 
     def recipe(track: Track | None = None, **kwargs: Any) -> tuple[float, float]:
         """The main fit on another reconstruction, with the main fit's errors where the frames are the same."""
-        other = reconstruct(rec.track if track is None else track, **{"geometry": rec.geometry, **kwargs})
+        other = reconstruct(rec.track if track is None else track,
+                            **{"geometry": rec.geometry, **same_pendulum(rec), **kwargs})
         frames = m & other.energy_valid
         if not np.array_equal(frames, m):
             return _calibrated(other, frames)
@@ -239,13 +250,14 @@ def error_budget(rec: Reconstruction, sigma: np.ndarray) -> dict[str, Any]:
         "noise_model": noise,
         "b_statement": b_statement(noise, variants, halves_fit, factor, fit.error("b")),
         "stationarity": stationarity(rec, sigma, r1_drift(rec), recipe, (a, b), rows),
-        "seed": {"a_J": SEED_FIT["a_J"], "a_relative": SEED_FIT["a_rel_err"], "b_per_s": SEED_FIT["b_per_s"],
-                 "b_relative": SEED_FIT["b_rel_err"]},  # fmt: skip
+        **({"seed": {"a_J": SEED_FIT["a_J"], "a_relative": SEED_FIT["a_rel_err"], "b_per_s": SEED_FIT["b_per_s"],
+                     "b_relative": SEED_FIT["b_rel_err"]}} if seed else {}),  # fmt: skip
     }
 
 
 def budget_table(budget: Mapping[str, Any]) -> str:
-    """Markdown table of the budget: contributions to a [mJ] and b [1e-4 1/s], relative, and the seed's."""
+    """Markdown table of the budget: contributions to a [mJ] and b [1e-4 1/s], relative, and the seed's (if the
+    budget has it: the seed's record)."""
     a, b = budget["a_J"], abs(budget["b_per_s"])
     fmt: Callable[[float, float, float], str] = lambda v, ref, s: f"{v * s:.2f} ({v / ref:.2%})"  # noqa: E731
     lines = ["| source | a [mJ] | b [1e-4 1/s] | how |", "|---|---|---|---|"]
@@ -253,6 +265,8 @@ def budget_table(budget: Mapping[str, Any]) -> str:
         lines.append(f"| {r['source']} | {fmt(r['a_J'], a, 1e3)} | {fmt(r['b_per_s'], b, 1e4)} | {r['how']} |")
     lines.append(f"| **total (quadrature)** | {fmt(budget['total_a_J'], a, 1e3)} | "
                  f"{fmt(budget['total_b_per_s'], b, 1e4)} | square root of the sum of the squared rows |")  # fmt: skip
+    if "seed" not in budget:  # a user's record
+        return "\n".join(lines)
     s = budget["seed"]
     lines.append(f"| the seed's quoted error | {s['a_relative'] * s['a_J'] * 1e3:.2f} ({s['a_relative']:.2%}) | "
                  f"{s['b_relative'] * abs(s['b_per_s']) * 1e4:.2f} ({s['b_relative']:.2%}) | "

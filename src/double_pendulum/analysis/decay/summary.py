@@ -132,8 +132,9 @@ def geometry_summary(rec: Reconstruction) -> dict[str, Any]:
     }
 
 
-def filter_summary(omegas: Sequence[float] = GAIN_CHECK_OMEGA) -> dict[str, Any]:
-    """Both derivative stencils c_k [1/s]: length, noise gain sqrt(sum c_k^2) dt [1] and harmonic gains.
+def filter_summary(omegas: Sequence[float] = GAIN_CHECK_OMEGA, dt: float = 1.0 / FPS) -> dict[str, Any]:
+    """Both derivative stencils c_k [1/s] at the frame interval ``dt`` [s] (default the seed's camera): length,
+    noise gain sqrt(sum c_k^2) dt [1] and harmonic gains.
 
     The noise gain is the standard deviation of the derivative of white noise of unit standard
     deviation, times the frame interval dt; the gain at omega [rad/s] is the stencil's derivative of
@@ -141,14 +142,14 @@ def filter_summary(omegas: Sequence[float] = GAIN_CHECK_OMEGA) -> dict[str, Any]
     """
     out = {}
     stencils = {
-        "central_difference": central_difference_coefficients(),
-        "savgol": savgol_derivative_coefficients(),
+        "central_difference": central_difference_coefficients(dt),
+        "savgol": savgol_derivative_coefficients(dt=dt),
     }
     for name, c in stencils.items():
-        gains = derivative_gain(c, omegas)
+        gains = derivative_gain(c, omegas, dt)
         out[name] = {
             "frames": len(c),
-            "noise_gain": math.sqrt(float(np.sum(c * c))) / FPS,
+            "noise_gain": math.sqrt(float(np.sum(c * c))) * dt,
             "gain": {f"{w:g}_rad_s": float(g) for w, g in zip(omegas, gains)},
         }
     return out
@@ -263,8 +264,10 @@ def seed_comparison(main: dict[str, Any]) -> dict[str, Any]:
     }
 
 
-def decay_curves(fits: Sequence[FitResult], t_end: float) -> tuple[np.ndarray, dict[str, np.ndarray], str]:
-    """Fitted decay curves E(t) [J] on 0..``t_end`` [s] for the plot, labelled with their dAIC, and the seed's.
+def decay_curves(fits: Sequence[FitResult], t_end: float,
+                 seed: bool = True) -> tuple[np.ndarray, dict[str, np.ndarray], str]:  # fmt: skip
+    """Fitted decay curves E(t) [J] on 0..``t_end`` [s] for the plot, labelled with their dAIC, and the seed's
+    (``seed``: the seed's record; not on a user's).
 
     ``fits`` best first (as :func:`~double_pendulum.analysis.decay.fit.fit_all`). Returns the times,
     the curves by label and the label of the best model by AIC (the curve the plot's residuals refer to).
@@ -274,5 +277,6 @@ def decay_curves(fits: Sequence[FitResult], t_end: float) -> tuple[np.ndarray, d
     for f in fits:
         curves[f"{f.model} (dAIC {f.aic - fits[0].aic:.1f})"] = MODELS[f.model].func(t_curve, *f.params)
     best_label = next(iter(curves))
-    curves["seed: 0.813 J exp(-0.024 t)"] = SEED_FIT["a_J"] * np.exp(SEED_FIT["b_per_s"] * t_curve)
+    if seed:
+        curves["seed: 0.813 J exp(-0.024 t)"] = SEED_FIT["a_J"] * np.exp(SEED_FIT["b_per_s"] * t_curve)
     return t_curve, curves, best_label

@@ -96,7 +96,7 @@ class FitProblem:
 
     ``t0`` [s]: start frame; ``offsets``: fitted frames after it; ``t`` [s], ``energy`` [J],
     ``sigma`` [J]: the measurement; ``base``: FMU start values of the pendulum (lengths, rods,
-    start state, solver settings) to which a model's loss values are added.
+    start state, solver settings) to which a model's loss values are added; ``dt`` [s]: the frame interval.
     """
 
     t0: float
@@ -105,11 +105,12 @@ class FitProblem:
     energy: np.ndarray
     sigma: np.ndarray
     base: dict[str, Any]
+    dt: float = FRAME_INTERVAL
 
     @property
     def duration(self) -> float:
         """Simulated time [s] from t0 to the last fitted frame."""
-        return int(self.offsets[-1]) * FRAME_INTERVAL
+        return int(self.offsets[-1]) * self.dt
 
     def simulate(self, values: Mapping[str, Any], outputs: Sequence[str] = ("E_pendulum",), runner: Any = None):
         """Run the pendulum with the loss ``values`` from t0 over the record (rows on the frame grid)."""
@@ -118,13 +119,13 @@ class FitProblem:
             {**self.base, **values},
             start_time=self.t0,
             stop_time=self.t0 + self.duration,
-            output_interval=FRAME_INTERVAL,
+            output_interval=self.dt,
             outputs=tuple(outputs),
         )
 
     def digest(self) -> str:
         """Hash of the measurement and the pendulum: what a fit of this problem depends on."""
-        h = hashlib.sha256(json.dumps({"t0": self.t0, "base": self.base}, sort_keys=True).encode())
+        h = hashlib.sha256(json.dumps({"t0": self.t0, "dt": self.dt, "base": self.base}, sort_keys=True).encode())
         for a in (self.offsets, self.t, self.energy, self.sigma):
             h.update(np.ascontiguousarray(a, dtype=float).tobytes())
         return h.hexdigest()[:16]
@@ -153,7 +154,8 @@ def problem_from_track(
     start = fit_release_state(runner, rec, {**pendulum, "air_drag": True, "rod_drag": True}, quick=quick)
     base = {**(QUICK_SIM_SETTINGS if quick else SIM_SETTINGS), **pendulum, **start.start_values()}
     f = md.frames
-    return FitProblem(f.t0, np.asarray(f.offsets), np.asarray(f.t), np.asarray(md.energy), np.asarray(f.sigma), base)
+    return FitProblem(f.t0, np.asarray(f.offsets), np.asarray(f.t), np.asarray(md.energy), np.asarray(f.sigma), base,
+                      f.dt)
 
 
 # --- fitting one model ---------------------------------------------------------------------------

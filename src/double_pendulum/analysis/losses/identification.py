@@ -198,7 +198,8 @@ def goal_checks(numbers: Mapping[str, float], halves: Mapping[str, Any]) -> dict
 
 
 def identify_losses(
-    runner: Any, *, quick: bool = False, thorough: bool = False, max_workers: int | None = None
+    runner: Any, *, quick: bool = False, thorough: bool = False, max_workers: int | None = None,
+    record: Any = None,
 ) -> LossIdentification:
     """Fit every model (:data:`FULL_MODELS`; thorough: :data:`THOROUGH_MODELS`; quick: :data:`QUICK_MODELS`,
     in this process, at :data:`QUICK_SIM_SETTINGS` with :data:`QUICK_RUN_BUDGET` runs: one Gauss-Newton
@@ -213,7 +214,8 @@ def identify_losses(
     model fitted to each half, 12 runs a fit, quick: the quick budget) runs in the thorough and the quick mode only."""
     from ..sweep import parallel_map, worker_pool  # noqa: PLC0415 - process pools only when identifying
 
-    rec = seed_reconstruction()
+    seed = record is None
+    rec = seed_reconstruction() if seed else record.reconstruction()
     md = measured(rec)
     problem = problem_from_track(rec, md, quick=quick)
     models = QUICK_MODELS if quick else THOROUGH_MODELS if thorough else FULL_MODELS
@@ -248,7 +250,9 @@ def identify_losses(
                       else regularisation_effect(problem, drag_fit.model, drag_fit.theta))
     summary = {
         "scenario": "loss_identification",
-        "source": "seed Table 1 (data/seed_table1.csv), rigid links SEED_RIGID_LINKS",
+        "source": ("seed Table 1 (data/seed_table1.csv), rigid links SEED_RIGID_LINKS" if seed
+                   else f"{record.name}: a user's own record"),
+        **({} if seed else {"record": record.describe()}),
         "pendulum": {k: getattr(rec.params, k) for k in ("m1", "m2", "l1", "l2", *SEED_RIGID_LINKS)},
         "t0_s": problem.t0,
         "record_s": float(problem.t[-1] - problem.t[0]),
@@ -281,10 +285,10 @@ def identify_losses(
         "suspension_as_main_loss": loss_claims.suspension_bound(rows),
         "supported_models": loss_claims.supported_models(rows),
         "b_sim_range_all_models_per_s": loss_claims.b_sim_range(rows),
-        "load_proportional_friction_against_seed": loss_claims.seed_friction_coefficient(rows),
+        "load_proportional_friction_against_seed": loss_claims.seed_friction_coefficient(rows) if seed else None,
         "drag_torque_against_seed_rolling_friction": next(
             (loss_claims.seed_rolling_friction(rec.params, r["parameters"]["tau_b"]["value"]) for r in rows
-             if r["model"] == "air+drag"), None),
+             if r["model"] == "air+drag"), None) if seed else None,
         "air_drag_at_defaults": air_share_at_defaults(problem, loss, _air_model_on_measured_decay(fits, rows)),
         "models": rows,
         "suspension_fixed": {"k_N_per_m": SUSPENSION_K, "M_s_kg": SUSPENSION_M},
@@ -305,7 +309,12 @@ def identify_losses(
                        "out_of_sample": "not run: the half-record test runs with --thorough (and --quick, one model "
                                         "as a smoke run); it would add about 85 % to the default run's time",
                        "profile_likelihood": "empty: profiled with --thorough only (its intervals matched the "
-                                             "curvature errors in the runs so far)"},
+                                             "curvature errors in the runs so far)",
+                       **({} if seed else {
+                           "load_proportional_friction_against_seed": "a user's record: the seed's bearing values "
+                                                                      "are not this pendulum's",
+                           "drag_torque_against_seed_rolling_friction": "a user's record: the seed's bearing values "
+                                                                        "are not this pendulum's"})},
         "start_state": {k: problem.base[k] for k in ("phi1_0", "phi2_0", "omega1_0", "omega2_0")},
     }
     t = problem.t

@@ -97,12 +97,14 @@ N s/m), but the simulated decay rate then ends 5 % from the measured one, outsid
 @dataclass(frozen=True, eq=False)
 class FitFrames:
     """Frames on which a decay rate is fitted: ``t0`` [s] of the start frame, ``offsets`` (frames
-    after it), their times ``t`` [s] and energy errors ``sigma`` [J] (None: equal weights)."""
+    after it), their times ``t`` [s] and energy errors ``sigma`` [J] (None: equal weights), ``dt`` [s]
+    the frame interval."""
 
     t0: float
     offsets: np.ndarray
     t: np.ndarray
     sigma: np.ndarray | None
+    dt: float = FRAME_INTERVAL
 
     @property
     def n_frames(self) -> int:
@@ -112,7 +114,7 @@ class FitFrames:
     @property
     def duration(self) -> float:
         """Simulated time [s] from t0 to the last fitted frame."""
-        return (self.n_frames - 1) * FRAME_INTERVAL
+        return (self.n_frames - 1) * self.dt
 
 
 @dataclass(frozen=True, eq=False)
@@ -153,7 +155,7 @@ def measured_decay(rec: Reconstruction, window_s: float | None = None) -> Measur
     errors = calibrate_error_model(t, e, rec.sigma_energy[idx], rec.momentum[idx])
     fit = fit_model("exponential", t, e, errors.sigma)
     factor = record_correlation_factor(t, e, errors.sigma)
-    frames = FitFrames(float(rec.t[i0]), idx - i0, t, errors.sigma)
+    frames = FitFrames(float(rec.t[i0]), idx - i0, t, errors.sigma, rec.track.dt)
     return MeasuredDecay(rec, int(i0), frames, e, fit, factor)
 
 
@@ -184,7 +186,7 @@ def fit_release_state(
     window = track_window(rec, rec.release_frame, START_FIT_FRAMES)
     return fit_start_state(
         runner, window.t0, window.offsets, window.positions, window.sigma_positions, window.guess, model_values,
-        **({"tolerance": QUICK_START_TOLERANCE} if quick else {}),
+        dt=rec.track.dt, **({"tolerance": QUICK_START_TOLERANCE} if quick else {}),
     )
 
 
@@ -194,14 +196,15 @@ def simulate_frames_from(
     frames: FitFrames,
     settings: Mapping[str, Any] = FIT_SETTINGS,
     outputs: Sequence[str] = ("E_pendulum", "E_total"),
-    interval: float = FRAME_INTERVAL,
+    interval: float | None = None,
 ) -> np.ndarray:
-    """Run the FMU from ``frames.t0`` to the last fitted frame (rows on ``t0 + n interval``)."""
+    """Run the FMU from ``frames.t0`` to the last fitted frame (rows on ``t0 + n interval``, default the frames'
+    interval ``frames.dt``)."""
     return runner.simulate(
         {**settings, **values},
         start_time=frames.t0,
         stop_time=frames.t0 + frames.duration,
-        output_interval=interval,
+        output_interval=frames.dt if interval is None else interval,
         outputs=outputs,
     )
 

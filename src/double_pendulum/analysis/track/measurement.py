@@ -69,6 +69,8 @@ class Track:
     """The measured track: one entry per video frame (positions as printed, origin not the pivot).
 
     ``valid`` is false for frames flagged by :func:`flag_bad_frames`; they are kept, not dropped.
+    ``dt`` [s] is the time between frames (the seed's camera: :data:`FRAME_INTERVAL`; a user's record:
+    :mod:`.user_track`); every derivative and every simulation on the frame grid uses it.
     """
 
     frame: np.ndarray
@@ -78,6 +80,7 @@ class Track:
     x2: np.ndarray
     y2: np.ndarray
     valid: np.ndarray
+    dt: float = FRAME_INTERVAL
 
     def __len__(self) -> int:
         return len(self.frame)
@@ -130,7 +133,8 @@ class Reconstruction:
     the propagated position noise for ``energy``; ``momentum`` = sqrt(m1^2 v1^2 + m2^2 v2^2)
     [kg m/s] with the Savitzky-Golay speeds (eq. 25 without its dv). ``energy_valid`` marks the
     frames where both energies are defined and no stencil touches a flagged frame;
-    ``release_frame`` is the end of the hand release (:func:`find_release_frame`).
+    ``release_frame`` is the end of the hand release (:func:`find_release_frame`), at the earliest the first
+    ``energy_valid`` frame (where the rates are defined).
     """
 
     track: Track
@@ -494,6 +498,14 @@ def find_release_frame(energy: np.ndarray) -> int:
     return int(idx[0]) if len(idx) else 0
 
 
+def same_pendulum(rec: Reconstruction) -> dict[str, object]:
+    """The keywords of :func:`reconstruct` that give ``rec``'s masses, rods and g (its geometry apart): to
+    reconstruct the same pendulum with one choice changed."""
+    p = rec.params
+    return {"m1": p.m1, "m2": p.m2, "g": p.g,
+            "rods": {k: getattr(p, k) for k in ("m_rod1", "m_rod2", "L_rod1", "L_rod2")}}  # fmt: skip
+
+
 def _touches_invalid(valid: np.ndarray, half_width: int) -> np.ndarray:
     """True where a flagged frame lies within ``half_width`` frames."""
     bad = (~valid).astype(float)
@@ -510,6 +522,7 @@ def reconstruct(
     window: int = SG_WINDOW,
     polyorder: int = SG_POLYORDER,
     rods: Mapping[str, float] | None = None,
+    g: float | None = None,
 ) -> Reconstruction:
     """Angles, rates and energies per frame of a measured track.
 
@@ -518,7 +531,8 @@ def reconstruct(
     :func:`estimate_position_noise`. The energy is ``total_energy`` of a ``PendulumParameters``
     with the measured l1, l2 (potential zero with both bobs hanging at rest below the fitted pivot);
     ``rods`` (``m_rod1, m_rod2, L_rod1, L_rod2``, e.g. :data:`~double_pendulum.model.parameters.SEED_RIGID_LINKS`)
-    adds the links' rods to it (default: point masses on massless rods).
+    adds the links' rods to it (default: point masses on massless rods); ``g`` [m/s^2] defaults to the model's.
+    The derivative stencils use the track's frame interval ``track.dt``.
     """
     geometry = fit_geometry(track) if geometry is None else geometry
     defaults = PendulumParameters()
@@ -528,13 +542,14 @@ def reconstruct(
         l1=geometry.l1,
         l2=geometry.l2,
         **dict(rods or {}),
+        **({} if g is None else {"g": g}),
     )
     s1, s2 = estimate_position_noise(track, geometry) if sigma_pos is None else sigma_pos
     x1, y1 = track.x1 - geometry.pivot.xc, track.y1 - geometry.pivot.yc
     x2, y2 = track.x2 - geometry.pivot.xc, track.y2 - geometry.pivot.yc
     phi1, phi2 = angles(x1, y1, x2, y2)
-    cd = central_difference_coefficients()
-    sg = savgol_derivative_coefficients(window, polyorder)
+    cd = central_difference_coefficients(track.dt)
+    sg = savgol_derivative_coefficients(window, polyorder, track.dt)
     w1_cd, w2_cd = apply_stencil(phi1, cd), apply_stencil(phi2, cd)
     w1, w2 = apply_stencil(phi1, sg), apply_stencil(phi2, sg)
     energy_cd = total_energy(phi1, phi2, w1_cd, w2_cd, params, np.cos)
@@ -566,5 +581,6 @@ def reconstruct(
         sigma_energy=sigma_energy_propagated(phi1, phi2, w1, w2, params, s1, s2, sg),
         momentum=np.sqrt((params.m1 * v1) ** 2 + (params.m2 * v2) ** 2),
         energy_valid=valid,
-        release_frame=find_release_frame(energy_cd),
+        # not before the first frame with both energies and rates (a record that starts in free motion)
+        release_frame=max(find_release_frame(energy_cd), int(np.argmax(valid)) if valid.any() else 0),
     )
