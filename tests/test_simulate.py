@@ -223,3 +223,35 @@ def test_the_summary_s_fmpy_call_works_from_any_folder_and_null_means_only_expla
     for key in summary["null_means"]:
         assert summary.get(key) is None, (key, summary.get(key))
     assert outcome.message is None and "fmu_message" in summary["null_means"]
+
+
+def test_one_rule_for_start_angles_in_the_model_the_component_and_the_cli(fmu_path, tmp_path, capsys):
+    """A start angle is any number within +-1e4 rad, used as given: phi1_0 = 9 rad is the state 9 - 2 pi rad, and
+    its run is that one's shifted by a turn. The component (the FMU) and the CLI refuse 2e4 rad in the same words,
+    naming the angle and its value; the CLI before it writes anything."""
+    from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
+    from double_pendulum.model.parameters import MAX_START_ANGLE, ParameterError, check_start_angle
+
+    for value in (9.0, -MAX_START_ANGLE, MAX_START_ANGLE, np.pi + 0.05):
+        check_start_angle("phi2_0", value)
+    for value in (2e4, -1.0001e4, float("nan"), float("inf")):
+        with pytest.raises(ParameterError, match=rf"phi2_0 = {value!r} rad: a start angle must be a finite number "
+                                                 r"from -10000 to 10000 rad"):
+            check_start_angle("phi2_0", value)
+    with pytest.raises(ParameterError, match=r"phi1_0 = 20000.0 rad: a start angle must be"):
+        DoublePendulumCoSimulation().set("phi1_0", 2e4)
+
+    assert main(["simulate", "--set", "phi1_0=2e4", "--fmu", str(fmu_path), "--out", str(tmp_path / "x")]) == 2
+    err = _one_error_line(capsys)
+    assert "--set phi1_0=2e4: invalid phi1_0 = 20000.0 rad: a start angle must be a finite number" in err
+    assert list(tmp_path.iterdir()) == []
+
+    out = tmp_path / "nine"
+    assert main(["simulate", "--set", "phi1_0=9", "--stop", "0.5", "--no-animation", "--fmu", str(fmu_path),
+                 "--out", str(out)]) == 0
+    nine = read_results_csv(out / "simulation.csv")
+    wrapped = simulate_fmu(str(fmu_path), start_values={"phi1_0": 9.0 - 2 * np.pi}, stop_time=0.5,
+                           output_interval=0.01, output=["phi1", "phi2"])
+    assert nine["phi1"][0] == 9.0  # not wrapped: the output counts the turn
+    np.testing.assert_allclose(nine["phi1"] - 2 * np.pi, wrapped["phi1"], atol=1e-6)
+    np.testing.assert_allclose(nine["phi2"], wrapped["phi2"], atol=1e-6)

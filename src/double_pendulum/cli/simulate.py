@@ -29,6 +29,25 @@ def check_fmi(args: argparse.Namespace, fmu: FmuChoice) -> None:
         raise CliError(f"{fmu.path} (FMI {md.fmiVersion}) is model exchange only: pass --me")
 
 
+def check_start_angles(settings: list[str]) -> None:
+    """Check the start angles among ``--set NAME=VALUE`` by the one rule the FMU and the app apply
+    (:func:`~double_pendulum.model.parameters.check_start_angle`), before anything is built or written; a CliError
+    naming the angle and its value if one breaks it. A text that is no number is left to the --set checks."""
+    from ..model.parameters import START_ANGLES, ParameterError, check_start_angle
+
+    for setting in settings:
+        name, _, text = setting.partition("=")
+        if name.strip() in START_ANGLES:
+            try:
+                value = float(text)
+            except ValueError:
+                continue
+            try:
+                check_start_angle(name.strip(), value)
+            except ParameterError as error:
+                raise CliError(f"--set {setting.strip()}: {error}") from None
+
+
 def cmd_simulate(args: argparse.Namespace) -> int:
     """Run a case of one's own through the FMU (:mod:`double_pendulum.case`): CSV, figure, animation, summary."""
     from fmpy import read_model_description
@@ -38,6 +57,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
     chosen = choose_fmu(args)  # before --out is made: a given FMU that is missing or unusable changes nothing
     check_fmi(args, chosen)
+    check_start_angles(args.set)
     stop, step = positive("--stop", args.stop), positive("--step", args.step)
     if step > stop:
         raise CliError(f"--step {step:g} s is longer than the run (--stop {stop:g} s)")
