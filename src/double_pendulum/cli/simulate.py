@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from .common import PROG, CliError, positive, private_tempdir, writable_folder
@@ -52,7 +53,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     """Run a case of one's own through the FMU (:mod:`double_pendulum.case`): CSV, figure, animation, summary."""
     from fmpy import read_model_description
 
-    from ..case import Case, run_case, start_state_words
+    from ..case import PROBE_S, Case, Estimate, TooLong, run_case, start_state_words
     from ..fmu.running.start_values import StartValueError, parse_start_values
 
     chosen = choose_fmu(args)  # before --out is made: a given FMU that is missing or unusable changes nothing
@@ -61,6 +62,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     stop, step = positive("--stop", args.stop), positive("--step", args.step)
     if step > stop:
         raise CliError(f"--step {step:g} s is longer than the run (--stop {stop:g} s)")
+    max_wall = positive("--max-wall", args.max_wall)
     out = writable_folder(args.out)
     with private_tempdir():
         if chosen.given:
@@ -75,7 +77,18 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             raise CliError(str(error)) from None
         case = Case(fmu, values, stop, step, "ModelExchange" if args.me else "CoSimulation")
         print(f"simulating {case.words()} through {fmu} with fmpy ...", flush=True)
-        outcome = run_case(case, out, animate=not args.no_animation)
+
+        def tell(estimate: Estimate) -> None:
+            if stop >= 10 * PROBE_S:
+                print(f"this run takes {estimate.words()}", flush=True)
+
+        try:
+            outcome = run_case(case, out, animate=not args.no_animation, max_wall_s=max_wall, on_estimate=tell)
+        except TooLong as error:
+            raise CliError(f"--stop {stop:g} s would take {error.estimate.words()}: more than --max-wall "
+                           f"{max_wall:g} s; stopped after the first {error.estimate.probe_s:.2g} s of it, nothing "
+                           f"written (to run it all: --max-wall {math.ceil(1.2 * error.estimate.total_wall_s)})"
+                           ) from None
     names = ", ".join(path.name for path in outcome.files)
     state = f"start state: {start_state_words(outcome.start_state)}"
     if outcome.message is not None:
@@ -116,4 +129,8 @@ def add_simulate_parser(sub: argparse._SubParsersAction) -> None:
                     "its own version, read from its modelDescription): read as it is, never built or written (an "
                     "error if it is missing or not usable)")
     p_sim.add_argument("--no-animation", action="store_true", help="write no simulation.gif")
+    p_sim.add_argument("--max-wall", type=float, default=3600.0, metavar="SECONDS",
+                       help="the longest the run may take [s of wall time] (default: 3600): the first 0.5 s of "
+                       "simulated time estimate the whole run's time (printed for runs of 5 s or more), and a run "
+                       "estimated to take longer stops there, writing nothing")
     p_sim.set_defaults(func=cmd_simulate)
