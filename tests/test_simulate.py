@@ -314,7 +314,7 @@ def test_a_long_run_is_estimated_and_refused_beyond_max_wall(fmu_path, tmp_path,
     assert main(["simulate", "--stop", "1e9", "--max-wall", "60", "--fmu", str(fmu_path), "--out", str(out)]) == 2
     captured = capsys.readouterr()
     estimate = captured.out.splitlines()[-1]
-    assert estimate.startswith("this run takes about ") and "100,000,000,000 rows, about" in estimate
+    assert estimate.startswith("this run takes about ") and "100,000,000,001 rows, about" in estimate
     err = captured.err
     assert err.count("\n") == 1 and "Traceback" not in err
     assert err.startswith("double-pendulum: error: --stop 1e+09 s would take about ")

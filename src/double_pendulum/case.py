@@ -17,9 +17,10 @@ alone starts the lower rod at the FMU's ``phi2_0``, which the user did not choos
 
 The rows go to ``simulation.csv`` as the FMU computes them (:class:`~double_pendulum.runs.row_stream.RowStream`),
 so memory stays flat however long the run; the figure is drawn from at most :data:`FIGURE_ROWS` rows spread over
-the file. Once the first :data:`PROBE_S` seconds of simulated time (and :data:`PROBE_WALL_S` of wall time) are done, the
-run's wall time is estimated from their pace (:class:`Estimate`, told to ``on_estimate``); a run estimated to
-take longer than ``max_wall_s`` stops there and writes nothing (:class:`TooLong`).
+the file. Once the first :data:`PROBE_S` seconds of simulated time and :data:`PROBE_WALL_S` of wall time are done,
+a run still going is estimated from their pace (:class:`Estimate`, told to ``on_estimate``); a run estimated to
+take longer than ``max_wall_s`` stops there and writes nothing (:class:`TooLong`). A run over sooner is not
+estimated.
 
 The files are made in a folder of their own inside the output folder and moved into it once all are written.
 When the FMU stops the run (a bad value it refuses at the start, a step it cannot complete), the rows it returned
@@ -233,9 +234,10 @@ class Estimate:
     csv_bytes: float
 
     def words(self) -> str:
-        """``about 4.2 s (the first 0.5 s of simulated time took 0.21 s; about 3 MB of CSV)``."""
-        return (f"about {duration_words(self.total_wall_s)} (the first {self.probe_s:g} s of simulated time took "
-                f"{_two_digits(self.probe_wall_s)} s; {self.rows:,} rows, about {size_words(self.csv_bytes)} of CSV)")
+        """``about 15 s (the first 65 s of simulated time took 1 s; 100,001 rows, about 36 MB of CSV)``."""
+        return (f"about {duration_words(self.total_wall_s)} (the first {_two_digits(self.probe_s)} s of simulated "
+                f"time took {_two_digits(self.probe_wall_s)} s; {self.rows:,} rows, about {size_words(self.csv_bytes)} "
+                "of CSV)")
 
 
 def duration_words(seconds: float) -> str:
@@ -289,8 +291,8 @@ def run_case(case: Case, out: Path, *, animate: bool = True, max_wall_s: float =
             recorders.append(recorder)
             probe.update(t0=t, wall0=time.perf_counter())
         stream.take(recorder)
-        if "estimate" not in probe and (t - probe["t0"] >= PROBE_S and time.perf_counter() - probe["wall0"]
-                                        >= PROBE_WALL_S or t >= case.stop_time):
+        probed = t - probe["t0"] >= PROBE_S and time.perf_counter() - probe["wall0"] >= PROBE_WALL_S
+        if "estimate" not in probe and probed and t < case.stop_time:
             probe["estimate"] = _estimate(case, probe, t, time.perf_counter() - start, stream)
             if on_estimate is not None:
                 on_estimate(probe["estimate"])
@@ -344,7 +346,7 @@ def _estimate(case: Case, probe: dict[str, Any], t: float, wall_s: float, stream
     included): the pace since the first step, for the rest of the run; the CSV's size from the rows so far."""
     probe_s, probe_wall = t - probe["t0"], time.perf_counter() - probe["wall0"]
     pace = probe_wall / probe_s if probe_s > 0 else 0.0
-    rows = int(round((case.stop_time - probe["t0"]) / case.output_interval)) + 1
+    rows = int(round(case.stop_time / case.output_interval)) + 1  # from t = 0, as fmpy records
     size = stream.path.stat().st_size
     per_row = size / stream.rows if stream.rows else 25.0 * (len(case.outputs) + 1)
     return Estimate(probe_s, probe_wall, wall_s + pace * (case.stop_time - t), rows, per_row * rows)

@@ -53,7 +53,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     """Run a case of one's own through the FMU (:mod:`double_pendulum.case`): CSV, figure, animation, summary."""
     from fmpy import read_model_description
 
-    from ..case import PROBE_S, Case, Estimate, TooLong, run_case, start_state_words
+    from ..case import Case, Estimate, TooLong, run_case, start_state_words
     from ..fmu.running.start_values import StartValueError, parse_start_values
 
     chosen = choose_fmu(args)  # before --out is made: a given FMU that is missing or unusable changes nothing
@@ -79,8 +79,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(f"simulating {case.words()} through {fmu} with fmpy ...", flush=True)
 
         def tell(estimate: Estimate) -> None:
-            if stop >= 10 * PROBE_S:
-                print(f"this run takes {estimate.words()}", flush=True)
+            print(f"this run takes {estimate.words()}", flush=True)
 
         try:
             outcome = run_case(case, out, animate=not args.no_animation, max_wall_s=max_wall, on_estimate=tell)
@@ -131,6 +130,6 @@ def add_simulate_parser(sub: argparse._SubParsersAction) -> None:
     p_sim.add_argument("--no-animation", action="store_true", help="write no simulation.gif")
     p_sim.add_argument("--max-wall", type=float, default=3600.0, metavar="SECONDS",
                        help="the longest the run may take [s of wall time] (default: 3600): the first 0.5 s of "
-                       "simulated time estimate the whole run's time (printed for runs of 5 s or more), and a run "
-                       "estimated to take longer stops there, writing nothing")
+                       "simulated time (and 1 s of wall time) estimate the whole run's time, printed where the run "
+                       "goes on beyond them, and a run estimated to take longer stops there, writing nothing")
     p_sim.set_defaults(func=cmd_simulate)
