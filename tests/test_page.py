@@ -117,7 +117,7 @@ def test_a_report_is_a_web_page_rendered_from_its_markdown_with_tables_and_the_p
     (folder / "report.md").write_text("# Title\n\n## In short\n\nIt **works**.\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n"
                                       "![a figure](fig.png) <script>alert(1)</script>\n")
     (folder / "summary.json").write_text(json.dumps({"x": 1.0}))
-    assert write_report_page(folder) == folder / "report.html"
+    assert write_report_page(folder, STYLE) == folder / "report.html"
     text = (folder / "report.html").read_text()
     assert "<h1>Title</h1>" in text and "<strong>works</strong>" in text
     assert "<table>" in text and "<td>1</td>" in text  # tables enabled
@@ -127,7 +127,7 @@ def test_a_report_is_a_web_page_rendered_from_its_markdown_with_tables_and_the_p
     page_text = page_html(tmp_path, _run(["sc"]), [ScenarioPage("sc", "s", (Headline("x", "x"),))])
     assert 'href="sc/report.html"' in page_text and 'href="sc/report.md"' in page_text
     (tmp_path / "bare").mkdir()
-    assert write_report_page(tmp_path / "bare") is None and list((tmp_path / "bare").iterdir()) == []
+    assert write_report_page(tmp_path / "bare", STYLE) is None and list((tmp_path / "bare").iterdir()) == []
 
 
 def test_an_animation_is_one_player_its_gif_only_where_scripts_cannot_run(tmp_path):

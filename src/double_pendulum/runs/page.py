@@ -459,5 +459,5 @@ def write_index(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> Path:
 
     for page in pages:
         if page.name in run.ran:
-            write_report_page(Path(out) / page.name)
+            write_report_page(Path(out) / page.name, STYLE)
     return write_text(Path(out) / PAGE, page_html(Path(out), run, pages))

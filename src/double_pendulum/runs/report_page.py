@@ -1,8 +1,8 @@
 """A scenario's ``report.md`` as a web page, ``report.html`` beside it, which the run's page links to.
 
 A browser shows a Markdown file as plain text (the reports hold about 15,800 words, with tables): the page is
-rendered by markdown-it-py (CommonMark, with tables), styled by the run page's own style sheet
-(:data:`~double_pendulum.runs.page.STYLE`) and :data:`REPORT_STYLE` (a wide table or a formula scrolls sideways
+rendered by markdown-it-py (CommonMark, with tables), styled by the run page's own style sheet (given:
+:data:`~double_pendulum.runs.page.STYLE`) and :data:`REPORT_STYLE` (a wide table or a formula scrolls sideways
 inside its own box, so that the page is never wider than a phone's screen), with a link back to the scenario's
 section of ``index.html``. Relative links and images keep working: the page sits beside the report. Written
 atomically (:mod:`.results_io`).
@@ -34,23 +34,23 @@ def render_markdown(text: str) -> str:
     return MarkdownIt("commonmark", {"html": False}).enable("table").render(text)
 
 
-def report_html(folder: Path) -> str:
-    """The page of ``folder``'s ``report.md``: its text rendered, a link back to its section of the run's page."""
-    from .page import STYLE  # here: the page imports this module
-
+def report_html(folder: Path, style: str) -> str:
+    """The page of ``folder``'s ``report.md``: its text rendered, a link back to its section of the run's page, the
+    run page's ``style`` sheet and :data:`REPORT_STYLE`."""
     name = folder.name
     back = f'<p class="back"><a href="../index.html#{html.escape(name)}">back to the run\'s page</a></p>'
     body = render_markdown((folder / REPORT).read_text(encoding="utf-8"))
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-            f"<title>{html.escape(name)}: report</title><style>{STYLE}{REPORT_STYLE}</style></head><body>\n"
+            f"<title>{html.escape(name)}: report</title><style>{style}{REPORT_STYLE}</style></head><body>\n"
             f'{back}<article class="report">\n{body}</article>{back}\n</body></html>\n')
 
 
-def write_report_page(folder: Path) -> Path | None:
-    """Write ``folder/report.html`` from ``folder/report.md`` (None, and nothing written, if there is none)."""
+def write_report_page(folder: Path, style: str) -> Path | None:
+    """Write ``folder/report.html`` from ``folder/report.md`` in the run page's ``style`` (None, and nothing written,
+    if there is no report)."""
     from .results_io import write_text
 
     if not (folder / REPORT).is_file():
         return None
-    return write_text(folder / REPORT_PAGE, report_html(folder))
+    return write_text(folder / REPORT_PAGE, report_html(folder, style))
