@@ -1,13 +1,15 @@
 """The FMU driven through its inputs: a motor torque at the pivot, at the slow mode's frequency and away from it.
 
-    python examples/drive_inputs.py [--stop 20] [--fmu PATH]
+    python examples/drive_inputs.py [--stop 20] [--fmu PATH] [--out DIR]
 
 An input signal for fmpy is a structured array: a ``time`` column and one column per input, interpolated
 between its rows. Every input of the FMU is in it (the unused ones zero), so fmpy has no missing input to warn
-about. The energy the motor feeds in is the FMU's output ``W_input``. Writes drive_inputs.png.
+about. The energy the motor feeds in is the FMU's output ``W_input``. Writes drive_inputs.png into the folder
+``--out`` (default: ``examples_output/`` under the current folder, made if missing) and nothing anywhere else.
 """
 
 import argparse
+from pathlib import Path
 
 import matplotlib
 
@@ -36,7 +38,9 @@ def main() -> None:
     parser.add_argument("--stop", type=float, default=20.0, help="length of each run [s] (default: 20)")
     parser.add_argument("--fmu", default=None, help="an FMU of the double pendulum to run, read and never built "
                         "over (default: build/DoublePendulum.fmu, built there if missing or older than the sources)")
-    parser.add_argument("--out", default="drive_inputs.png", help="the figure to write")
+    parser.add_argument("--out", default="examples_output", metavar="DIR",
+                        help="the folder the figure drive_inputs.png goes into, made if missing "
+                        "(default: examples_output)")
     args = parser.parse_args()
     try:  # a path given is only read; the default is built first if missing or older than the sources
         fmu = str(fmu_to_run(args.fmu))
@@ -59,8 +63,10 @@ def main() -> None:
     for ax in (ax_angle, ax_work):
         ax.grid(alpha=0.3)
         ax.legend(loc="upper left", fontsize=8)
-    fig.savefig(args.out, dpi=100)
-    print(f"wrote {args.out}")
+    out = Path(args.out) / "drive_inputs.png"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=100)
+    print(f"wrote {out}")
 
 
 if __name__ == "__main__":

@@ -1,14 +1,17 @@
 """How long until the lower rod first turns over, for every pair of start angles: a parameter sweep.
 
-    python examples/flip_time_sweep.py [--grid 24] [--stop 10] [--workers N] [--fmu PATH]
+    python examples/flip_time_sweep.py [--grid 24] [--stop 10] [--workers N] [--fmu PATH] [--out DIR]
 
 ``run_sweep`` runs the FMU once per case (a dict of start values) on worker processes, one per core, and gives
 the results back in the order of the cases. ``reduce`` is applied on the worker, so only one number per run
 travels back. The workers are started afresh ("spawn"): a script that sweeps must guard its top level with
-``if __name__ == "__main__":``, as here. Writes flip_times.png and prints the share of starts that flip.
+``if __name__ == "__main__":``, as here. Writes flip_times.png into the folder ``--out`` (default:
+``examples_output/`` under the current folder, made if missing), nothing anywhere else, and prints the share of
+starts that flip.
 """
 
 import argparse
+from pathlib import Path
 
 import matplotlib
 
@@ -33,7 +36,9 @@ def main() -> None:
     parser.add_argument("--workers", type=int, default=None, help="worker processes (default: one per core)")
     parser.add_argument("--fmu", default=None, help="an FMU of the double pendulum to run, read and never built "
                         "over (default: build/DoublePendulum.fmu, built there if missing or older than the sources)")
-    parser.add_argument("--out", default="flip_times.png", help="the figure to write")
+    parser.add_argument("--out", default="examples_output", metavar="DIR",
+                        help="the folder the figure flip_times.png goes into, made if missing "
+                        "(default: examples_output)")
     args = parser.parse_args()
     try:  # a path given is only read; the default is built first if missing or older than the sources
         fmu = str(fmu_to_run(args.fmu))
@@ -51,9 +56,11 @@ def main() -> None:
     fig.colorbar(image, ax=ax, label="time until the lower rod first turns over [s]")
     ax.set(xlabel="upper rod's start angle phi1_0 [rad]", ylabel="lower rod's start angle phi2_0 [rad]",
            title=f"first flip of the lower rod (white: none within {args.stop:g} s)", aspect="equal")
-    fig.savefig(args.out, dpi=100)
+    out = Path(args.out) / "flip_times.png"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=100)
     print(f"{np.isfinite(grid).mean():.0%} of {grid.size} starts flip the lower rod within {args.stop:g} s; "
-          f"wrote {args.out}")
+          f"wrote {out}")
 
 
 if __name__ == "__main__":  # the sweep's worker processes import this file: they must not run the sweep again

@@ -222,9 +222,9 @@ CONCLUSIONS: dict[str, str] = {
              "Lyapunov exponent, {0}, and hand releases within 5 mm of each other spread beyond 1 cm after {2}.",
     "energy_decay": "The measured energy decays as E = a exp(b t) with b = {0} (statistical error); the choice of "
                     "weights, window or energy shifts b by up to {1}.",
-    "loss_identification": "Loss models that fit the measured energy about equally well: {0}, air drag's share of the "
-                           "loss {1} among them; where there is more than one, the record does not tell which losses "
-                           "cause the decay.",
+    "loss_identification": "The number of loss models that fit the measured energy about equally well is {0}; among "
+                           "them air drag takes {1} of the loss, and where more than one fits, the record does not "
+                           "tell which losses cause the decay.",
     "base_excitation": "Shaking the pivot at 50 rad/s holds the single pendulum upright from an amplitude of {0} "
                        "(Kapitza), and the simulated resonance peaks are within {2} of the damped linear theory.",
     "cosimulation": "Split into two FMUs, plain exchange converges with order {0} in the macro step, the iterative "
@@ -245,7 +245,8 @@ ANIMATIONS: dict[str, tuple[Animation, ...]] = {
         "twin_starts.gif", "frictionless: two chaotic starts a hair apart",
         drawn=(Drawn("first start", "C0", "chaotic.csv"), Drawn("second start", "C3", "chaotic_nudged.csv"))),),
 }
-"""The players the run's page shows under these GIFs, drawn from the CSV files the GIFs are drawn from
+"""The players the run's page shows in place of these GIFs (each GIF only where scripts cannot run), drawn from the
+CSV files the GIFs are drawn from
 (:class:`~double_pendulum.runs.player.Animation`), with play, pause, step, speed and a time slider."""
 
 

@@ -1,5 +1,6 @@
-"""The examples a user copies run as the README shows them, in a quick form: each writes its figure and says what
-it found. They run as scripts, in processes of their own (the sweep's workers import the script again)."""
+"""The examples a user copies run as the README shows them, in a quick form: each writes its figure into a folder of
+its own and says what it found, and writes nothing else in the folder it runs in. They run as scripts, in processes of
+their own (the sweep's workers import the script again)."""
 
 from __future__ import annotations
 
@@ -28,22 +29,40 @@ def test_every_example_is_linked_from_the_readme_and_guards_its_top_level():
         assert 'if __name__ == "__main__":' in script.read_text(), script.name
 
 
+def _users_cwd(folder: Path) -> Path:
+    """A folder a user runs the example in, holding a file of theirs."""
+    folder.mkdir()
+    (folder / "notes.txt").write_text("the user's own file\n")
+    return folder
+
+
 def test_the_flip_time_sweep_runs_on_worker_processes(fmu_path, tmp_path):
+    """With no --out, the figure goes into examples_output/ under the current folder, and nothing else is written."""
+    cwd = _users_cwd(tmp_path / "work")
+    before = folder_state(cwd)
     out = _run("flip_time_sweep.py", "--grid", "3", "--stop", "1.5", "--workers", "2", "--fmu", str(fmu_path),
-               "--out", "flips.png", cwd=tmp_path)
-    assert "of 9 starts flip the lower rod within 1.5 s; wrote flips.png" in out
-    assert (tmp_path / "flips.png").stat().st_size > 10_000
+               cwd=cwd)
+    assert "of 9 starts flip the lower rod within 1.5 s; wrote examples_output/flip_times.png" in out
+    after = folder_state(cwd)
+    assert sorted(set(after) - set(before)) == ["examples_output", "examples_output/flip_times.png"]
+    assert {name: after[name] for name in before if name != "."} == {n: v for n, v in before.items() if n != "."}
+    assert (cwd / "examples_output" / "flip_times.png").stat().st_size > 10_000
 
 
 def test_the_driven_pendulum_takes_energy_from_the_motor_at_resonance(built_fmus, tmp_path):
     """Through a user's FMU dated 2020 (older than the sources), which the example reads and never builds over."""
     home = users_folder(tmp_path / "home", built_fmus)
-    before = folder_state(home)
-    out = _run("drive_inputs.py", "--stop", "4", "--fmu", str(home / "models" / "Other.fmu"), "--out", "driven.png",
-               cwd=tmp_path)
+    cwd = _users_cwd(tmp_path / "work")
+    before, before_cwd = folder_state(home), folder_state(cwd)
+    out = _run("drive_inputs.py", "--stop", "4", "--fmu", str(home / "models" / "Other.fmu"), "--out", "figures/driven",
+               cwd=cwd)
     assert folder_state(home) == before
+    after_cwd = folder_state(cwd)  # only the folder asked for is new; the user's file is untouched
+    assert sorted(set(after_cwd) - set(before_cwd)) == ["figures", "figures/driven", "figures/driven/drive_inputs.png"]
+    assert after_cwd["notes.txt"] == before_cwd["notes.txt"]
     lines = {line.split(":")[0]: line for line in out.splitlines()}
     fed = {name: float(line.split("work fed in ")[1].split()[0]) for name, line in lines.items() if "work" in line}
     at, off = fed["torque at 4.81 rad/s"], fed["torque at 2.89 rad/s"]
     assert at > 10 * abs(off)  # in resonance the motor does the work
-    assert (tmp_path / "driven.png").stat().st_size > 10_000
+    assert "wrote figures/driven/drive_inputs.png" in out
+    assert (cwd / "figures" / "driven" / "drive_inputs.png").stat().st_size > 10_000

@@ -90,14 +90,23 @@ def test_ctrl_c_ends_every_process_of_the_run_and_leaves_no_temporary_file(tmp_p
 
 
 @pytest.mark.slow
-def test_ctrl_c_on_a_case_of_one_s_own_writes_nothing_and_leaves_nothing(tmp_path, fmu_path):
+def test_ctrl_c_on_a_case_of_one_s_own_keeps_the_rows_so_far_and_leaves_nothing_else(tmp_path, fmu_path):
+    """The rows computed before Ctrl-C are in simulation.csv, every line whole, with a summary.json that says so
+    (an earlier run's files replaced); no figure, no staging folder, no extracted FMU."""
+    import json
+
+    import numpy as np
+
+    from double_pendulum.runs.results_io import read_results_csv
+
     out = tmp_path / "case"
     out.mkdir()
     (out / "summary.json").write_text("an earlier run's\n")
+    (out / "simulation.png").write_text("an earlier run's\n")
     args = ["--stop", "200", "--step", "0.001", "--fmu", str(fmu_path), "--out", str(out)]  # long: 200,000 steps
     process, lines, tmpdir = _start(args, tmp_path, command="simulate")
     try:
-        _wait_for(lines, "simulating", process)
+        _wait_for(lines, "this run takes about", process)  # the probe's second is done
         time.sleep(1.0)  # into the FMU's run
         os.killpg(process.pid, signal.SIGINT)
         code = process.wait(timeout=120)  # a guard against a hang, not a bound on the time
@@ -107,7 +116,13 @@ def test_ctrl_c_on_a_case_of_one_s_own_writes_nothing_and_leaves_nothing(tmp_pat
             process.wait()
     stderr = process.stderr.read()
     assert code == 130, stderr
-    assert "Traceback" not in stderr and "interrupted; nothing was written" in stderr
+    assert "Traceback" not in stderr and "interrupted; wrote the " in stderr and "rows so far, to t = " in stderr
     assert list(tmpdir.iterdir()) == []  # no extracted FMU
-    assert [p.name for p in out.iterdir()] == ["summary.json"]  # no staging folder, the earlier file as it was
-    assert (out / "summary.json").read_text() == "an earlier run's\n"
+    assert sorted(p.name for p in out.iterdir()) == ["simulation.csv", "summary.json"]  # no staging folder
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["status"] == "interrupted by the user"
+    assert (out / "simulation.csv").read_bytes().endswith(b"\n")
+    rows = read_results_csv(out / "simulation.csv")
+    assert len(rows) == summary["rows"] > 1000 and f"{len(rows)} rows so far" in stderr
+    np.testing.assert_allclose(np.diff(rows["time"]), 0.001, rtol=1e-6)  # no row lost or doubled
+    assert rows["time"][0] == 0.0 and rows["time"][-1] == summary["end_time_s"] < 200

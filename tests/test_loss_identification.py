@@ -164,7 +164,10 @@ def test_models_within_two_aic_are_reported_with_weights_and_the_range_of_the_ai
             in out["text"])
     assert "from 10% to 40%" in out["text"]
     assert loss_claims.b_sim_range(rows) == [-0.0256, -0.0252]  # air alone reproduces b as well
-    assert loss_claims.supported_models([{**rows[2], "delta_aic": 0.0}])["air_share_range"] == [1.0, 1.0]
+    alone = loss_claims.supported_models([{**rows[2], "delta_aic": 0.0}])
+    assert alone["air_share_range"] == [1.0, 1.0]
+    assert alone["text"].startswith("One model lies within delta AIC 2 of the lowest, the lowest itself: air drag")
+    assert "It puts air drag's share of the loss at 100%" in alone["text"] and "ranges" not in alone["text"]
 
 
 def test_the_suspension_joins_a_fitted_model_at_each_damping_of_its_scan():

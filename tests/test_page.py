@@ -15,6 +15,7 @@ from browser import Browser, find_chromium
 from double_pendulum.scenarios import ANIMATIONS, CONCLUSIONS, FIGURES, HEADLINES, READING_ORDER, SCENARIOS
 
 from double_pendulum.runs.page import (
+    STYLE,
     Headline,
     RunInfo,
     ScenarioPage,
@@ -26,6 +27,7 @@ from double_pendulum.runs.page import (
     null_reason,
     page_html,
 )
+from double_pendulum.runs.report_page import write_report_page
 
 SRC_OR_HREF = re.compile(r'(?:src|href)="([^"]+)"')
 
@@ -44,7 +46,9 @@ def test_lookup_walks_keys_lists_selectors_and_scales():
 
 @pytest.mark.parametrize("value, uncertainty, text", [
     (-0.02515277933048963, 0.0020621874767029636, "-0.0252 \u00b1 0.0021"),
-    (48.65185663245, 9.2e-05, "48.651857 \u00b1 0.000092"),
+    (48.65185663245, 9.2e-05, "48.65186 \u00b1 0.00009"),  # issue 52: it read 48.651857 +- 0.000092
+    (3.14159, 0.00097, "3.1416 \u00b1 0.0010"), (123.4, 4.2, "123 \u00b1 4"), (1234.5, 97.0, "1230 \u00b1 100"),
+    (1.0, 0.0355, "1.00 \u00b1 0.04"), (0.5, 0.354, "0.50 \u00b1 0.35"),
     (2.062512148422251, 0.0264751271309287, "2.063 \u00b1 0.026"),
     (1.5e-7, 2.5e-8, "(1.50 \u00b1 0.25) \u00d7 10^-7"),
     (19.986653319986655, None, "20.0"), (0.0015656906443263265, None, "0.00157"), (3.436e-09, None, "3.44e-09"),
@@ -52,7 +56,9 @@ def test_lookup_walks_keys_lists_selectors_and_scales():
     ([2.7361, 2.7364], None, "2.74"),  # a range whose ends read the same is one value
     (19, None, "19"), (True, None, "yes"), ("regular", None, "regular"),
 ])
-def test_a_figure_is_shown_with_its_uncertainty_to_two_digits(value, uncertainty, text):
+def test_a_figure_is_shown_to_the_precision_its_uncertainty_supports(value, uncertainty, text):
+    """The uncertainty to two significant digits where its leading ones are 100 to 354, else one (950 to 999 round up
+    to two): the Particle Data Group's rule; the value to the same place."""
     assert format_figure(value, uncertainty) == text
 
 
@@ -105,6 +111,44 @@ def test_the_plain_summary_is_the_report_s_in_short_or_the_summary_s(tmp_path):
     assert in_short(tmp_path, {"in_short": "this"}) == "this"
 
 
+def test_a_report_is_a_web_page_rendered_from_its_markdown_with_tables_and_the_page_s_style(tmp_path):
+    folder = tmp_path / "sc"
+    folder.mkdir()
+    (folder / "report.md").write_text("# Title\n\n## In short\n\nIt **works**.\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n"
+                                      "![a figure](fig.png) <script>alert(1)</script>\n")
+    (folder / "summary.json").write_text(json.dumps({"x": 1.0}))
+    assert write_report_page(folder, STYLE) == folder / "report.html"
+    text = (folder / "report.html").read_text()
+    assert "<h1>Title</h1>" in text and "<strong>works</strong>" in text
+    assert "<table>" in text and "<td>1</td>" in text  # tables enabled
+    assert '<img src="fig.png" alt="a figure"' in text  # relative: the page sits beside the report
+    assert "<script>" not in text and "&lt;script&gt;" in text  # HTML in the text is shown, not run
+    assert STYLE in text and text.count('href="../index.html#sc"') == 2
+    page_text = page_html(tmp_path, _run(["sc"]), [ScenarioPage("sc", "s", (Headline("x", "x"),))])
+    assert 'href="sc/report.html"' in page_text and 'href="sc/report.md"' in page_text
+    (tmp_path / "bare").mkdir()
+    assert write_report_page(tmp_path / "bare", STYLE) is None and list((tmp_path / "bare").iterdir()) == []
+
+
+def test_an_animation_is_one_player_its_gif_only_where_scripts_cannot_run(tmp_path):
+    from double_pendulum.runs.player import Animation, Drawn
+
+    folder = tmp_path / "sc"
+    folder.mkdir()
+    (folder / "run.gif").write_bytes(b"GIF89a" + (640).to_bytes(2, "little") + (480).to_bytes(2, "little"))
+    (folder / "summary.json").write_text(json.dumps({"x": 1.0}))
+    page = ScenarioPage("sc", "s", (Headline("x", "x"),), (("run.gif", "it swings"),),
+                        animations=(Animation("run.gif", "it swings", (Drawn("FMU", "C0", "run.csv"),)),))
+    missing = page_html(tmp_path, _run(["sc"]), [page])  # no CSV for the player: the GIF shows the motion
+    assert 'class="dp-player"' not in missing and missing.count('<img src="sc/run.gif"') == 1
+    assert "<noscript>" not in missing
+    (folder / "run.csv").write_text('"time [s]","x1 [m]","y1 [m]","x2 [m]","y2 [m]"\n0.0,0.1,-0.2,0.2,-0.4\n'
+                                    "0.05,0.11,-0.2,0.21,-0.4\n")
+    text = page_html(tmp_path, _run(["sc"]), [page])
+    assert text.count('class="dp-player"') == 1 and text.count('<img src="sc/run.gif"') == 1
+    assert re.search(r'<noscript><a href="sc/run.gif"><img src="sc/run.gif"[^>]*></a></noscript>', text)
+
+
 def _run(names, failed=()) -> RunInfo:
     return RunInfo(datetime.datetime(2026, 12, 2, 12, 0, tzinfo=datetime.UTC), "0.1.0", "quick", 30.0, 50.0,
                    "double-pendulum run all --quick", tuple(names), tuple(failed))
@@ -155,6 +199,11 @@ def test_the_page_shows_each_scenario_with_the_figures_its_summary_holds(quick_r
         assert 'class="short"' in section, f"{name}: no plain summary"
         assert f'href="{name}/summary.json"' in section
         assert section.count('class="dp-player"') == len(ANIMATIONS.get(name, ())), f"{name}: not every player"
+        for animation in ANIMATIONS.get(name, ()):  # one player; its GIF only where scripts cannot run
+            gif = f'<img src="{name}/{animation.gif}"'
+            assert section.count(gif) == 1 and f"<noscript><a href=\"{name}/{animation.gif}\">{gif}" in section
+        if (quick_results / name / "report.md").is_file():
+            assert f'href="{name}/report.html"' in section
     conclusions = page.split('<section id="conclusions">', 1)[1].split("</section>", 1)[0]
     assert conclusions.count("<li>") == min(5, len(CONCLUSIONS)), "a sentence for each of the first five that ran"
 
@@ -183,20 +232,15 @@ def test_the_page_in_a_real_browser_loads_every_image_plays_the_animations_and_l
         browser.open(index.as_uri())
         images = browser.evaluate(
             "Array.from(document.images).map(i => [i.getAttribute('src'), i.complete && i.naturalWidth > 0])")
-        assert len(images) >= sum(len(figures) for figures in FIGURES.values())
+        players = sum(len(animations) for animations in ANIMATIONS.values())
+        assert len(images) >= sum(len(figures) for figures in FIGURES.values()) - players
         assert [src for src, loaded in images if not loaded] == []
+        assert [src for src, _ in images if src.endswith(".gif")] == []  # a GIF only in <noscript>: not shown
+        assert browser.evaluate("document.querySelectorAll('.dp-player').length") == players
         assert browser.evaluate("document.querySelectorAll('section:not(#conclusions)').length") == len(SCENARIOS)
-        gif = browser.evaluate(
-            "(() => { const i = document.querySelector('img[src$=\"measured_vs_sim.gif\"]'); i.scrollIntoView(); "
-            "const r = i.getBoundingClientRect(); "
-            "return {x: r.x + scrollX, y: r.y + scrollY, width: r.width, height: r.height}; })()")
-        first = browser.screenshot(tmp_path / "gif_1.png", gif).read_bytes()
-        later = first
-        for attempt in range(20):  # the GIF moves on every 50 to 70 ms; a busy machine may draw late
-            later = browser.screenshot(tmp_path / f"gif_{attempt + 2}.png", gif).read_bytes()
-            if later != first:
-                break
-        assert later != first, "the animation does not play"
+        player = "document.querySelector('#measured_vs_sim .dp-player')"
+        browser.evaluate(f"{player}.scrollIntoView(), {player}.querySelector('.dp-play').click()")
+        assert browser.wait_for(f"parseInt({player}.dataset.frame, 10) > 3"), "the player does not play"
         shot = browser.screenshot(tmp_path / "index.png")
         links = browser.evaluate(
             "Array.from(document.querySelectorAll('#contents a, #conclusions a, a[href=\"#top\"]'))"
@@ -205,11 +249,37 @@ def test_the_page_in_a_real_browser_loads_every_image_plays_the_animations_and_l
         assert [href for _, href, found in links if not found] == []  # every link of contents and conclusions lands
         assert {href for where, href, _ in links if where == "contents"} >= {f"#{name}" for name in SCENARIOS}
         assert {href for where, href, _ in links if where == "conclusions"} <= {f"#{name}" for name in SCENARIOS}
-        assert browser.evaluate("getComputedStyle(document.querySelector('a.to-top')).position") == "fixed"
+        top = ("(() => { const a = document.querySelector('a.to-top'), r = a.getBoundingClientRect(), "
+               "b = document.body.getBoundingClientRect(); return [getComputedStyle(a).display, "
+               "getComputedStyle(a).position, r.left >= b.right || r.right <= b.left]; })()")
+        wide = ("Array.from(document.querySelectorAll('figure.wide .frame'))"
+                ".map(f => [f.scrollWidth > f.clientWidth + 50, f.querySelector('img').getBoundingClientRect().width])")
         for width in (1280, 390):  # a desktop window and a phone: never wider than the screen
             browser.emulate(width, 900, mobile=width < 500)
             assert browser.evaluate("document.documentElement.scrollWidth") <= width
+            shown, position, beside = browser.evaluate(top)
+            if width == 1280:  # in the margin beside the text column: it covers no text
+                assert (shown, position, beside) == ("block", "fixed", True)
+            else:  # no margin: no button; each section ends with a link to the top
+                assert shown == "none"
+            frames = browser.evaluate(wide)
+            assert frames, "no figure of several panels side by side"
+            if width == 390:  # wider than the screen, scrolled sideways within their own box
+                assert all(scrolls and image_px >= 800 for scrolls, image_px in frames), frames
+            else:
+                assert not any(scrolls for scrolls, _ in frames), frames
             browser.screenshot(tmp_path / f"top_{width}.png", {"x": 0, "y": 0, "width": width, "height": 1500})
+            section = browser.evaluate(
+                "(() => { const r = document.querySelector('#measured_vs_sim').getBoundingClientRect(); "
+                "return {x: 0, y: r.y + scrollY, width: innerWidth, height: Math.min(r.height, 3000)}; })()")
+            browser.screenshot(tmp_path / f"measured_vs_sim_{width}.png", section)
+        assert browser.errors() == []
+        browser.open((quick_results / "loss_identification" / "report.html").as_uri())
+        for width in (1280, 390):  # the report as a page: its tables, no wider than a phone's screen
+            browser.emulate(width, 900, mobile=width < 500)
+            assert browser.evaluate("document.querySelectorAll('table').length") >= 1
+            assert browser.evaluate("document.documentElement.scrollWidth") <= width
+            browser.screenshot(tmp_path / f"report_{width}.png", {"x": 0, "y": 0, "width": width, "height": 2000})
         assert browser.errors() == []
         assert {urlparse(url).scheme for url in browser.requested_urls()} == {"file"}  # nothing from the network
     assert shot.stat().st_size > 100_000

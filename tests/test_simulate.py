@@ -4,6 +4,7 @@ against the modelDescription, misuse answered in one line, nothing lost or left 
 from __future__ import annotations
 
 import json
+import tempfile
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -223,3 +224,111 @@ def test_the_summary_s_fmpy_call_works_from_any_folder_and_null_means_only_expla
     for key in summary["null_means"]:
         assert summary.get(key) is None, (key, summary.get(key))
     assert outcome.message is None and "fmu_message" in summary["null_means"]
+
+
+def test_one_rule_for_start_angles_in_the_model_the_component_and_the_cli(fmu_path, tmp_path, capsys):
+    """A start angle is any number within +-1e4 rad, used as given: phi1_0 = 9 rad is the state 9 - 2 pi rad, and
+    its run is that one's shifted by a turn. The component (the FMU) and the CLI refuse 2e4 rad in the same words,
+    naming the angle and its value; the CLI before it writes anything."""
+    from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
+    from double_pendulum.model.parameters import MAX_START_ANGLE, ParameterError, check_start_angle
+
+    for value in (9.0, -MAX_START_ANGLE, MAX_START_ANGLE, np.pi + 0.05):
+        check_start_angle("phi2_0", value)
+    for value in (2e4, -1.0001e4, float("nan"), float("inf")):
+        with pytest.raises(ParameterError, match=rf"phi2_0 = {value!r} rad: a start angle must be a finite number "
+                                                 r"from -10000 to 10000 rad"):
+            check_start_angle("phi2_0", value)
+    with pytest.raises(ParameterError, match=r"phi1_0 = 20000.0 rad: a start angle must be"):
+        DoublePendulumCoSimulation().set("phi1_0", 2e4)
+
+    assert main(["simulate", "--set", "phi1_0=2e4", "--fmu", str(fmu_path), "--out", str(tmp_path / "x")]) == 2
+    err = _one_error_line(capsys)
+    assert "--set phi1_0=2e4: invalid phi1_0 = 20000.0 rad: a start angle must be a finite number" in err
+    assert list(tmp_path.iterdir()) == []
+
+    out = tmp_path / "nine"
+    assert main(["simulate", "--set", "phi1_0=9", "--stop", "0.5", "--no-animation", "--fmu", str(fmu_path),
+                 "--out", str(out)]) == 0
+    nine = read_results_csv(out / "simulation.csv")
+    wrapped = simulate_fmu(str(fmu_path), start_values={"phi1_0": 9.0 - 2 * np.pi}, stop_time=0.5,
+                           output_interval=0.01, output=["phi1", "phi2"])
+    assert nine["phi1"][0] == 9.0  # not wrapped: the output counts the turn
+    np.testing.assert_allclose(nine["phi1"] - 2 * np.pi, wrapped["phi1"], atol=1e-6)
+    np.testing.assert_allclose(nine["phi2"], wrapped["phi2"], atol=1e-6)
+
+
+def _growth(fmu_path: Path, tmp_path: Path, monkeypatch, stop: float, batch: int) -> int:
+    """How many memory blocks Python's heap (``sys.getallocatedblocks``) gained over the second half of a run of
+    ``stop`` s at 5 ms, its rows streamed to the CSV file every ``batch`` rows: the most it held then, less what it
+    held at half time (a run's fixed costs, the FMU's instance and the like, come before)."""
+    import sys
+
+    from double_pendulum.runs import row_stream
+
+    monkeypatch.setattr(row_stream, "BATCH_ROWS", batch)
+    held = []
+    take = row_stream.RowStream.take
+
+    def sampled(self, recorder, keep=1):
+        take(self, recorder, keep)
+        if recorder.rows[-1][0] >= stop / 2:
+            held.append(sys.getallocatedblocks())
+
+    monkeypatch.setattr(row_stream.RowStream, "take", sampled)
+    out = Path(tempfile.mkdtemp(dir=tmp_path))
+    outcome = case_module.run_case(case_module.Case(fmu_path, {}, stop, 0.005), out, animate=False)
+    assert outcome.summary["rows"] == round(stop / 0.005) + 1
+    return max(held) - held[0]
+
+
+def test_memory_stays_flat_however_long_the_run(fmu_path, tmp_path, monkeypatch):
+    """Over the second half of a run of N = 2000 steps and of 4N, Python's heap grows by no more than a batch of
+    rows (512 rows, 31 blocks each: 16,000): the rows go to the file as they come. Kept in memory, as fmpy keeps them
+    (a batch larger than the run), the 4N run's second half, 4000 rows, adds 124,000 blocks."""
+    for stop in (10.0, 40.0):
+        assert _growth(fmu_path, tmp_path, monkeypatch, stop, 512) < 20_000
+    assert _growth(fmu_path, tmp_path, monkeypatch, 10.0, 10**9) > 25_000  # the measure sees rows that are kept
+    assert _growth(fmu_path, tmp_path, monkeypatch, 40.0, 10**9) > 100_000
+
+
+def test_the_streamed_csv_holds_fmpy_s_numbers_bit_for_bit(fmu_path, tmp_path, monkeypatch):
+    """Streamed in batches of 64 rows, the file is the one fmpy's whole result gives."""
+    from double_pendulum.runs import row_stream
+
+    monkeypatch.setattr(row_stream, "BATCH_ROWS", 64)
+    out = tmp_path / "streamed"
+    out.mkdir()
+    values = {"phi1_0": 2.0, "air_drag": True}
+    case_module.run_case(case_module.Case(fmu_path, values, 3.0, 0.01), out, animate=False)
+    plain = simulate_fmu(str(fmu_path), start_values=values, stop_time=3.0, output_interval=0.01,
+                         output=list(OUTPUT_NAMES))
+    streamed = read_results_csv(out / "simulation.csv")
+    assert len(streamed) == len(plain) == 301
+    for name in plain.dtype.names:
+        np.testing.assert_array_equal(streamed[name], plain[name], err_msg=name)
+
+
+def test_a_long_run_is_estimated_and_refused_beyond_max_wall(fmu_path, tmp_path, capsys):
+    out = tmp_path / "long"
+    assert main(["simulate", "--stop", "1e9", "--max-wall", "60", "--fmu", str(fmu_path), "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    estimate = captured.out.splitlines()[-1]
+    assert estimate.startswith("this run takes about ") and "100,000,000,001 rows, about" in estimate
+    err = captured.err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("double-pendulum: error: --stop 1e+09 s would take about ")
+    assert "more than --max-wall 60 s" in err and "nothing written (to run it all: --max-wall " in err
+    assert list(out.iterdir()) == []  # the probe's rows are not kept
+
+
+def test_the_estimate_is_near_the_run_s_time(fmu_path, tmp_path, capsys):
+    """The first second of a 200 s run estimates its wall time to within a factor of 2 (the machine's load moves
+    it)."""
+    assert main(["simulate", "--stop", "200", "--no-animation", "--fmu", str(fmu_path), "--out",
+                 str(tmp_path / "o")]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    estimated = lines[1].removeprefix("this run takes about ").split()
+    took = float(lines[2].split(" rows, ")[1].split(" s)")[0])
+    estimated_s = float(estimated[0]) * {"s": 1, "min": 60}[estimated[1]]
+    assert took / 2 < estimated_s < 2 * took, (lines[1], lines[2])

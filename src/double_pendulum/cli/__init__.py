@@ -63,9 +63,9 @@ def main(argv: list[str] | None = None) -> int:
     except CliError as error:
         print(f"{PROG}: error: {error}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        kept = ("nothing was written" if args.command == "simulate"
-                else "finished scenarios are kept, unfinished ones are discarded")
+    except KeyboardInterrupt as interrupt:  # simulate's says what it kept (double_pendulum.case.Interrupted)
+        kept = str(interrupt) or ("nothing was written" if args.command == "simulate"
+                                  else "finished scenarios are kept, unfinished ones are discarded")
         print(f"{PROG}: interrupted; {kept}", file=sys.stderr)
         return 130
     except BrokenPipeError:  # the reader of stdout went away: say nothing more there

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 
 from .common import PROG, CliError, positive, private_tempdir, writable_folder
@@ -29,18 +30,39 @@ def check_fmi(args: argparse.Namespace, fmu: FmuChoice) -> None:
         raise CliError(f"{fmu.path} (FMI {md.fmiVersion}) is model exchange only: pass --me")
 
 
+def check_start_angles(settings: list[str]) -> None:
+    """Check the start angles among ``--set NAME=VALUE`` by the one rule the FMU and the app apply
+    (:func:`~double_pendulum.model.parameters.check_start_angle`), before anything is built or written; a CliError
+    naming the angle and its value if one breaks it. A text that is no number is left to the --set checks."""
+    from ..model.parameters import START_ANGLES, ParameterError, check_start_angle
+
+    for setting in settings:
+        name, _, text = setting.partition("=")
+        if name.strip() in START_ANGLES:
+            try:
+                value = float(text)
+            except ValueError:
+                continue
+            try:
+                check_start_angle(name.strip(), value)
+            except ParameterError as error:
+                raise CliError(f"--set {setting.strip()}: {error}") from None
+
+
 def cmd_simulate(args: argparse.Namespace) -> int:
     """Run a case of one's own through the FMU (:mod:`double_pendulum.case`): CSV, figure, animation, summary."""
     from fmpy import read_model_description
 
-    from ..case import Case, run_case, start_state_words
+    from ..case import Case, Estimate, TooLong, run_case, start_state_words
     from ..fmu.running.start_values import StartValueError, parse_start_values
 
     chosen = choose_fmu(args)  # before --out is made: a given FMU that is missing or unusable changes nothing
     check_fmi(args, chosen)
+    check_start_angles(args.set)
     stop, step = positive("--stop", args.stop), positive("--step", args.step)
     if step > stop:
         raise CliError(f"--step {step:g} s is longer than the run (--stop {stop:g} s)")
+    max_wall = positive("--max-wall", args.max_wall)
     out = writable_folder(args.out)
     with private_tempdir():
         if chosen.given:
@@ -55,7 +77,17 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             raise CliError(str(error)) from None
         case = Case(fmu, values, stop, step, "ModelExchange" if args.me else "CoSimulation")
         print(f"simulating {case.words()} through {fmu} with fmpy ...", flush=True)
-        outcome = run_case(case, out, animate=not args.no_animation)
+
+        def tell(estimate: Estimate) -> None:
+            print(f"this run takes {estimate.words()}", flush=True)
+
+        try:
+            outcome = run_case(case, out, animate=not args.no_animation, max_wall_s=max_wall, on_estimate=tell)
+        except TooLong as error:
+            raise CliError(f"--stop {stop:g} s would take {error.estimate.words()}: more than --max-wall "
+                           f"{max_wall:g} s; stopped after the first {error.estimate.probe_s:.2g} s of it, nothing "
+                           f"written (to run it all: --max-wall {math.ceil(1.2 * error.estimate.total_wall_s)})"
+                           ) from None
     names = ", ".join(path.name for path in outcome.files)
     state = f"start state: {start_state_words(outcome.start_state)}"
     if outcome.message is not None:
@@ -96,4 +128,8 @@ def add_simulate_parser(sub: argparse._SubParsersAction) -> None:
                     "its own version, read from its modelDescription): read as it is, never built or written (an "
                     "error if it is missing or not usable)")
     p_sim.add_argument("--no-animation", action="store_true", help="write no simulation.gif")
+    p_sim.add_argument("--max-wall", type=float, default=3600.0, metavar="SECONDS",
+                       help="the longest the run may take [s of wall time] (default: 3600): the first 0.5 s of "
+                       "simulated time (and 1 s of wall time) estimate the whole run's time, printed where the run "
+                       "goes on beyond them, and a run estimated to take longer stops there, writing nothing")
     p_sim.set_defaults(func=cmd_simulate)

@@ -45,11 +45,13 @@ def spec(
 
 COUNT_MAX = 2**31 - 1  # a count is an FMI Integer (fmi2Integer, fmi3Int32): 32 bits
 MAX_START_ANGLE = 1e4
-"""Largest start angle [rad] (about 1600 turns). The solver's error control is relative to the state's size
-(atol + rtol |phi|), so an angle of 1e300 rad makes every error look small and the run is garbage (its
-energy rose from 3 J to 2438 J without friction before the step size underflowed); an angle is
-2 pi-periodic, so any start is given within this bound, best within (-pi, pi]. At 1e4 rad a double's spacing is
-1.8e-12 rad and rtol = 1e-9 allows 1e-5 rad per step: still a meaningful angle."""
+"""Largest start angle [rad] in size (about 1600 turns): the one rule for a start angle (:func:`check_start_angle`).
+The solver's error control is relative to the state's size (atol + rtol |phi|), so an angle of 1e300 rad makes every
+error look small and the run is garbage (its energy rose from 3 J to 2438 J without friction before the step size
+underflowed). At 1e4 rad a double's spacing is 1.8e-12 rad and rtol = 1e-9 allows 1e-5 rad per step: still a
+meaningful angle."""
+START_ANGLES = ("phi1_0", "phi2_0")
+"""The start angles: the parameters :func:`check_start_angle` checks."""
 
 
 def check_value(name: str, value: Any, unit: str, rule: str) -> None:
@@ -75,9 +77,23 @@ def check_value(name: str, value: Any, unit: str, rule: str) -> None:
         raise ParameterError(f"invalid {shown}: must be > 0")
     if rule == "nonnegative" and not value >= 0.0:
         raise ParameterError(f"invalid {shown}: must be >= 0")
-    if rule == "angle" and not abs(value) <= MAX_START_ANGLE:
-        raise ParameterError(f"invalid {shown}: a start angle must be within +-{MAX_START_ANGLE:g} rad (the solver's "
-                             "error control is relative to it); an angle is 2 pi-periodic: give it within (-pi, pi]")
+    if rule == "angle":
+        check_start_angle(name, value)
+
+
+def check_start_angle(name: str, value: Any) -> None:
+    """The one rule for a start angle (``phi1_0``, ``phi2_0`` [rad]), the same in the FMU, the CLI and the app: any
+    finite real number from -:data:`MAX_START_ANGLE` to +:data:`MAX_START_ANGLE` rad. Angles are 2 pi-periodic, so
+    phi and phi + 2 pi k start the same motion; the start angle is used as given, not wrapped, so the outputs
+    ``phi1``, ``phi2`` (unwrapped: they count the turns) start from it. That lets a run continue another's end state
+    or start an inverted pendulum at pi + 0.05 rad. Raises :class:`ParameterError` naming ``name`` and ``value``."""
+    shown = f"{name} = {value!r} rad"
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ParameterError(f"invalid {shown}: must be a real number")
+    if not abs(value) <= MAX_START_ANGLE:  # NaN fails too
+        raise ParameterError(f"invalid {shown}: a start angle must be a finite number from -{MAX_START_ANGLE:g} to "
+                             f"{MAX_START_ANGLE:g} rad (the solver's error control is relative to it); angles are "
+                             "2 pi-periodic, so give it within (-pi, pi] or near the state you continue")
 
 
 class Validated:

@@ -61,7 +61,7 @@ class ScenarioPage:
     conclusion: str = ""
     """One sentence of the run's conclusions at the top of the page, with ``{0}``, ``{1}``, ... where the headline
     figures of that index go, formatted as in the table (:func:`conclusion`); "" for none."""
-    animations: Sequence[Animation] = ()  # the players shown under their GIFs (:mod:`.player`)
+    animations: Sequence[Animation] = ()  # the players shown in place of their GIFs (:mod:`.player`)
 
 
 @dataclass(frozen=True)
@@ -137,6 +137,17 @@ def _decimals(uncertainty: float, digits: int = 2) -> int:
     return max(0, digits - 1 - math.floor(math.log10(uncertainty)))
 
 
+def rounded_uncertainty(uncertainty: float) -> tuple[float, int]:
+    """``uncertainty`` (> 0) rounded as the Particle Data Group rounds an error, and the place of its last digit (the
+    power of ten: -5 for 0.00009): to two significant digits if its three leading digits are 100 to 354, to one if
+    they are 355 to 949, and 950 to 999 up to 1000, two digits (0.000092 -> 0.00009; 0.0264 -> 0.026;
+    0.00097 -> 0.0010; 97 -> 100). A value is shown to the same place: as precise as its uncertainty supports."""
+    exponent = math.floor(math.log10(uncertainty))
+    leading = round(uncertainty / 10.0 ** (exponent - 2))  # 100 .. 1000
+    place = exponent - 1 if leading <= 354 else exponent
+    return round(uncertainty, -place), place
+
+
 def _is_number(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
@@ -144,7 +155,8 @@ def _is_number(value: Any) -> bool:
 def format_figure(value: Any, uncertainty: Any = None, resolution: Any = None) -> str:
     """A headline value as text, the one format of the page's table and its conclusions.
 
-    A number with its uncertainty u > 0 as ``v +- u`` (u to two significant digits, v to the same decimal); a number
+    A number with its uncertainty u > 0 as ``v +- u`` (u to one or two significant digits,
+    :func:`rounded_uncertainty`, v to the same decimal); a number
     with a ``resolution`` r > 0 (the smallest difference its data resolve) to the decimal of r's first significant
     digit (r = 0.25 s: one decimal); any other float to :data:`SIGNIFICANT` significant digits; a range ``lo to hi``
     (each end so), one value where both ends read the same; yes/no; or the text."""
@@ -159,8 +171,8 @@ def format_figure(value: Any, uncertainty: Any = None, resolution: Any = None) -
         return str(value)
     if _is_number(uncertainty) and uncertainty > 0:
         exponent = math.floor(math.log10(abs(value))) if value and not 1e-3 <= abs(value) < 1e5 else 0
-        v, u = value / 10**exponent, float(uncertainty) / 10**exponent
-        digits = _decimals(u)
+        u, place = rounded_uncertainty(float(uncertainty) / 10**exponent)
+        v, digits = round(value / 10**exponent, -place), max(0, -place)
         text = f"{v:.{digits}f} \u00b1 {u:.{digits}f}"
         return f"({text}) \u00d7 10^{exponent}" if exponent else text
     if not math.isfinite(value) or value == 0:
@@ -237,9 +249,10 @@ def _headline_rows(page: ScenarioPage, summary: Mapping[str, Any]) -> list[str]:
         note = ""
         if line.note:
             try:
-                note = str(lookup(summary, line.note))
+                found = lookup(summary, line.note)
             except (KeyError, IndexError, StopIteration, TypeError):
-                note = ""
+                found = None
+            note = "" if found is None else str(found)  # a null note is no text ("None")
         source = line.value + (f", \u00b1 {line.uncertainty}" if line.uncertainty else "")
         rows.append(f'<tr><td>{html.escape(line.label)}</td><td class="value" title="summary.json: '
                     f'{html.escape(source)}">{html.escape(shown)}</td><td class="note">{html.escape(note)}</td></tr>')
@@ -250,8 +263,9 @@ def _files(folder: Path, shown: set[str]) -> str:
     """The links to a scenario folder's report, summary, CSV files and the figures not shown above."""
     name = folder.name
     parts = []
-    if (folder / "report.md").is_file():
-        parts.append("report: " + _link(f"{name}/report.md", "report.md"))
+    if (folder / "report.md").is_file():  # its page, report.html, is written with index.html (write_index)
+        parts.append("report: " + _link(f"{name}/report.html", "report") + " (its Markdown: "
+                     + _link(f"{name}/report.md", "report.md") + ")")
     parts.append("figures in numbers: " + _link(f"{name}/summary.json", "summary.json"))
     csv = sorted(p.name for p in folder.glob("*.csv"))
     if csv:
@@ -310,13 +324,48 @@ def _section(out: Path, page: ScenarioPage, failed: bool) -> str:
     for name, caption in page.figures:
         if (folder / name).is_file():
             shown.add(name)
-            src = f"{page.name}/{name}"
-            parts.append(f'<figure><a href="{html.escape(src)}"><img src="{html.escape(src)}" '
-                         f'alt="{html.escape(caption)}"></a><figcaption>{html.escape(caption)} '
-                         f"({html.escape(name)})</figcaption></figure>")
-            parts.extend(animation_html(folder, a) for a in page.animations if a.gif == name)
+            parts.append(_figure(folder, page, name, caption))
     parts.append(_files(folder, shown))
     return "\n".join([*parts, BACK]) + "</section>"
+
+
+def _figure(folder: Path, page: ScenarioPage, name: str, caption: str) -> str:
+    """A key figure of the scenario in ``folder``, linked to its file (a tap opens it full size). An animation's GIF
+    with a player (:mod:`.player`) is shown as the player, the one animation where scripts run; the GIF stands in
+    for it only where they cannot (``<noscript>``), or where the player's CSV files are missing."""
+    src = html.escape(f"{page.name}/{name}")
+    image = f'<a href="{src}"><img src="{src}" alt="{html.escape(caption)}"></a>'
+    players = [player for player in (animation_html(folder, a) for a in page.animations if a.gif == name) if player]
+    if players:
+        return (f'<figure class="animation">{"".join(players)}<noscript>{image}</noscript><figcaption>'
+                f'{html.escape(caption)}: play, pause, step or drag the time (the same as a GIF: '
+                f'<a href="{src}">{html.escape(name)}</a>)</figcaption></figure>')
+    size = _pixels(folder / name)
+    if size is not None and size[0] >= WIDE_PX:  # on a phone shown wider than the screen, scrolled in its box
+        return (f'<figure class="wide"><div class="frame">{image}</div><figcaption>{html.escape(caption)} '
+                f'({html.escape(name)})<span class="narrow">: scroll it sideways, or tap it for the full size'
+                "</span></figcaption></figure>")
+    return f"<figure>{image}<figcaption>{html.escape(caption)} ({html.escape(name)})</figcaption></figure>"
+
+
+WIDE_PX = 1100
+"""A figure at least this many pixels wide (several panels side by side: 14 in at 100 dpi is 1400) is shown at
+:data:`PHONE_FIGURE` on a phone, scrolled sideways in its box, so that its labels stay readable."""
+PHONE_FIGURE = "52rem"
+
+
+def _pixels(path: Path) -> tuple[int, int] | None:
+    """Width and height [pixels] of a PNG or GIF file, read from its header (None for another kind of file)."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(24)
+    except OSError:
+        return None
+    if head.startswith(b"\x89PNG\r\n\x1a\n") and len(head) == 24:
+        return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+    if head[:6] in (b"GIF87a", b"GIF89a"):
+        return int.from_bytes(head[6:8], "little"), int.from_bytes(head[8:10], "little")
+    return None
 
 
 STYLE = """
@@ -331,17 +380,25 @@ table.headlines { border-collapse: collapse; margin: 0.8rem 0; } .headlines td, 
 figure { margin: 1rem 0; } img { max-width: 100%; height: auto; border: 1px solid #eee; }
 .failed { color: #a00; font-weight: bold; } .files { font-size: 0.92em; overflow-wrap: anywhere; }
 code { font-size: 0.95em; overflow-wrap: anywhere; } nav li { margin: 0.15rem 0; } .back { font-size: 0.9em; }
-a.to-top { position: fixed; right: 0.8rem; bottom: 0.8rem; padding: 0.2rem 0.6rem; background: #fff;
-  border: 1px solid #bbb; border-radius: 0.3rem; font-size: 0.9em; text-decoration: none; }
+a.to-top { display: none; } .narrow { display: none; } .frame { overflow-x: auto; }
+@media (min-width: 72rem) {
+  a.to-top { display: block; position: fixed; right: 0.8rem; bottom: 0.8rem; padding: 0.2rem 0.6rem; background: #fff;
+    border: 1px solid #bbb; border-radius: 0.3rem; font-size: 0.9em; text-decoration: none; }
+}
 @media (max-width: 40rem) {
+  figure.wide img { width: PHONE_FIGURE; max-width: none; } .narrow { display: inline; }
   body { margin: 0.8rem auto; padding: 0 0.7rem; } h1 { font-size: 1.35rem; }
   .headlines thead { display: none; } .headlines tr { display: block; border-bottom: 1px solid #e4e4e4;
     padding: 0.35rem 0; } .headlines td { display: block; border: none; padding: 0.05rem 0; }
   .headlines .value { white-space: normal; font-weight: bold; } .headlines .note:empty { display: none; }
 }
 """
+STYLE = STYLE.replace("PHONE_FIGURE", PHONE_FIGURE)
 """The page's style sheet. Below 40rem (a phone) a headline table's rows become blocks, label above value above
-note, so that the page is never wider than the screen."""
+note, so that the page is never wider than the screen, and a wide figure is shown at :data:`PHONE_FIGURE`, scrolled
+sideways in its box (a tap opens it full size). The "top" button sits in the margin beside the 62rem column, so only
+where there is one (72rem and wider): nowhere does it cover text; below that each section ends with a link to the
+top."""
 
 
 MOST_CONCLUSIONS = 5
@@ -404,7 +461,12 @@ def page_html(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> str:
 
 
 def write_index(out: Path, run: RunInfo, pages: Sequence[ScenarioPage]) -> Path:
-    """Write ``out/index.html`` (:func:`page_html`), atomically; return its path."""
+    """Write ``out/index.html`` (:func:`page_html`) and the report page of each scenario of the run that has a
+    ``report.md`` (:mod:`.report_page`), atomically; return the index's path."""
+    from .report_page import write_report_page
     from .results_io import write_text
 
+    for page in pages:
+        if page.name in run.ran:
+            write_report_page(Path(out) / page.name, STYLE)
     return write_text(Path(out) / PAGE, page_html(Path(out), run, pages))

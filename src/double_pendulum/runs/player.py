@@ -46,8 +46,9 @@ class Drawn:
 
 @dataclass(frozen=True)
 class Animation:
-    """A player the run's page shows beside the GIF ``gif``, drawn from the CSV files of :class:`Drawn` over their
-    column ``time`` [s] (at most ``until_s`` seconds of it; None: all), with ``title`` above it."""
+    """A player the run's page shows in place of the GIF ``gif`` (the GIF only where scripts cannot run), drawn from
+    the CSV files of :class:`Drawn` over their column ``time`` [s] (at most ``until_s`` seconds of it; None: all),
+    with ``title`` above it."""
 
     gif: str
     title: str
@@ -204,7 +205,7 @@ def standalone_html(data: Mapping[str, Any], element_id: str = "player") -> str:
 
 def animation_html(folder: Path, animation: Animation) -> str:
     """The player of ``animation`` drawn from the CSV files in the scenario's ``folder`` ("" when one is missing
-    or cannot be read: the GIF beside it still shows the motion)."""
+    or cannot be read: the page then shows the GIF instead)."""
     from .results_io import read_results_csv  # here: the page imports this module, and NumPy is slow
 
     tables: dict[str, Any] = {}

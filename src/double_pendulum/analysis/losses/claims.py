@@ -78,10 +78,15 @@ def supported_models(rows: Sequence[Mapping[str, Any]], daic: float = SUPPORTED_
                       for name, m in models.items())  # fmt: skip
     same = "".join(f" {model_title(name)} fits no better than {model_title(other)}, which it contains (its extra "
                    "mechanism fitted to nothing), so it is no candidate of its own." for name, other in reduced.items())
-    text = (f"{len(models)} models lie within delta AIC {daic:g} of the lowest: {parts}.{same} The energy record does "
-            "not rank them, so none is the model and no split of the loss is measured: "
-            + (f"the air-drag share ranges from {min(air):.0%} to {max(air):.0%} across them, depending on which "
-               "mechanism is assumed beside it or instead of it." if air else "none of them has air drag."))
+    if len(models) == 1:  # a sentence of its own: "1 models lie within ...; the share ranges from 37% to 37%"
+        text = (f"One model lies within delta AIC {daic:g} of the lowest, the lowest itself: {parts}.{same} "
+                + (f"It puts air drag's share of the loss at {max(air):.0%}; that holds only among the candidates "
+                   "fitted." if air else "It has no air drag."))
+    else:
+        text = (f"{len(models)} models lie within delta AIC {daic:g} of the lowest: {parts}.{same} The energy record "
+                "does not rank them, so none is the model and no split of the loss is measured: "
+                + (f"the air-drag share ranges from {min(air):.0%} to {max(air):.0%} across them, depending on which "
+                   "mechanism is assumed beside it or instead of it." if air else "none of them has air drag."))
     return {"daic": daic, "models": models, "n_models": len(models), "reduced": reduced,
             "air_share_range": [min(air), max(air)] if air else None, "text": text}
 
