@@ -270,6 +270,7 @@ def test_the_run_against_the_measured_track_is_the_fmpy_call_it_shows(fmu_path):
     frames = np.rint((np.asarray(answer["columns"]["time"]) - answer["start_time"]) / answer["output_interval"])
     np.testing.assert_allclose(moved[frames.astype(int), 2], answer["columns"]["x2_simulated"], rtol=1e-12, atol=1e-15)
     assert answer["horizon"]["horizon_s"] > 1.0  # the fitted start follows the track (quick: the 0.5 s fit)
+    assert len(answer["error_smoothed"]) == len(answer["columns"]["time"])  # the horizon's curve, drawn beside
 
 
 def test_a_run_the_fmu_cannot_complete_answers_the_fmu_s_own_message(fmu_path):

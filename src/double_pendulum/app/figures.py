@@ -89,8 +89,10 @@ def separation_figure(c: Mapping[str, Sequence[float]], twin: Mapping[str, Seque
     return (f"two starts a hair apart (phi1_0 and phi1_0 + {nudge:g} rad): how far apart their lower bobs are"), fig
 
 
-def measured_figures(c: Mapping[str, Sequence[float]], t0: float) -> tuple[Titled, Titled]:
-    """The measured and simulated lower bob [m] in the x-y plane, and their distance [m] over time since t0 [s]."""
+def measured_figures(c: Mapping[str, Sequence[float]], t0: float, error_smoothed: Sequence[float],
+                     smoothing_s: float) -> tuple[Titled, Titled]:  # fmt: skip
+    """The measured and simulated lower bob [m] in the x-y plane, and their distance [m] over time since t0 [s],
+    frame by frame and smoothed over ``smoothing_s`` [s] as the horizon is (``error_smoothed``)."""
     paths = _figure("horizontal position x [m]", "vertical position y [m] (up)")
     paths.add_scatter(x=c["x2_measured"], y=c["y2_measured"], mode="markers", marker=dict(size=3, color="black"),
                       name="measured (camera, one dot a frame)")
@@ -98,9 +100,12 @@ def measured_figures(c: Mapping[str, Sequence[float]], t0: float) -> tuple[Title
                       name="simulated (FMU): the fitted start")
     paths.update_yaxes(scaleanchor="x", scaleratio=1)
     error = np.hypot(np.subtract(c["x2_simulated"], c["x2_measured"]), np.subtract(c["y2_simulated"], c["y2_measured"]))
-    errors = _figure("time since t0 [s]", "distance [m]", showlegend=False)
-    errors.add_scatter(x=c["t_since_t0"], y=error.tolist(), mode="lines", name="lower bob")
+    errors = _figure("time since t0 [s]", "distance [m]")
+    errors.add_scatter(x=c["t_since_t0"], y=error.tolist(), mode="lines", name="frame by frame",
+                       line=dict(width=1, color="#9db4e8"))
+    errors.add_scatter(x=c["t_since_t0"], y=list(error_smoothed), mode="lines", name=f"smoothed over {smoothing_s:g} s",
+                       line=dict(width=2, color="#1f3f99"))
     errors.add_hline(y=0.05, line=dict(color="grey", dash="dot"), annotation_text="5 cm",
                      annotation_position="top left")
     return ((f"against the measured track: the lower bob from t0 = {t0:.2f} s", paths),
-            ("how far the simulated lower bob is from the measured one, frame by frame", errors))
+            ("how far the simulated lower bob is from the measured one", errors))

@@ -64,7 +64,8 @@ def run_measured(fmu: str, *, quick: bool = False, progress: Callable[[float], N
     table (:func:`~double_pendulum.analysis.prediction.paths.paths_table`) as ``columns``, the FMU's own rows as
     ``simulated``, the run as fmpy is given it (``start_values``, ``start_time``, ``stop_time``,
     ``output_interval`` [s], ``outputs``: :func:`call_text`) and the camera geometry's ``transforms``, ``used``
-    (every value the run takes, for the page), ``horizon`` (the lower bob's smoothed 5 cm horizon), ``t0`` [s] and
+    (every value the run takes, for the page), ``horizon`` (the lower bob's smoothed 5 cm horizon), the lower bob's
+    error smoothed as the horizon smooths it (``error_smoothed`` [m], over ``smoothing_s``), ``t0`` [s] and
     ``losses``. ``progress`` is told the fraction done (0 to 1)."""
     from double_pendulum.scenarios.measured_vs_sim import (
         GEOMETRY_FIT_FRAMES,
@@ -83,6 +84,7 @@ def run_measured(fmu: str, *, quick: bool = False, progress: Callable[[float], N
         nearest_frame,
         predict,
         prediction_start_values,
+        smoothed,
     )
     from ..analysis.prediction.paths import paths_table
     from ..analysis.track.measurement import FRAME_INTERVAL
@@ -126,6 +128,7 @@ def run_measured(fmu: str, *, quick: bool = False, progress: Callable[[float], N
             "start_values": start_values, "start_time": t0, "stop_time": t0 + span, "output_interval": FRAME_INTERVAL,
             "outputs": list(RUN_OUTPUTS), "transforms": transforms, "message": None, "used": used, "t0": t0,
             "span_s": span, "fit_frames": fit.n_frames, "smoothing_s": SMOOTHING_S,
+            "error_smoothed": smoothed(prediction.t, prediction.e2).tolist(),
             "horizon": headline_horizon(prediction, span), "losses": {k: _plain(v) for k, v in losses.losses.items()}}
 
 
