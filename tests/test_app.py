@@ -1,11 +1,17 @@
 """The interactive app (``double-pendulum app``) and the run page's player, in a real browser (headless Chromium over
-the DevTools protocol, tests/browser.py): a run's final angle is the bare ``simulate_fmu``'s, a refused value says
-why beside its field, a run the FMU cannot complete shows the FMU's message, and the page's player scrubs."""
+the DevTools protocol, tests/browser.py): a run's final angle is the bare ``simulate_fmu``'s and the fmpy call it
+shows gives it, a refused value says why beside its field as it is typed, the fields that do not apply are disabled,
+the run button is on the first screen and Enter runs, the player comes into view, 390 px fit, a run the FMU cannot
+complete shows the FMU's message, the run against the measured track is the call it shows, the app takes a free port
+and refuses a busy one in a line, and the page's player scrubs."""
 
 from __future__ import annotations
 
 import datetime
 import importlib.util
+import json
+import math
+import re
 import signal
 import socket
 import subprocess
@@ -13,11 +19,12 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from browser import Browser, find_chromium
 
-from double_pendulum.app.form import check_form, default_values
+from double_pendulum.app.form import LOSSES, NUMBER_FIELDS, OWN_PENDULUM, SUSPENSION, check_form, default_values
 from double_pendulum.runs.page import RunInfo, ScenarioPage, page_html
 from double_pendulum.runs.player import Animation, Drawn
 from double_pendulum.runs.results_io import write_results_csv
@@ -41,30 +48,59 @@ def test_the_form_refuses_a_value_out_of_range_or_not_a_number_with_the_reason()
     assert checked.start_values["phi1_0"] == 2.0 and checked.stop_time == 20.0
 
 
+def test_a_field_that_does_not_apply_is_neither_checked_nor_used_and_one_that_does_is_refused_in_the_fmu_s_words():
+    own = check_form({**default_values(), "pendulum": "own", "m1": "-0.3"})
+    assert own.errors == {"m1": "invalid m1 = -0.3 kg: must be > 0"} and own.start_values == {}
+    seed = check_form({**default_values(), "pendulum": "seed", "m1": "-0.3"})  # m1 is disabled then
+    assert seed.errors == {} and "m1" not in seed.start_values and seed.start_values["m_rod1"] == 0.07
+    assert check_form({**default_values(), "pendulum": "own", "m1": "2.0"}).start_values["m1"] == 2.0
+    measured = check_form({**default_values(), "mode": "measured", "phi1_0": "x", "m1": "-1"})
+    assert measured.errors == {} and measured.start_values == {}  # the form does not apply there
+
+
+@pytest.mark.parametrize("field", [f for f in NUMBER_FIELDS if f.name != "stop_time"], ids=lambda f: f.name)
+def test_every_value_the_fmu_s_component_refuses_is_refused_beside_its_field(field):
+    """The component's own check of a start value (what the FMU does with it before it runs) against the form's:
+    whatever the component refuses, the form refuses, under that field, with the component's message."""
+    from double_pendulum.component.cosimulation import DoublePendulumCoSimulation
+    from double_pendulum.model.parameters import ParameterError
+
+    form = {**default_values(), "pendulum": "own", "switches": list(LOSSES), "suspension": True}
+    refused = 0
+    for value in (-1e6, -1.0, -1e-9, 0.0, 1e-9, 1.0, 2e4, 1e9, math.inf, -math.inf, math.nan):
+        try:
+            DoublePendulumCoSimulation().set(field.name, value)  # as the FMU sets a start value
+        except ParameterError as error:
+            refused += 1
+            assert check_form({**form, field.name: repr(value)}).errors == {field.name: str(error)}
+    assert refused >= 3  # nan and both infinities at least
+    assert {f.name for f in (*OWN_PENDULUM, *SUSPENSION)} <= {f.name for f in NUMBER_FIELDS}
+
+
+def _launch(fmu_path: Path, printed: Path, *port: str) -> subprocess.Popen:
+    with printed.open("w") as out:
+        return subprocess.Popen([sys.executable, "-m", "double_pendulum.app.server", *port, "--fmu", str(fmu_path)],
+                                stdout=out, stderr=subprocess.STDOUT, text=True)
+
+
 @pytest.fixture(scope="module")
 def app_url(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory):
-    """The app served by ``python -m double_pendulum.app.server`` on a free port: its address. What the server
-    prints goes to a file (a pipe nobody reads while the tests run would fill and stop the server)."""
+    """The app served by ``python -m double_pendulum.app.server`` without ``--port``: on the free port it prints.
+    What the server prints goes to a file (a pipe nobody reads while the tests run would fill and stop the
+    server)."""
     if NO_DASH:
         pytest.skip("Dash is not installed (pip install -e \".[app]\")")
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        port = s.getsockname()[1]
     printed = tmp_path_factory.mktemp("app") / "printed.txt"
-    with printed.open("w") as out:
-        server = subprocess.Popen([sys.executable, "-m", "double_pendulum.app.server", "--port", str(port), "--fmu",
-                                   str(fmu_path)], stdout=out, stderr=subprocess.STDOUT, text=True)
+    server = _launch(fmu_path, printed)
     try:
         deadline = time.monotonic() + 60
-        while True:  # the address is printed before the server listens
-            try:
-                socket.create_connection(("127.0.0.1", port), timeout=1).close()
-                break
-            except OSError:
-                assert time.monotonic() < deadline and server.poll() is None, "the app did not start: " + (
-                    printed.read_text())
-                time.sleep(0.2)
-        assert f"open http://127.0.0.1:{port}/ in a browser" in printed.read_text().splitlines()[0]
+        while not (found := re.search(r"open http://127\.0\.0\.1:(\d+)/ in a browser", printed.read_text())):
+            started = time.monotonic() < deadline and server.poll() is None
+            assert started, f"the app did not start: {printed.read_text()}"
+            time.sleep(0.1)
+        port = int(found.group(1))
+        assert port != 8050  # FMPy's web app's
+        socket.create_connection(("127.0.0.1", port), timeout=5).close()  # it listens before it says so
         yield f"http://127.0.0.1:{port}/"
     finally:
         server.send_signal(signal.SIGINT)  # as Ctrl-C: the app ends its runs and its fork server cleans up
@@ -73,34 +109,168 @@ def app_url(fmu_path: Path, tmp_path_factory: pytest.TempPathFactory):
     assert text.rstrip().endswith("double-pendulum app: ended") and '"GET ' not in text and '"POST ' not in text, text
 
 
+@needs_dash
+def test_a_port_in_use_is_one_line_naming_it_and_exit_status_2(fmu_path, tmp_path):
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        printed = tmp_path / "printed.txt"
+        server = _launch(fmu_path, printed, "--port", str(port))
+        assert server.wait(timeout=60) == 2
+    lines = printed.read_text().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"double-pendulum app: --port {port}: the port is in use"), lines
+
+
+def _press_enter(browser: Browser, selector: str) -> None:
+    """Focus the field ``selector`` and press Enter in it, as a user does."""
+    browser.evaluate(f"document.querySelector({json.dumps(selector)}).focus()")
+    for kind in ("keyDown", "keyUp"):
+        browser.send("Input.dispatchKeyEvent", type=kind, key="Enter", code="Enter", windowsVirtualKeyCode=13,
+                     nativeVirtualKeyCode=13, **({"text": "\r"} if kind == "keyDown" else {}))
+
+
+def _run_the_call(text: str) -> Any:
+    """The fmpy call the app shows, run: its ``result``."""
+    namespace: dict[str, Any] = {}
+    exec(compile(text, "<the app's fmpy call>", "exec"), namespace)  # the Python the page gives, as a user runs it
+    return namespace["result"]
+
+
+RECT = "(s => {{ const r = document.querySelector(s).getBoundingClientRect(); return [r.top, r.bottom, r.right]; }})"
+CUT = """(() => {
+    const cut = [];
+    for (const box of document.querySelectorAll('.results-panel > div[id$="-box"]')) {
+        if (box.style.display === 'none') continue;
+        const title = box.querySelector('h3'), svg = box.querySelector('.main-svg').getBoundingClientRect();
+        if (title.scrollWidth > title.clientWidth || title.getBoundingClientRect().right > innerWidth)
+            cut.push(box.id + ' title');
+        for (const t of box.querySelectorAll('.legend text, .gtitle, .xtitle, .ytitle')) {
+            const r = t.getBoundingClientRect();
+            if (r.width && (r.left < svg.left - 1 || r.right > svg.right + 1 || r.left < 0 || r.right > innerWidth))
+                cut.push(box.id + ': ' + t.textContent);
+        }
+    }
+    return cut;
+})()"""
+"""What is cut among the visible plots: a title wider than its box or the screen, a legend entry or axis title that
+reaches out of its figure or off the screen."""
+
+
 @needs_browser
 @needs_dash
 def test_the_app_runs_the_fmu_as_simulate_fmu_and_refuses_a_bad_value_beside_its_field(app_url, fmu_path, tmp_path):
-    from fmpy import simulate_fmu
-
-    with Browser(BROWSER, width=1400, height=1000) as browser:
+    with Browser(BROWSER, width=1280, height=800) as browser:
         browser.open(app_url)
+        browser.emulate(1280, 800, mobile=False)
+        browser.wait_for("document.querySelector('#in-m1') !== null")
+        top, bottom, _ = browser.evaluate(f"{RECT}('#run')")
+        assert 0 < top and bottom <= 800, "the run button must be on the first screen"
+        browser.screenshot(tmp_path / "app-1280-before.png", clip={"x": 0, "y": 0, "width": 1280, "height": 800})
+        # the seed's pendulum: its masses and lengths are disabled, and the page says why
+        assert browser.evaluate("document.querySelector('#in-m1').disabled")
+        assert "do not apply" in browser.wait_for("document.querySelector('#pendulum-note').textContent")
+        browser.click("#pendulum input[value='own']")
+        browser.wait_for("!document.querySelector('#in-m1').disabled")
+        browser.type_into("#in-m1", "-0.3")  # refused beside m1 as it is typed, before any run
+        assert browser.wait_for("document.querySelector('#err-m1').textContent") == "invalid m1 = -0.3 kg: must be > 0"
+        browser.click("#run")
+        assert browser.wait_for("document.querySelector('#status').textContent") == (
+            "some values are refused: see the messages under them")
+        assert browser.evaluate("document.activeElement.id") == "in-m1"  # the first refused field, in view
+        browser.type_into("#in-m1", "2.0")
+        browser.wait_for("document.querySelector('#err-m1').textContent === ''")
         browser.type_into("#in-phi1_0", "2.0")
         browser.click("#switch-air_drag input")
-        browser.click("#run")
+        browser.evaluate("window.scrollTo(0, document.body.scrollHeight)")  # as after typing far down the form
+        _press_enter(browser, "#in-rtol")  # Enter in a field runs
         assert browser.wait_for(DONE) == "done"
         final = browser.wait_for("(() => { const g = document.querySelector('#angles .js-plotly-plot'); "
                                  "return g && g.data ? g.data.map(d => d.y[d.y.length - 1]) : null; })()")
-        browser.screenshot(tmp_path / "app.png")
-        form = {**default_values(), "phi1_0": "2.0", "switches": ["air_drag"]}
+        call = browser.evaluate("document.querySelector('#fmpy-call').textContent")
+        top, bottom, _ = browser.wait_for(f"(() => {{ const r = {RECT}('#player'); return r[0] < 60 ? r : null; }})()")
+        assert -1 <= top and bottom > 300, "after a run the player is in view"
+        browser.screenshot(tmp_path / "app-1280-after.png")
+        form = {**default_values(), "phi1_0": "2.0", "switches": ["air_drag"], "pendulum": "own", "m1": "2.0"}
         checked = check_form(form)
-        bare = simulate_fmu(str(fmu_path), start_values=checked.start_values, stop_time=checked.stop_time,
-                            output_interval=0.01)
-        assert final == [pytest.approx(bare["phi1"][-1], rel=1e-12), pytest.approx(bare["phi2"][-1], rel=1e-12)]
-        assert "fmpy.simulate_fmu(" in browser.evaluate("document.querySelector('#fmpy-call').textContent")
+        assert "'m1': 2.0" in call and f"start_values={checked.start_values!r}" in call, call
+        shown = _run_the_call(call)  # the call shown, as a user runs it, gives the plotted run
+        assert final == [pytest.approx(shown["phi1"][-1], rel=1e-12), pytest.approx(shown["phi2"][-1], rel=1e-12)]
         assert browser.evaluate("document.querySelector('#player').srcdoc.includes('dpPlayer')")
 
-        browser.type_into("#in-phi1_0", "9")
+        browser.click("#mode input[value='twins']")  # the twins' plot: its title whole at 1280 px
+        browser.type_into("#in-stop_time", "3")
         browser.click("#run")
+        browser.wait_for("document.querySelector('#compare-box').style.display === 'block' && "
+                         "document.querySelector('#status').textContent === 'done'")
+        assert "a hair apart" in browser.evaluate("document.querySelector('#compare-title').textContent")
+        assert browser.evaluate(CUT) == []
+
+        browser.click("#mode input[value='measured']")  # against the measured track the form does not apply
+        browser.wait_for("document.querySelector('#mode-note').style.display === 'block'")
+        assert browser.evaluate("[...document.querySelectorAll('.form-panel fieldset input[type=text]')]"
+                                ".every(e => e.disabled)")
+        assert "does not apply" in browser.evaluate("document.querySelector('#mode-note').textContent")
+
+        browser.click("#mode input[value='case']")  # back to one's case: a bad value is refused beside its field
+        browser.wait_for("!document.querySelector('#in-phi1_0').disabled")
+        browser.type_into("#in-phi1_0", "9")
         message = browser.wait_for("document.querySelector('#err-phi1_0').textContent")
         assert message == "phi1_0 = 9 is out of range: -3.14159 to 3.14159 rad"
-        assert "refused" in browser.evaluate("document.querySelector('#status').textContent")
         assert browser.errors() == []
+
+
+@needs_browser
+@needs_dash
+def test_at_390_px_the_app_fits_the_screen_and_cuts_no_title_or_legend(app_url, tmp_path):
+    with Browser(BROWSER, width=390, height=844) as browser:
+        browser.open(app_url)
+        browser.emulate(390, 844)
+        browser.wait_for("document.querySelector('#run') !== null")
+        assert browser.evaluate("document.documentElement.scrollWidth") <= 390
+        assert browser.evaluate(f"{RECT}('#run')")[1] <= 844
+        browser.screenshot(tmp_path / "app-390-before.png")
+        browser.type_into("#in-stop_time", "4")
+        browser.click("#switch-air_drag input")
+        browser.click("#run")
+        assert browser.wait_for(DONE) == "done"
+        browser.wait_for("document.querySelector('#budget .legend') !== null")
+        top, bottom, right = browser.wait_for(f"(() => {{ const r = {RECT}('#player'); "
+                                              "return Math.abs(r[0]) < 2 ? r : null; })()")
+        assert right <= 390 and bottom - top > 300  # in view, as wide as the screen allows, whole
+        time.sleep(0.5)  # Plotly's responsive resize
+        assert browser.evaluate("document.documentElement.scrollWidth") <= 390
+        assert browser.evaluate(CUT) == []
+        browser.screenshot(tmp_path / "app-390-after.png")
+        assert browser.errors() == []
+
+
+def test_the_run_against_the_measured_track_is_the_fmpy_call_it_shows(fmu_path):
+    """The fitted start of measured_vs_sim (quick mode here, the tests' stand-in for the same code: a 0.5 s fit
+    window, 3 s of record): the call the app shows, run with fmpy, gives the app's run bit for bit, and moved by the
+    fitted camera geometry it gives the positions the app compares with the camera's."""
+    import numpy as np
+
+    from double_pendulum.analysis.track.start_state import POSITION_OUTPUTS, output_matrix, shift_outputs
+    from double_pendulum.app.measured import call_text, run_measured
+
+    answer = run_measured(str(fmu_path), quick=True)
+    call = call_text(str(fmu_path), answer)
+    shown = _run_the_call(call)
+    for name in shown.dtype.names:
+        np.testing.assert_allclose(shown[name], answer["simulated"][name], rtol=1e-12, atol=1e-15)
+    assert answer["start_time"] == pytest.approx(0.8008, abs=1e-4) and f"start_time={answer['start_time']!r}" in call
+    for name, value in answer["start_values"].items():  # every start value it took is in the call and in the list
+        assert f"{name!r}: {value!r}" in call
+    assert {u["name"] for u in answer["used"]} == {*answer["start_values"], *answer["transforms"]}
+    assert set(answer["transforms"]) == {"view_rotation", "pivot_offset_x", "pivot_offset_y"}
+    fitted = {u["name"] for u in answer["used"] if u["what"].startswith("fitted to the track")}
+    assert fitted == {"phi1_0", "phi2_0", "omega1_0", "omega2_0", "l2", *answer["transforms"]}
+    moved = shift_outputs(output_matrix(shown), POSITION_OUTPUTS, answer["transforms"])
+    frames = np.rint((np.asarray(answer["columns"]["time"]) - answer["start_time"]) / answer["output_interval"])
+    np.testing.assert_allclose(moved[frames.astype(int), 2], answer["columns"]["x2_simulated"], rtol=1e-12, atol=1e-15)
+    assert answer["horizon"]["horizon_s"] > 1.0  # the fitted start follows the track (quick: the 0.5 s fit)
+    assert len(answer["error_smoothed"]) == len(answer["columns"]["time"])  # the horizon's curve, drawn beside
 
 
 def test_a_run_the_fmu_cannot_complete_answers_the_fmu_s_own_message(fmu_path):

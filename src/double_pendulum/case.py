@@ -74,8 +74,8 @@ the downward vertical and their rates omega1_0, omega2_0 [rad/s] (the model's
 @dataclass(frozen=True)
 class Case:
     """A run of the FMU file ``fmu`` as :func:`fmpy.simulate_fmu` makes it: ``fmi_type``, the ``start_values``,
-    ``stop_time`` [s], ``output_interval`` [s] (also the communication step of a co-simulation) and the
-    quantities recorded, ``outputs`` (the FMU's outputs and its local diagnostics: every quantity)."""
+    ``stop_time`` [s], ``output_interval`` [s] (also the communication step of a co-simulation), the quantities
+    recorded, ``outputs`` (the FMU's outputs and its local diagnostics: every quantity), and ``start_time`` [s]."""
 
     fmu: Path
     start_values: dict[str, Any] = field(default_factory=dict)
@@ -83,12 +83,15 @@ class Case:
     output_interval: float = 0.01
     fmi_type: str = "CoSimulation"
     outputs: tuple[str, ...] = OUTPUT_NAMES
+    start_time: float = 0.0
 
     def fmpy_call(self) -> str:
         """The Python call that gives the same numbers, from any folder (the FMU's absolute path); it names
         what it records, as fmpy records only the FMU's outputs by default."""
         return (f"fmpy.simulate_fmu({str(Path(self.fmu).resolve())!r}, fmi_type={self.fmi_type!r}, "
-                f"start_values={self.start_values!r}, stop_time={self.stop_time!r}, "
+                f"start_values={self.start_values!r}, "
+                + (f"start_time={self.start_time!r}, " if self.start_time else "")
+                + f"stop_time={self.stop_time!r}, "
                 f"output_interval={self.output_interval!r}, output={list(self.outputs)!r})")
 
     def words(self) -> str:

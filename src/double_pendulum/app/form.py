@@ -2,9 +2,13 @@
 (:mod:`double_pendulum.model.parameters`, :mod:`double_pendulum.component.settings`), a range the app offers, and
 the check of a whole form into FMU start values or messages per field.
 
-A value is refused when it is not a number, when it lies outside the field's :class:`Field` range (the app's
-ranges: what a lab pendulum sensibly has; the FMU accepts more), or when the component itself refuses it
-(:func:`~double_pendulum.model.parameters.check_value`, the rule of the parameter's field): the message says which.
+A value is refused when it is not a number, when the component itself refuses it
+(:func:`~double_pendulum.model.parameters.check_value`, the rule of the parameter's field, in the FMU's words), or
+when it lies outside the field's :class:`Field` range (the app's ranges: what a lab pendulum sensibly has; the FMU
+accepts more): the message says which.
+Only the fields that apply are checked and used (:func:`applying`): the masses and lengths with one's own
+pendulum, a loss's coefficients with its switch on, the suspension's with it on, none of them against the
+measured track (:data:`MODES`), which runs the fitted start of ``measured_vs_sim``; the page disables the others.
 No Dash here: the callbacks (:mod:`.callbacks`) pass the form's values in and show the messages beside the fields.
 """
 
@@ -97,6 +101,13 @@ PENDULUMS = {
 }
 """The pendulums offered: the seed's (the defaults with its rods, :data:`SEED_RIGID_LINKS`), the frictionless
 point-mass pendulum, or the masses and lengths typed in."""
+MODES = {
+    "case": "your case",
+    "twins": "your case and a start a hair apart",
+    "measured": "against the measured track",
+}
+"""What a run runs: the form's case, the case and its twin (``phi1_0`` nudged), or ``measured_vs_sim``'s main
+prediction of the camera's track, whose start, pendulum and losses are fitted, not the form's."""
 NUMBER_FIELDS: tuple[Field, ...] = (STOP_TIME, *START, *OWN_PENDULUM, *(f for fs in LOSSES.values() for f in fs),
                                     *SUSPENSION, TOLERANCE)
 
@@ -104,8 +115,41 @@ NUMBER_FIELDS: tuple[Field, ...] = (STOP_TIME, *START, *OWN_PENDULUM, *(f for fs
 def default_values() -> dict[str, Any]:
     """The form as it opens: every number field at its default (stop time 20 s), the seed's pendulum, no loss."""
     values: dict[str, Any] = {f.name: f.default for f in NUMBER_FIELDS}
-    return {**values, "pendulum": "seed", "switches": [], "suspension": False,
+    return {**values, "mode": "case", "pendulum": "seed", "switches": [], "suspension": False,
             "solver": SolverSettings.solver}
+
+
+def applying(form: Mapping[str, Any]) -> tuple[list[Field], list[str]]:
+    """The number fields that apply to ``form`` (its ``mode``, ``pendulum``, ``switches`` and ``suspension``) and
+    the loss switches that do: nothing against the measured track, no loss with the frictionless pendulum."""
+    if form.get("mode") == "measured":
+        return [], []
+    pendulum = form.get("pendulum", "seed")
+    switches = [s for s in form.get("switches") or () if s in LOSSES] if pendulum != "frictionless" else []
+    needed = [STOP_TIME, *START, TOLERANCE]
+    if pendulum == "own":
+        needed += OWN_PENDULUM
+    for name in switches:
+        needed += LOSSES[name]
+    if form.get("suspension"):
+        needed += SUSPENSION
+    return needed, switches
+
+
+def notes(form: Mapping[str, Any]) -> tuple[str, str]:
+    """Why the pendulum's fields (m1..l2) and the losses' are disabled in ``form``, each "" when nothing needs
+    saying (against the measured track the page says why the whole form does not apply)."""
+    if form.get("mode") == "measured":
+        return "", ""
+    names = ", ".join(f.name for f in OWN_PENDULUM)
+    pendulum = form.get("pendulum", "seed")
+    if pendulum == "seed":
+        return (f"{names} do not apply: the seed's pendulum has its own (the FMU's defaults, with its acrylic rods); "
+                f"choose \"{PENDULUMS['own']}\" to set them."), "a loss's coefficients apply when it is switched on"
+    if pendulum == "frictionless":
+        return (f"{names} do not apply: the frictionless pendulum has the FMU's default masses and lengths, no rods.",
+                "no loss applies to the frictionless pendulum")
+    return "", "a loss's coefficients apply when it is switched on"
 
 
 @dataclass(frozen=True)
@@ -126,30 +170,27 @@ def _number(field: Field, raw: Any) -> tuple[float | None, str | None]:
         value = float(raw)
     except (TypeError, ValueError):
         return None, f"{field.name} = {raw!r} is not a number ({field.range_text()})"
-    if not field.low <= value <= field.high:
-        return None, f"{field.name} = {value:g} is out of range: {field.range_text()}"
-    if field.name in _FIELDS:
+    if field.name in _FIELDS:  # the FMU's own rule first: its words for what it would refuse
         meta = _FIELDS[field.name].metadata
         try:
             check_value(field.name, value, meta["unit"], meta["rule"])
         except ParameterError as error:
             return None, str(error)
+    if not field.low <= value <= field.high:
+        return None, f"{field.name} = {value:g} is out of range: {field.range_text()}"
     return value, None
 
 
 def check_form(form: Mapping[str, Any]) -> Checked:
-    """The FMU start values of ``form`` (field name -> raw value; ``pendulum``, ``switches``: the switched-on loss
-    mechanisms, ``suspension``, ``solver``), only those that differ from the FMU's defaults' meaning."""
+    """The FMU start values of ``form`` (field name -> raw value; ``mode``, ``pendulum``, ``switches``: the
+    switched-on loss mechanisms, ``suspension``, ``solver``), only those that differ from the FMU's defaults' meaning;
+    the fields that do not apply (:func:`applying`) are neither checked nor used. Against the measured track no
+    field applies: no start values, no errors."""
     errors: dict[str, str] = {}
     pendulum = form.get("pendulum", "seed")
-    switches = [s for s in form.get("switches") or () if s in LOSSES] if pendulum != "frictionless" else []
-    needed = [STOP_TIME, *START, TOLERANCE]
-    if pendulum == "own":
-        needed += OWN_PENDULUM
-    for name in switches:
-        needed += LOSSES[name]
-    if form.get("suspension"):
-        needed += SUSPENSION
+    needed, switches = applying(form)
+    if form.get("mode") == "measured":
+        return Checked({}, 0.0, {})
     values: dict[str, float] = {}
     for field in needed:
         value, message = _number(field, form.get(field.name))

@@ -4,20 +4,31 @@ command to the ``double-pendulum`` command line).
 The app is Dash (Plotly's web framework, the one FMPy's own web app uses): the page is Dash's components, the plots
 Plotly's, the runs :mod:`.worker`'s processes. Dash and Plotly are the ``app`` extra (``pip install -e ".[app]"``);
 without them the command says so in one line.
+
+The port: ``--port N``, or a free one the system gives (not a fixed default: FMPy's own web app, ``python -m
+fmpy.webapp``, takes 8050, and both must run side by side); the address is printed. The app listens before it builds
+the FMU, so a port in use is said at once, in one line. What the app caches (the fits of *against the measured
+track*) goes to the result cache (:func:`~double_pendulum.runs.result_cache.cache_root`): ``.cache/`` in the
+project's folder, elsewhere a temporary folder removed when the app ends, unless ``$DOUBLE_PENDULUM_CACHE`` names
+one: nothing is written where the app is started.
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import errno
 import logging
+import os
 import signal
+import socket
 import sys
 from pathlib import Path
 from typing import Any
 
 HOST = "127.0.0.1"
-DEFAULT_PORT = 8050
+FMPY_WEBAPP_PORT = 8050
+"""The port ``python -m fmpy.webapp`` takes: the app's is another, a free one unless ``--port`` names it."""
 
 
 def create_app(fmu: Path) -> tuple[Any, Any]:
@@ -25,10 +36,11 @@ def create_app(fmu: Path) -> tuple[Any, Any]:
     from dash import Dash
 
     from .callbacks import register
-    from .layout import page
+    from .layout import INDEX, page
     from .worker import Runs
 
     app = Dash(__name__, title="Double pendulum: the app")
+    app.index_string = INDEX
     app.layout = page()
     runs = Runs(fmu)
     register(app, runs)
@@ -39,7 +51,9 @@ def add_app_command(subparsers: Any) -> argparse.ArgumentParser:
     """Add ``app`` to the command line's subcommands (``subparsers`` of :mod:`argparse`)."""
     parser = subparsers.add_parser("app", help="a local web app: change the pendulum and watch what happens",
                                    description="Serve the interactive app on 127.0.0.1 and print its address.")
-    parser.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"the port (default {DEFAULT_PORT})")
+    parser.add_argument("--port", type=int, default=None,
+                        help=f"the port (default: a free one, printed with the address; FMPy's web app takes "
+                        f"{FMPY_WEBAPP_PORT})")
     parser.add_argument("--fmu", default=None, metavar="PATH",
                         help="an FMI 2.0 FMU file of the double pendulum to run instead of the project's: read as it "
                         "is, never built or written (an error if it is missing or not usable)")
@@ -95,6 +109,37 @@ def app_fmu(args: argparse.Namespace, stack: contextlib.ExitStack) -> Path:
                        "build it elsewhere)") from None
 
 
+def listening_socket(port: int | None) -> socket.socket:
+    """A socket listening on ``HOST``:``port`` (None: a free port the system chooses); a port in use or not allowed
+    is an :class:`AppError` naming it."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    # As werkzeug's own server: a port the app left a moment ago (its connections in TIME_WAIT) is free again; a
+    # port another socket listens on stays refused.
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    try:
+        sock.bind((HOST, port or 0))
+        sock.listen(128)
+    except OSError as error:
+        sock.close()
+        if error.errno == errno.EADDRINUSE:
+            raise AppError(f"--port {port}: the port is in use (another program listens on it, perhaps an app "
+                           "started before); give another, or leave --port out to take a free one") from None
+        raise AppError(f"--port {port}: cannot listen on it ({error.strerror or error})") from None
+    return sock
+
+
+def app_cache(stack: contextlib.ExitStack) -> None:
+    """Point the result cache (``$DOUBLE_PENDULUM_CACHE``) at a temporary folder that ``stack`` removes, unless it
+    is set or the app runs in the project's folder (then ``.cache/`` there, as the scenarios')."""
+    import tempfile
+
+    from ..fmu.running.choice import is_project_folder
+    from ..runs.result_cache import CACHE_ENV
+
+    if not os.environ.get(CACHE_ENV) and not is_project_folder(Path.cwd()):
+        os.environ[CACHE_ENV] = stack.enter_context(tempfile.TemporaryDirectory(prefix="double-pendulum-app-cache-"))
+
+
 def cmd_app(args: argparse.Namespace) -> int:
     """Serve the app until interrupted; 2 when Dash is not installed, the port is not usable or the FMU is not
     (:func:`app_fmu`)."""
@@ -104,33 +149,41 @@ def cmd_app(args: argparse.Namespace) -> int:
     except ImportError as error:
         print(f"double-pendulum app: needs Dash and Plotly ({error}): pip install -e \".[app]\"", file=sys.stderr)
         return 2
-    if not 1 <= args.port <= 65535:
+    if args.port is not None and not 1 <= args.port <= 65535:
         print(f"double-pendulum app: --port {args.port} is no port (1 to 65535)", file=sys.stderr)
         return 2
-    with contextlib.ExitStack() as stack:  # a temporary build folder (app_fmu) is removed when the app ends
+    with contextlib.ExitStack() as stack:  # the socket, a temporary build and cache folder: closed, removed at the end
         try:
+            sock = stack.enter_context(listening_socket(args.port))
             fmu = app_fmu(args, stack)
         except AppError as error:
             print(f"double-pendulum app: {error}", file=sys.stderr)
             return 2
-        serve(fmu, args.port)
+        app_cache(stack)
+        serve(fmu, sock)
     print("double-pendulum app: ended", file=sys.stderr)
     return 0
 
 
-def serve(fmu: Path, port: int) -> None:
-    """Serve the app for the FMU file ``fmu`` on ``port`` until interrupted (Ctrl-C or SIGTERM), then end its runs."""
+def serve(fmu: Path, sock: socket.socket) -> None:
+    """Serve the app for the FMU file ``fmu`` on the listening socket ``sock`` until interrupted (Ctrl-C or
+    SIGTERM), then end its runs."""
+    from werkzeug.serving import make_server
+
     app, runs = create_app(fmu)
+    port = sock.getsockname()[1]
+    server = make_server(HOST, port, app.server, threaded=True, fd=sock.fileno())
     print(f"double-pendulum app: open http://{HOST}:{port}/ in a browser (Ctrl-C ends it)", flush=True)
     previous = signal.signal(signal.SIGTERM, _interrupt)  # `kill` ends it as Ctrl-C does: runs and files cleaned
     # The server's log of every request (a tab asks for its run's progress ten times a second) would bury the
     # address above; its warnings and errors still show.
     logging.getLogger("werkzeug").setLevel(logging.WARNING)
     try:
-        app.run(host=HOST, port=port, debug=False)
+        server.serve_forever()
     except KeyboardInterrupt:
         pass
     finally:
+        server.server_close()
         runs.close()
         signal.signal(signal.SIGTERM, previous)
 

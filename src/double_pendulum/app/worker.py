@@ -11,9 +11,9 @@ fmpy, NumPy and the package once, so a run starts in milliseconds.
 
 The kinds of run (:data:`KINDS`): ``case`` (the form's case), ``twins`` (the case and the same with ``phi1_0``
 moved by :data:`~double_pendulum.scenarios.free_swing.NUDGE_RAD`, as ``free_swing`` runs its twin starts) and
-``measured`` (the seed's start at t0 with the losses fitted to the measured energy decay, against the camera's
-track, as ``measured_vs_sim`` predicts it: :mod:`double_pendulum.analysis.prediction`; the first such run fits
-the losses, later ones read the fit from the cache).
+``measured`` (``measured_vs_sim``'s main prediction of the camera's track: the start and camera geometry fitted to
+the track, the losses fitted to the measured energy decay, :mod:`.measured`; the first such run fits them, later ones
+read the fits from the cache).
 """
 
 from __future__ import annotations
@@ -76,28 +76,12 @@ def run_twins(fmu: str, start_values: Mapping[str, Any], stop_time: float, outpu
 
 def run_measured(fmu: str, start_values: Mapping[str, Any], stop_time: float, output_interval: float,
                  progress: Progress | None = None) -> dict[str, Any]:
-    """The seed's start with the fitted losses against the camera's track (``measured_vs_sim``'s run
-    ``seed_start_identified``), over at most ``stop_time`` [s] of the record: the paths table of
-    :func:`~double_pendulum.analysis.prediction.paths.paths_table` and the losses' values."""
-    from double_pendulum.scenarios.measured_vs_sim import SEED_T0
+    """``measured_vs_sim``'s main prediction against the camera's track (:func:`.measured.run_measured`: the start and
+    camera geometry fitted to the track, the fitted losses); the form's ``start_values``, ``stop_time`` and
+    ``output_interval`` do not apply. ``progress`` is told ``stop_time`` times the fraction done."""
+    from .measured import run_measured as measured
 
-    from ..analysis.losses.identification import seed_reconstruction
-    from ..analysis.prediction.comparison import identified_losses, nearest_frame, predict, reconstructed_state
-    from ..analysis.prediction.paths import paths_table
-    from ..analysis.track.measurement import FRAME_INTERVAL
-    from ..fmu.running.runner import FmuRunner
-
-    rec = seed_reconstruction()
-    losses = identified_losses(rec)
-    i0 = nearest_frame(rec, SEED_T0)
-    frames = min(int(round(stop_time / FRAME_INTERVAL)) + 1, len(rec.t) - i0)
-    with FmuRunner(fmu, reuse_instance=False) as runner:
-        prediction = predict(runner, "seed_start_identified", losses.values, reconstructed_state(rec, i0), rec, i0,
-                             frames)
-    table = paths_table(rec, i0, frames, prediction)
-    if progress is not None:
-        progress(stop_time)
-    return {"columns": _columns(table), "message": None, "losses": losses.losses, "t0": float(rec.t[i0])}
+    return measured(fmu, progress=None if progress is None else lambda fraction: progress(fraction * stop_time))
 
 
 RUNS = {"case": run_case, "twins": run_twins, "measured": run_measured}

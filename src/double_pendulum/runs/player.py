@@ -93,9 +93,9 @@ def player_data(times: Sequence[float], swings: Sequence[Mapping[str, Any]], tit
 def player_html(element_id: str, data: Mapping[str, Any]) -> str:
     """One player (the page must hold :data:`PLAYER_SCRIPT` before it): its canvas, controls and legend."""
     speeds = "".join(f'<option value="{s:g}"{" selected" if s == 1.0 else ""}>{s:g}\u00d7</option>' for s in SPEEDS)
-    legend = "".join(
+    legend = "".join(  # a space after each key: the line may break there (a key itself does not break)
         f'<span class="dp-key"><span class="dp-swatch" style="background:{html.escape(s["colour"])}"></span>'
-        f'{html.escape(s["label"])}: {"rods and bobs" if s["links"] else "markers on both bobs"}</span>'
+        f'{html.escape(s["label"])}: {"rods and bobs" if s["links"] else "markers on both bobs"}</span> '
         for s in data["swings"])
     payload = json.dumps(data, separators=(",", ":")).replace("</", "<\\/")
     return (f'<div class="dp-player" id="{html.escape(element_id)}" data-frame="0">'

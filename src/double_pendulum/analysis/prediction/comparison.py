@@ -278,6 +278,15 @@ def start_fit_summary(fit: StartStateFit, guess: np.ndarray) -> dict[str, Any]:
 # --- predictions ---------------------------------------------------------------------------------
 
 
+def prediction_start_values(values: Mapping[str, Any], state: Sequence[float],
+                            geometry: Mapping[str, float] | None = None) -> dict[str, Any]:  # fmt: skip
+    """The FMU start values of a prediction (:func:`predict`): :data:`PREDICTION_SETTINGS`, ``values``, the fitted
+    geometry's start values (e.g. l2 [m]; not its position transforms) and the ``state`` (rad, rad, rad/s,
+    rad/s)."""
+    start, _ = split_geometry(dict(geometry or {}))
+    return {**PREDICTION_SETTINGS, **values, **start, **state_start_values(state)}
+
+
 def predict(
     runner: FmuRunner,
     label: str,
@@ -291,10 +300,10 @@ def predict(
     """Run the FMU from frame ``i0`` with ``state`` for ``n_frames`` frames and compare with the track;
     ``geometry`` (fitted start values such as l2 and pivot shifts [m]) overrides ``values`` and moves the positions."""
     geometry = dict(geometry or {})
-    start, shifts = split_geometry(geometry)
+    _, shifts = split_geometry(geometry)
     result = simulate_frames(
         runner,
-        {**PREDICTION_SETTINGS, **values, **start, **state_start_values(state)},
+        prediction_start_values(values, state, geometry),
         float(rec.t[i0]),
         n_frames,
         outputs=RUN_OUTPUTS,
