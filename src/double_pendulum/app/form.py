@@ -14,13 +14,13 @@ No Dash here: the callbacks (:mod:`.callbacks`) pass the form's values in and sh
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
 from ..component.settings import SolverSettings
 from ..model.parameters import (
+    MAX_START_ANGLE,
     SEED_RIGID_LINKS,
     AirDragParameters,
     BearingParameters,
@@ -81,7 +81,8 @@ class Field:
 
 STOP_TIME = Field("stop_time", 0.1, 120.0)
 """The run's length [s] (not an FMU variable: fmpy's stop_time)."""
-START = (Field("phi1_0", -math.pi, math.pi), Field("phi2_0", -math.pi, math.pi),
+# the start angles: the one rule of the FMU and the CLI (model.parameters.check_start_angle), no narrower range
+START = (Field("phi1_0", -MAX_START_ANGLE, MAX_START_ANGLE), Field("phi2_0", -MAX_START_ANGLE, MAX_START_ANGLE),
          Field("omega1_0", -30.0, 30.0), Field("omega2_0", -30.0, 30.0))
 OWN_PENDULUM = (Field("m1", 0.01, 10.0), Field("m2", 0.01, 10.0), Field("l1", 0.02, 2.0), Field("l2", 0.02, 2.0))
 LOSSES: dict[str, tuple[Field, ...]] = {
