@@ -215,9 +215,8 @@ void guard_orphan(const char *model_identifier, const char *function, const char
     char message[2048];
     va_list args;
     va_start(args, format);
-    int n = vsnprintf(message, sizeof message, format, args);
+    text_vformat(message, sizeof message, format, args);
     va_end(args);
-    if (n < 0) message[0] = '\0';
     fprintf(stderr, "[%s] %s: %s\n", model_identifier, function, message);
     fflush(stderr);
 }

@@ -6,7 +6,6 @@
 #include "guard_base.h"
 
 #include <stdarg.h>
-#include <stdio.h>
 #include <string.h>
 
 #include "text.h"
@@ -78,9 +77,8 @@ int guard_fail(guard_instance *g, const char *format, ...) {
     char message[2048];
     va_list args;
     va_start(args, format);
-    int n = vsnprintf(message, sizeof message, format, args);
+    text_vformat(message, sizeof message, format, args);
     va_end(args);
-    if (n < 0) message[0] = '\0';
     guard_emit(g, STATUS_ERROR, "logStatusError", message);
     g->at.state = g->version->error_state;
     return STATUS_ERROR;

@@ -474,16 +474,22 @@ static int fmu_state_restores_the_time(void) {
     fmi2FreeInstance_(c);
     return from_half == fmi2OK && from_one == fmi2Error && state == NULL ? 0 : -2;
 }
+/* The serialized state of `a` where it is now (malloc'ed, *size bytes). */
+static fmi2Byte *serialized_now(fmi2Component a, size_t *size) {
+    fmi2FMUstate state = NULL;
+    *size = 0;
+    fmi2GetFMUstate_(a, &state);
+    fmi2SerializedFMUstateSize_(a, state, size);
+    fmi2Byte *bytes = malloc(*size);
+    fmi2SerializeFMUstate_(a, state, bytes, *size);
+    return bytes;
+}
 /* A serialized state into a new instance: phi1 after one more step equals the original's (0, else -2). */
 static int serialized_state_in_a_new_instance(void) {
     FRESH(a);
     fmi2DoStep_(a, 0.0, 0.5, fmi2True);
-    fmi2FMUstate state = NULL;
-    size_t size = 0;
-    fmi2GetFMUstate_(a, &state);
-    fmi2SerializedFMUstateSize_(a, state, &size);
-    fmi2Byte *bytes = malloc(size);
-    fmi2SerializeFMUstate_(a, state, bytes, size);
+    size_t size;
+    fmi2Byte *bytes = serialized_now(a, &size);
     fmi2Component b = instantiate(fmi2False);
     fmi2FMUstate copy = NULL;
     int ok = fmi2DeSerializeFMUstate_(b, bytes, size, &copy) == fmi2OK && fmi2SetFMUstate_(b, copy) == fmi2OK;
@@ -502,12 +508,8 @@ static int serialized_state_in_a_new_instance(void) {
 static int deserialize_tampered(void (*tamper)(fmi2Byte *bytes, size_t size)) {
     FRESH(a);
     fmi2DoStep_(a, 0.0, 0.125, fmi2True);
-    fmi2FMUstate state = NULL;
-    size_t size = 0;
-    fmi2GetFMUstate_(a, &state);
-    fmi2SerializedFMUstateSize_(a, state, &size);
-    fmi2Byte *bytes = malloc(size);
-    fmi2SerializeFMUstate_(a, state, bytes, size);
+    size_t size;
+    fmi2Byte *bytes = serialized_now(a, &size);
     fmi2FreeInstance_(a);
     tamper(bytes, size);
     fmi2Component b = instantiate(fmi2False);
