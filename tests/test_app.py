@@ -190,7 +190,10 @@ def test_the_app_runs_the_fmu_as_simulate_fmu_and_refuses_a_bad_value_beside_its
         final = browser.wait_for("(() => { const g = document.querySelector('#angles .js-plotly-plot'); "
                                  "return g && g.data ? g.data.map(d => d.y[d.y.length - 1]) : null; })()")
         call = browser.evaluate("document.querySelector('#fmpy-call').textContent")
-        top, bottom, _ = browser.wait_for(f"(() => {{ const r = {RECT}('#player'); return r[0] < 60 ? r : null; }})()")
+        # the app scrolls the player to the top 50 ms after its figure is drawn: wait for it to arrive there (the page
+        # was scrolled to its bottom, so the player's top is far above until then, and 'below 60 px' held too early)
+        arrived = f"(() => {{ const r = {RECT}('#player'); return Math.abs(r[0]) < 60 ? r : null; }})()"
+        top, bottom, _ = browser.wait_for(arrived)
         assert -1 <= top and bottom > 300, "after a run the player is in view"
         browser.screenshot(tmp_path / "app-1280-after.png")
         form = {**default_values(), "phi1_0": "2.0", "switches": ["air_drag"], "pendulum": "own", "m1": "2.0"}
