@@ -95,18 +95,19 @@ def redelivery(error: BaseException) -> type:
     return HostException
 
 
-def host_redelivery(error: BaseException) -> type | None:
-    """For an exception that escaped a call before its answer was made (a signal handler runs as a Python function
-    starts, before its ``try``): its redelivery if it is the host's own (:func:`host_exception`), else None. The
-    loader asks it of the object it called (:class:`Bridge`, :class:`Instance`)."""
-    return redelivery(error) if host_exception(error) else None
-
-
 def host_answer(error: BaseException, messages: tuple) -> Answer:
     """The answer of a call the host's own exception stopped: Error with its line, and its redelivery."""
     said = (ERROR, "logStatusError", f"the host's own {describe(error)} stopped the call, which was not completed; "
             "it is raised again in the host, and a reset makes the instance usable again")
     return HOST, redelivery(error), messages + (said,)
+
+
+def escaped_answer(error: BaseException) -> Answer | None:
+    """For an exception that escaped a call before its answer was made (a signal handler runs as a Python function
+    starts, before its ``try``): the call's answer (:func:`host_answer`) if it is the host's own
+    (:func:`host_exception`), else None. The loader asks it of the object it called (:class:`Bridge`,
+    :class:`Instance`) and reads it as any answer."""
+    return host_answer(error, ()) if host_exception(error) else None
 
 
 def _unpack(code: str, data: bytes) -> list:
@@ -116,7 +117,7 @@ def _unpack(code: str, data: bytes) -> list:
 class Bridge:
     """What an FMU's entry module exposes as ``fmi_bridge``: its slave class and FMI version."""
 
-    host_redelivery = staticmethod(host_redelivery)
+    escaped_answer = staticmethod(escaped_answer)
 
     def __init__(self, model_class: type, fmi_version: int) -> None:
         self.model_class = model_class
@@ -139,7 +140,7 @@ class Bridge:
 class Instance:
     """One FMI instance: its slave, and every call the loader makes on it."""
 
-    host_redelivery = staticmethod(host_redelivery)
+    escaped_answer = staticmethod(escaped_answer)
 
     def __init__(self, bridge: Bridge, resources: str, name: str, interface: str, visible: bool) -> None:
         self.bridge, self.resources, self.name, self.visible = bridge, resources, name, visible
@@ -166,8 +167,6 @@ class Instance:
             if host_exception(error):
                 return host_answer(error, self._messages())
             return ERROR, None, self._messages((ERROR, "logStatusError", describe(error)))
-
-
 
     def _messages(self, *last: tuple) -> tuple:
         """What the slave logged since the last call, then ``last``."""

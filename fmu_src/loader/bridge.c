@@ -137,9 +137,10 @@ static PyObject *build(const python_api *py, const char *format, ...) {
     return built;
 }
 
-/* The redelivery of exception `value` if it is the host's own (target.host_redelivery: fmi_bridge.py), else NULL. */
-static PyObject *host_redelivery(const python_api *py, PyObject *target, PyObject *value) {
-    PyObject *ask = target && value ? py->Object_GetAttrString(target, "host_redelivery") : NULL;
+/* The answer of the call that exception `value` escaped, if it is the host's own (target.escaped_answer:
+ * fmi_bridge.py, which writes its line and its redelivery), else NULL. */
+static PyObject *escaped_answer(const python_api *py, PyObject *target, PyObject *value) {
+    PyObject *ask = target && value ? py->Object_GetAttrString(target, "escaped_answer") : NULL;
     PyObject *arguments = ask ? build(py, "(O)", value) : NULL;
     PyObject *answer = arguments ? py->Object_Call(ask, arguments, NULL) : NULL;
     if (arguments) py->DecRef(arguments);
@@ -149,9 +150,12 @@ static PyObject *host_redelivery(const python_api *py, PyObject *target, PyObjec
     return answer;
 }
 
-/* The pending Python exception in words ("ValueError: ..."), cleared; notes a KeyboardInterrupt, and the host's own
- * exception (asked of `target`, NULL: none is) with its redelivery. An exception escapes a call of the Python side
- * only before its answer is made: a signal handler of the host runs as a Python function starts. */
+static int take_answer(const python_api *py, PyObject *answer, bridge_payload payload, answer_notes *notes,
+                       const char *method);
+
+/* The pending Python exception in words ("ValueError: ..."), cleared; notes a KeyboardInterrupt, and takes the
+ * answer `target` gives for the host's own exception (NULL: none is asked) as the call's. An exception escapes a call
+ * of the Python side only before its answer is made: a signal handler of the host runs as a Python function starts. */
 static void take_exception(const python_api *py, answer_notes *notes, const char *what, PyObject *target) {
     if (!py->Err_Occurred()) return note_failure(notes, "%s failed without saying why", what);
     PyObject *type = NULL, *value = NULL, *traceback = NULL;
@@ -165,15 +169,11 @@ static void take_exception(const python_api *py, answer_notes *notes, const char
     const char *value_text = text ? py->Unicode_AsUTF8AndSize(text, NULL) : NULL;
     py->Err_Clear(); /* whatever describing it raised */
     int interrupt = name_text && strcmp(name_text, "KeyboardInterrupt") == 0;
-    PyObject *host = interrupt ? NULL : host_redelivery(py, target, value);
+    PyObject *host = interrupt ? NULL : escaped_answer(py, target, value);
     if (interrupt) note_interrupt(notes);
-    else if (host) {
-        notes->host = host;
-        note_failure(notes, "the host's own %s%s%s stopped the call, which was not completed; it is raised again in "
-                     "the host, and a reset makes the instance usable again", name_text ? name_text : "exception",
-                     value_text && value_text[0] ? ": " : "", value_text ? value_text : "");
-    } else note_failure(notes, "%s raised %s: %s", what, name_text ? name_text : "an exception",
-                        value_text && value_text[0] ? value_text : "(no message)");
+    else if (host) take_answer(py, host, NO_PAYLOAD, notes, what), py->DecRef(host);
+    else note_failure(notes, "%s raised %s: %s", what, name_text ? name_text : "an exception",
+                      value_text && value_text[0] ? value_text : "(no message)");
     if (name) py->DecRef(name);
     if (text) py->DecRef(text);
     if (type) py->DecRef(type);
