@@ -349,6 +349,106 @@ def test_sixteen_threads_instantiate_step_and_free_at_once(hosts, extracted, tmp
         assert "threads-created 48 of 48" in out and "threads-identical 1" in out, out + err
 
 
+FORKS = 50
+
+
+def test_forks_while_another_thread_steps_never_hang_the_child_in_a_c_host(hosts, extracted, tmp_path):
+    """A C host (the loader starts the FMU's CPython itself) forks 50 times while another thread is inside
+    fmi2DoStep: no child hangs (before the loader's fork handlers, 2 children of 2 waited for the dead thread's GIL
+    forever) or crashes; in each, a new instance runs the case bit for bit as before the forks, and the instance the
+    other thread was inside answers fmi2Error with the line that says why (or OK where the fork fell between two of
+    its steps)."""
+    folder, description = extracted["fmi2"]
+    result = run(host_command(hosts[2], folder, description, 2, "fork", str(FORKS)), tmp_path)
+    assert result.returncode == 0, result.stdout + result.stderr
+    counts = {key: int(value) for key, value in
+              (line.split() for line in result.stdout.splitlines() if line.startswith("fork-"))}
+    assert counts["fork-children"] == FORKS and counts["fork-hung"] == 0 and counts["fork-crashed"] == 0, counts
+    assert counts["fork-identical"] == FORKS and counts["fork-bad"] == 0, counts
+    assert counts["fork-refused"] > 0, f"no fork fell inside a step: the refusal was not exercised ({counts})"
+
+
+FORKING_PYTHON_HOST = """
+import os, signal, sys, threading, time
+from fmpy.fmi1 import FMICallException
+from fmpy.fmi2 import FMU2Slave
+folder, guid, phi1, forks = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])
+def made():
+    fmu = FMU2Slave(guid=guid, unzipDirectory=folder, modelIdentifier="DoublePendulum", instanceName="fork")
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    return fmu
+def case():
+    fmu = made()
+    for k in range(20):
+        fmu.doStep(k * 0.01, 0.01)
+    value = fmu.getReal([phi1])[0]
+    fmu.terminate()
+    fmu.freeInstance()
+    return value
+reference = case()
+busy, inside, stop = made(), threading.Event(), threading.Event()
+def keep_stepping():
+    t = 0.0
+    while not stop.is_set():
+        inside.set()
+        busy.doStep(t, 0.5)
+        t += 0.5
+thread = threading.Thread(target=keep_stepping)
+thread.start()
+hung = crashed = identical = refused = 0
+for k in range(forks):
+    inside.wait()
+    time.sleep(0.001 * (k % 5))
+    child = os.fork()
+    if child == 0:
+        code = 0
+        try:  # refused where the fork fell inside a step, else the next step
+            busy.doStep(busy.getRealStatus(2), 0.01)  # 2: fmi2LastSuccessfulTime
+        except FMICallException as error:
+            code |= 2 if error.status == 3 else 4
+        code |= case() != reference
+        os._exit(code)
+    for _ in range(6000):
+        ended, status = os.waitpid(child, os.WNOHANG)
+        if ended:
+            break
+        time.sleep(0.01)
+    else:
+        os.kill(child, signal.SIGKILL)
+        os.waitpid(child, 0)
+        hung += 1
+        continue
+    code = os.waitstatus_to_exitcode(status)
+    crashed += code < 0 or bool(code & 4)
+    identical += code >= 0 and not code & 1
+    refused += code >= 0 and bool(code & 2)
+stop.set()
+thread.join()
+print("counts forks", forks, "hung", hung, "crashed", crashed, "identical", identical, "refused", refused)
+"""
+
+
+@in_this_process
+def test_forks_while_another_thread_steps_never_hang_the_child_in_a_python_host(extracted, tmp_path):
+    """The same in a Python host through fmpy (os.fork: the interpreter is the host's, its own fork handling runs,
+    the loader's holds its locks and marks the busy instance): 50 forks, no child hangs or crashes, every new
+    instance's case as before the forks, and the busy instance refused with fmi2Error where the fork fell inside
+    its step, with the line that says so (printed by fmpy's logger)."""
+    folder, description = extracted["fmi2"]
+    phi1 = next(v.valueReference for v in description.modelVariables if v.name == "phi1")
+    result = subprocess.run([sys.executable, "-c", FORKING_PYTHON_HOST, str(folder), description.guid, str(phi1),
+                             str(FORKS)], capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert result.returncode == 0, result.stdout + result.stderr
+    words = result.stdout.splitlines()[-1].split()[1:]  # before it, fmpy's logger prints the FMU's lines
+    counts = dict(zip(words[::2], map(int, words[1::2])))
+    assert counts == {**counts, "forks": FORKS, "hung": 0, "crashed": 0, "identical": FORKS}, counts
+    assert counts["refused"] > 0, f"no fork fell inside a step: the refusal was not exercised ({counts})"
+    assert "this process was forked while another thread was inside fmi2DoStep of this instance" in result.stdout
+
+
 def rss_figures(stdout: str) -> dict[int, int]:
     """The host's "rss CYCLE KIB" lines: resident memory (KiB) by cycle."""
     return {int(k): int(kib) for _, k, kib in (line.split() for line in stdout.splitlines()

@@ -261,7 +261,7 @@ static int call_object(guard_instance *g, PyObject *target, bridge_payload paylo
                        const char *format, va_list args) {
     const python_api *py = g->api;
     answer_notes notes = {0};
-    int gil = py->GILState_Ensure();
+    int gil = python_runtime_take_gil();
     PyObject *arguments = py->VaBuildValue(format, args);
     PyObject *callable = arguments ? py->Object_GetAttrString(target, method) : NULL;
     PyObject *answer = callable ? py->Object_Call(callable, arguments, NULL) : NULL;
@@ -305,7 +305,7 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
                        PyObject **instance) {
     g->api = py;
     answer_notes notes = {0};
-    int gil = py->GILState_Ensure();
+    int gil = python_runtime_take_gil();
     PyObject *globals = py->Dict_New();
     PyObject *resources_text = py->Bytes_FromStringAndSize(resources, (ssize_t)strlen(resources));
     PyObject *entry_text = py->Unicode_FromString(entry);
@@ -350,7 +350,7 @@ int bridge_instantiate(guard_instance *g, const python_api *py, const char *reso
 
 void bridge_release(guard_instance *g, PyObject *object) {
     if (!object) return;
-    int gil = g->api->GILState_Ensure();
+    int gil = python_runtime_take_gil();
     g->api->DecRef(object);
     g->api->GILState_Release(gil);
 }
@@ -361,7 +361,7 @@ void bridge_deliver_host_exception(guard_instance *g) {
     g->host_exception = NULL;
     const python_api *py = g->api;
     int python_thread = py->GILState_GetThisThreadState() != NULL; /* before Ensure, which makes one */
-    int gil = py->GILState_Ensure();
+    int gil = python_runtime_take_gil();
     if (python_thread) py->ThreadState_SetAsyncExc(py->Thread_get_thread_ident(), redelivery);
     py->DecRef(redelivery);
     py->GILState_Release(gil);

@@ -126,8 +126,7 @@ static void destroy(guard_instance *common) {
     (void)scope;                                                                                                  \
     g->common.function = "fmi2" #F;                                                                               \
     if (!(g->common.at.state & (MASK)))                                                                           \
-        return (fmi2Status)fail(&g->common, "fmi2" #F ": illegal call sequence: not allowed in state %s",        \
-                                state_name(g->common.at.state))
+        return (fmi2Status)guard_refuse_state(&g->common, "fmi2" #F, state_name(g->common.at.state))
 #define BEGIN(F) BEGIN_MASKED(F, MASK_##F)
 
 #define REQUIRE(condition, ...)                                                                                   \

@@ -143,8 +143,7 @@ enum { ME = 1, CS = 2, BOTH = 3 };
         return (fmi3Status)fail(&g->common, "fmi3" #F ": not a function of %s, which this instance was made for", \
                                 g->model_exchange ? "Model Exchange" : "Co-Simulation");                        \
     if (!(g->common.at.state & (MASK)))                                                                           \
-        return (fmi3Status)fail(&g->common, "fmi3" #F ": illegal call sequence: not allowed in state %s",        \
-                                state_name(g->common.at.state))
+        return (fmi3Status)guard_refuse_state(&g->common, "fmi3" #F, state_name(g->common.at.state))
 #define BEGIN(F) BEGIN_FOR(F, MASK_##F, BOTH)
 
 #define REQUIRE(condition, ...)                                                                                   \

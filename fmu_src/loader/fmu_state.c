@@ -248,3 +248,7 @@ int guard_deserialize_state(guard_instance *g, const unsigned char *bytes, size_
     guard_position at = {header.state, header.time, header.last_successful_time, header.wants_to_terminate};
     return deliver(g, FMUstate, s, python, at);
 }
+
+void fmu_state_fork_prepare(void) { platform_lock(&fmu_states.lock); }
+
+void fmu_state_fork_after(void) { platform_unlock(&fmu_states.lock); }

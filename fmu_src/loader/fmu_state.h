@@ -26,5 +26,8 @@ int guard_free_state(guard_instance *g, void **FMUstate);
 int guard_serialized_size(guard_instance *g, void *FMUstate, size_t *size);
 int guard_serialize_state(guard_instance *g, void *FMUstate, unsigned char *bytes, size_t size);
 int guard_deserialize_state(guard_instance *g, const unsigned char *bytes, size_t size, void **FMUstate);
+/* Around a fork (guard.c): hold the states' lock in the forking thread, let go of it after, in either process. */
+void fmu_state_fork_prepare(void);
+void fmu_state_fork_after(void);
 
 #endif

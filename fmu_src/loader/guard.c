@@ -60,7 +60,7 @@ void guard_release(guard_instance *g) {
 }
 
 guard_scope guard_scope_begin(guard_instance *g) {
-    g->depth++;
+    if (g->depth++ == 0) g->thread = platform_thread_self();
     return (guard_scope){g, g->function};
 }
 
@@ -108,6 +108,54 @@ void guard_free_common(guard_instance *g) {
     free(g->name);
     free(g->strings);
     g->name = g->strings = NULL;
+}
+
+/* ------------------------------------------------------------------------------------ fork */
+
+/* A host may fork() while another thread is inside an FMU call (docs/fmu.md, "Threads and fork").  Around every
+ * fork, this copy of the loader holds its locks and, where it started the process's Python, that Python's GIL
+ * (python_runtime_fork_prepare), so that the child finds none of them held by a thread it does not have.  In the
+ * child, an instance another thread was inside is in its Error state: its call never ends there, and what the
+ * Python side had done of it is unknown; its calls say so (guard_refuse_state), and it can be freed. */
+static void mark_forked(void *pointer) {
+    guard_instance *g = pointer;
+    if (g->depth == 0 || g->thread == platform_thread_self()) return; /* idle, or the forking thread's own */
+    g->forked_inside = g->function ? g->function : "an FMI function";
+    g->at.state = g->version->error_state;
+    g->references -= g->depth; /* the calls that will not return; the host's reference stays */
+    g->depth = 0;
+}
+
+static void fork_prepare(void) {
+    python_runtime_fork_prepare(); /* the GIL first: a call takes it with none of these locks held */
+    platform_lock(&instances.lock);
+    fmu_state_fork_prepare();
+}
+
+static void fork_parent(void) {
+    fmu_state_fork_after();
+    platform_unlock(&instances.lock);
+    python_runtime_fork_parent();
+}
+
+static void fork_child(void) {
+    fmu_state_fork_after();
+    pointer_set_each_locked(&instances, mark_forked);
+    platform_unlock(&instances.lock);
+    python_runtime_fork_child();
+}
+
+/* Registered when the library is loaded (one thread: the dynamic loader's), dropped when it is unloaded. */
+__attribute__((constructor)) static void register_fork_handlers(void) {
+    platform_at_fork(fork_prepare, fork_parent, fork_child);
+}
+
+int guard_refuse_state(guard_instance *g, const char *function, const char *state) {
+    if (g->forked_inside)
+        return guard_fail(g, "%s: this process was forked while another thread was inside %s of this instance; that "
+                          "call cannot end in the child, so the instance is in the Error state: free it and "
+                          "instantiate a new one", function, g->forked_inside);
+    return guard_fail(g, "%s: illegal call sequence: not allowed in state %s", function, state);
 }
 
 /* ---------------------------------------------------------------------------- instantiation */

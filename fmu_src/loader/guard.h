@@ -46,6 +46,10 @@ void guard_scope_end(guard_scope *scope);
  * otherwise take the interrupt, and ctypes drops exceptions in callbacks). */
 void guard_deliver_interrupt(guard_instance *g);
 
+/* The failure of `function` in a state that does not allow it (`state`: its name), logged: an illegal call sequence,
+ * or, in a forked child, the call another thread was inside when the process forked. */
+int guard_refuse_state(guard_instance *g, const char *function, const char *state);
+
 /* Fill in `g` (calloc'ed, first in the version's struct) for a new instance. */
 int guard_init_instance(guard_instance *g, const guard_version *version, const char *interface,
                         const char *name, int logging_on,

@@ -60,6 +60,9 @@ struct guard_instance {
     PyObject *host_exception; /* another exception of the host's stopped a call: its redelivery (fmi_bridge.py), raised
                                * again in the host's thread when the outermost FMI call of the instance returns */
     int depth;             /* FMI calls of the instance in progress (the host's logger may call in: nested) */
+    unsigned long thread;  /* the thread of the outermost call in progress (platform_thread_self) */
+    const char *forked_inside; /* the FMI function another thread was inside when the process forked (in the
+                                * child, where that thread is gone: the instance is then in its Error state) */
     char *strings;         /* the values of the last get of Strings (valid until the next one) */
     /* give one message to the host's logger, or stderr if it has none */
     void (*log)(guard_instance *g, int status, const char *category, const char *message);

@@ -77,6 +77,18 @@ int platform_own_folder(char *folder, size_t size) {
     return text_fits(folder, size, "%s", resolved);
 }
 
+int platform_at_fork(void (*prepare)(void), void (*parent)(void), void (*child)(void)) {
+    return pthread_atfork(prepare, parent, child) == 0; /* glibc drops them when this library is unloaded */
+}
+
+unsigned long platform_thread_self(void) { return (unsigned long)pthread_self(); }
+
+void platform_pin_self(void) {
+    Dl_info info;
+    if (dladdr((void *)&platform_pin_self, &info) && info.dli_fname)
+        dlopen(info.dli_fname, RTLD_NOW | RTLD_NOLOAD | RTLD_NODELETE); /* never unloaded from now on */
+}
+
 const char *platform_getenv(const char *name, char *buffer, size_t size) {
     const char *value = getenv(name);
     return value && text_fits(buffer, size, "%s", value) ? buffer : NULL;
@@ -304,6 +316,16 @@ void platform_uri_path(char *path) {
 }
 
 int platform_is_separator(char c) { return c == '/' || c == '\\'; }
+
+/* Windows has no fork: nothing to register, nothing to pin. */
+int platform_at_fork(void (*prepare)(void), void (*parent)(void), void (*child)(void)) {
+    (void)prepare, (void)parent, (void)child;
+    return 1;
+}
+
+void platform_pin_self(void) {}
+
+unsigned long platform_thread_self(void) { return GetCurrentThreadId(); }
 
 int platform_own_folder(char *folder, size_t size) {
     HMODULE self = NULL;

@@ -67,6 +67,18 @@ void platform_unload(void *library);
  * them).  0 if there is none. */
 int platform_loaded_python(void **library, char *path, size_t size);
 
+/* ----------------------------------------------------------------------------------- fork */
+
+/* Run `prepare` in the thread that calls fork() just before it, `parent` and `child` just after it in each
+ * process (POSIX pthread_atfork; the handlers go when this library is unloaded).  1 if registered.  Windows has
+ * no fork: nothing to do (1). */
+int platform_at_fork(void (*prepare)(void), void (*parent)(void), void (*child)(void));
+/* Keep this library in the process until it ends (POSIX RTLD_NODELETE; Windows: nothing), for the copy of the
+ * loader that started the process's Python: its fork handlers must outlive an unload of the FMU. */
+void platform_pin_self(void);
+/* The calling thread, as a number no other live thread of the process has. */
+unsigned long platform_thread_self(void);
+
 /* ------------------------------------------------------------------------------- programs */
 
 /* The first executable file `name` in the folders of PATH, or `name` itself if it holds a separator. */

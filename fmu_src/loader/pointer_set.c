@@ -91,3 +91,8 @@ int pointer_set_has(pointer_set *set, void *pointer) {
     platform_unlock(&set->lock);
     return found;
 }
+
+void pointer_set_each_locked(pointer_set *set, void (*visit)(void *pointer)) {
+    for (size_t k = 0; k < set->capacity; k++)
+        if (set->slots[k] && set->slots[k] != TOMBSTONE) visit(set->slots[k]);
+}

@@ -24,5 +24,7 @@ int pointer_set_has(pointer_set *set, void *pointer);
 int pointer_set_add_locked(pointer_set *set, void *pointer);
 int pointer_set_remove_locked(pointer_set *set, void *pointer);
 int pointer_set_has_locked(pointer_set *set, void *pointer);
+/* Call `visit` with every pointer in the set. */
+void pointer_set_each_locked(pointer_set *set, void (*visit)(void *pointer));
 
 #endif

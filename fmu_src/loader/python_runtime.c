@@ -24,6 +24,9 @@
 static platform_mutex load_lock = PLATFORM_MUTEX_INIT;
 static python_api api;
 static int api_ready;
+static int started_here;  /* this copy started the process's Python: it handles forks (python_runtime_fork_*) */
+static int fork_gil = -1; /* the GIL state taken for a fork in progress */
+static platform_mutex taking_gil = PLATFORM_MUTEX_INIT; /* held while a thread of a C host takes the GIL */
 static char chosen[WHY_SIZE + PLATFORM_PATH_MAX]; /* which Python runs, and why */
 static char failure[2048];                        /* why the last search failed ("" if none failed) */
 static char failure_override[PLATFORM_PATH_MAX + 1]; /* DOUBLE_PENDULUM_FMU_PYTHON at that search */
@@ -263,7 +266,8 @@ static int try_candidate(const char *label, int described, const python_install 
         platform_lock_process(); /* one copy of the loader starts Python at a time; another may have by now */
         char refused[WHY_SIZE] = "";
         in_process here = python_in_process(library, refused, sizeof refused);
-        if (here == NONE_HERE) ready = (*library = python_start(python, why, WHY_SIZE)) != NULL;
+        if (here == NONE_HERE) ready = started_here = (*library = python_start(python, why, WHY_SIZE)) != NULL;
+        if (started_here) platform_pin_self(); /* its fork handlers must stay (python_runtime_fork_prepare) */
         platform_unlock_process();
         if (here == USABLE_HERE) return 1;
         if (here == REFUSED_HERE) text_format(why, WHY_SIZE, "%s", refused);
@@ -366,6 +370,9 @@ static int resolve_api(void *library, char *error, size_t error_size) {
     RESOLVE(GILState_GetThisThreadState, "PyGILState_GetThisThreadState")
     RESOLVE(Thread_get_thread_ident, "PyThread_get_thread_ident")
     RESOLVE(ThreadState_SetAsyncExc, "PyThreadState_SetAsyncExc")
+    RESOLVE(OS_BeforeFork, "PyOS_BeforeFork")
+    RESOLVE(OS_AfterFork_Parent, "PyOS_AfterFork_Parent")
+    RESOLVE(OS_AfterFork_Child, "PyOS_AfterFork_Child")
     RESOLVE(None, "_Py_NoneStruct")
 #undef RESOLVE
     /* '#' formats take a Py_ssize_t length: the _SizeT variant where it still exists (3.11, 3.12) */
@@ -403,6 +410,44 @@ const python_api *python_runtime_start(const char *resources, char *error, size_
     if (said) *said = ready ? chosen : NULL;
     platform_unlock(&load_lock);
     return ready;
+}
+
+int python_runtime_take_gil(void) {
+    if (!started_here) return api.GILState_Ensure();
+    platform_lock(&taking_gil);
+    int gil = api.GILState_Ensure();
+    platform_unlock(&taking_gil);
+    return gil;
+}
+
+/* The fork handlers run in the forking thread alone (prepare, then parent or child): no lock of their own. */
+void python_runtime_fork_prepare(void) {
+    if (started_here && api_ready) { /* the GIL first, as every call takes it before any lock of this copy */
+        platform_lock(&taking_gil); /* no thread between its PyThreadState and the GIL */
+        fork_gil = api.GILState_Ensure();
+        api.OS_BeforeFork();
+    }
+    platform_lock(&load_lock);
+}
+
+void python_runtime_fork_parent(void) {
+    platform_unlock(&load_lock);
+    if (fork_gil < 0) return;
+    api.OS_AfterFork_Parent();
+    int gil = fork_gil;
+    fork_gil = -1;
+    api.GILState_Release(gil);
+    platform_unlock(&taking_gil);
+}
+
+void python_runtime_fork_child(void) {
+    platform_unlock(&load_lock);
+    if (fork_gil < 0) return;
+    api.OS_AfterFork_Child(); /* the child's only thread holds the GIL, the other threads' states are gone */
+    int gil = fork_gil;
+    fork_gil = -1;
+    api.GILState_Release(gil);
+    platform_unlock(&taking_gil);
 }
 
 const char *python_runtime_stdlib(void) {

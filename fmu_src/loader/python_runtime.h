@@ -68,6 +68,9 @@ typedef struct {
     void *(*GILState_GetThisThreadState)(void); /* a PyThreadState *, NULL in a thread Python does not know */
     unsigned long (*Thread_get_thread_ident)(void);
     int (*ThreadState_SetAsyncExc)(unsigned long, PyObject *);
+    void (*OS_BeforeFork)(void);
+    void (*OS_AfterFork_Parent)(void);
+    void (*OS_AfterFork_Child)(void);
     PyObject *None; /* Py_None (_Py_NoneStruct) */
 } python_api;
 
@@ -76,6 +79,25 @@ typedef struct {
  * receives which Python runs and why, for the debug log.  On failure returns NULL and writes one line to
  * `error` saying what was looked for, where, and how to point the FMU at a Python. */
 const python_api *python_runtime_start(const char *resources, char *error, size_t error_size, const char **chosen);
+
+/* Take the GIL (PyGILState_Ensure) for a call of the FMU's Python side.  In a C host's thread, PyGILState_Ensure first
+ * makes a PyThreadState, under a lock of CPython's that a fork could leave held (CPython 3.11's PyOS_AfterFork_Child
+ * then waits for it forever): where this copy started the process's Python, no fork happens meanwhile
+ * (python_runtime_fork_prepare waits for it). */
+int python_runtime_take_gil(void);
+
+/* Around a fork() of the host (the guard's fork handlers call them, guard.c).  Where this copy of the loader
+ * started the process's Python, its fork handling is the loader's to do, as os.fork does it in a Python host:
+ * prepare waits for a thread that is taking the GIL (python_runtime_take_gil), takes the GIL (the thread inside an FMU
+ * call gives it up at its next switch, within about 5 ms) and
+ * readies Python for the fork (PyOS_BeforeFork); after the fork, the parent goes on (PyOS_AfterFork_Parent) and the
+ * child's Python forgets the threads the child does not have (PyOS_AfterFork_Child), and the GIL is given back.
+ * Without this, a child forked while another thread runs the FMU's Python would wait for that thread's GIL
+ * forever.  Where the Python is a host's own (its os.fork does this) or another copy's (whose handlers do it),
+ * these only hold and let go of this copy's lock. */
+void python_runtime_fork_prepare(void);
+void python_runtime_fork_parent(void);
+void python_runtime_fork_child(void);
 
 /* The path of the zipped standard library of the CPython this copy of the loader started from what the FMU carries
  * ("" if it started none: the Python is the host's, another FMU's, or one found), for the bootstrap to read it

@@ -15,6 +15,9 @@
  *   soak N [EVERY]    N instantiate/initialise/step/free cycles; print "rss CYCLE KIB" every EVERY cycles
  *                     (default N/20)
  *   reload N [EVERY]  N cycles of dlopen, instantiate, free, dlclose; "rss CYCLE KIB" as soak (and at 50)
+ *   fork N            a thread steps one instance while the main thread forks N times; each child steps that
+ *                     instance (refused: it was inside a call in a thread the child lacks) and runs a new case;
+ *                     print "fork-hung H", "fork-identical I" and the other counts of run_fork
  *   matrix            every FMI function with valid arguments in every state a fixed call sequence reaches,
  *                     each on a fresh instance: "matrix STATE FUNCTION STATUS" and its log lines
  *   neighbour DIR2 IDENTIFIER2 GUID2
@@ -24,6 +27,8 @@
  * The host's logger formats the message with the arguments it is given, as a C host does: a message
  * passed as a format would crash it here. Exit status 0 if it got to the end. */
 #include <dlfcn.h>
+#include <sched.h>
+#include <sys/wait.h>
 #include <locale.h>
 #include <math.h>
 #include <pthread.h>
@@ -1335,6 +1340,93 @@ static void run_threads(int n, int rounds) {
     free(threads);
 }
 
+/* ------------------------------------------------------------------------------------ fork */
+
+#define FORK_WAIT_S 60 /* a child that has not ended by then hangs (it is killed) */
+
+static fmi2Component busy_instance;
+static volatile int busy_inside, busy_stop;
+
+static void *keep_stepping(void *unused) {
+    (void)unused;
+    double t = 0.0;
+    while (!busy_stop) {
+        busy_inside = 1;
+        int s = fmi2DoStep_(busy_instance, t, 0.5, fmi2True);
+        busy_inside = 0;
+        if (s != fmi2OK) break;
+        t += 0.5;
+    }
+    return NULL;
+}
+
+/* In a child: the busy instance's time and next step (it was inside fmi2DoStep in a thread the child does not have,
+ * unless the fork fell between two steps), then a new instance's case. Exit status: bit 0 the new case differs from `reference`, bit 1 the busy instance's step was
+ * refused (Error) with a log line that says the process forked, bit 2 it was refused without that line. */
+static void forked_child(double reference) {
+    n_logs = 0;
+    double t = NAN; /* where the busy instance is, if the fork fell between two of its steps */
+    int s = fmi2GetRealStatus_(busy_instance, fmi2LastSuccessfulTime, &t);
+    if (s == fmi2OK) s = fmi2DoStep_(busy_instance, t, 0.01, fmi2True);
+    int said = 0;
+    for (int k = 0; k < n_logs; k++) said |= strstr(logs[k], "forked") != NULL;
+    thread_case fresh = {.start = 0.5};
+    run_case(&fresh);
+    int code = memcmp(&fresh.phi1, &reference, sizeof reference) != 0 || isnan(fresh.phi1);
+    if (s == fmi2Error) code |= said ? 2 : 4;
+    else if (s != fmi2OK) code |= 4;
+    fmi2FreeInstance_(busy_instance);
+    fflush(stdout);
+    _exit(code);
+}
+
+/* fork N: a thread runs 0.5 s steps on one instance while the main thread forks N times, each time while that thread
+ * is inside fmi2DoStep (or about to enter or leave it). Each child runs forked_child; the parent waits for it up to
+ * FORK_WAIT_S and kills it if it has not ended. Prints "fork-children N", "fork-hung H" (killed), "fork-crashed C"
+ * (ended by a signal), "fork-identical I" (the new case bit for bit as before the forks), "fork-refused R" (the busy
+ * instance refused with its line) and "fork-bad B" (refused without a line, or another status). */
+static void run_fork(int n) {
+    thread_case reference = {.start = 0.5};
+    run_case(&reference);
+    busy_instance = initialised();
+    pthread_t thread;
+    if (!busy_instance || pthread_create(&thread, NULL, keep_stepping, NULL) != 0) {
+        printf("fork-setup-failed 1\n");
+        return;
+    }
+    int hung = 0, crashed = 0, identical = 0, refused = 0, bad = 0;
+    for (int k = 0; k < n; k++) {
+        while (!busy_inside) sched_yield();
+        struct timespec pause = {0, 1000000L * (k % 5)}; /* 0 to 4 ms into the step */
+        nanosleep(&pause, NULL);
+        fflush(stdout);
+        pid_t child = fork();
+        if (child == 0) forked_child(reference.phi1);
+        int status = 0, ended = 0;
+        for (int waited = 0; child > 0 && waited < FORK_WAIT_S * 100 && !ended; waited++) {
+            ended = waitpid(child, &status, WNOHANG) == child;
+            if (!ended) nanosleep(&(struct timespec){0, 10000000L}, NULL);
+        }
+        if (child > 0 && !ended) {
+            kill(child, SIGKILL);
+            waitpid(child, &status, 0);
+            hung++;
+        } else if (child > 0 && WIFSIGNALED(status)) {
+            crashed++;
+        } else if (child > 0) {
+            int code = WEXITSTATUS(status);
+            identical += !(code & 1);
+            refused += (code & 2) != 0;
+            bad += (code & 4) != 0;
+        }
+    }
+    busy_stop = 1;
+    pthread_join(thread, NULL);
+    fmi2FreeInstance_(busy_instance);
+    printf("fork-children %d\nfork-hung %d\nfork-crashed %d\nfork-identical %d\nfork-refused %d\nfork-bad %d\n", n,
+           hung, crashed, identical, refused, bad);
+}
+
 static long rss_kib(void) {
     FILE *f = fopen("/proc/self/statm", "r");
     long pages = 0, resident = 0;
@@ -1457,6 +1549,7 @@ int main(int argc, char **argv) {
     else if (strcmp(mode, "threads") == 0 && k + 2 < argc) run_threads(atoi(argv[k + 1]), atoi(argv[k + 2]));
     else if (strcmp(mode, "soak") == 0 && k + 1 < argc) run_soak(atoi(argv[k + 1]), k + 2 < argc ? atoi(argv[k + 2]) : 0);
     else if (strcmp(mode, "matrix") == 0) run_matrix();
+    else if (strcmp(mode, "fork") == 0 && k + 1 < argc) run_fork(atoi(argv[k + 1]));
     else if (strcmp(mode, "reload") == 0 && k + 1 < argc) {
         dlclose(library); /* the cycles' handles are the only ones */
         library = NULL;
