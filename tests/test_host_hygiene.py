@@ -195,6 +195,60 @@ def test_pytest_timeouts_signal_method_and_system_exit_from_a_handler_reach_the_
     assert "Traceback" not in exited.stderr, exited.stderr[-3000:]
 
 
+ESCAPED = SLAVE + textwrap.dedent("""
+    import signal, sys
+    folder, guid = sys.argv[1], sys.argv[2]
+
+    class HostTimeout(Exception):
+        pass
+
+    raised = HostTimeout("the host's time is up")
+    def on_alarm(signum, frame):
+        raise raised
+    signal.signal(signal.SIGALRM, on_alarm)
+
+    def tracer(frame, event, arg):  # the signal arrives as the FMU's bridge method is called: its handler runs at
+        if event == "call" and frame.f_code.co_name == "do_step" and "fmi_bridge" in frame.f_code.co_filename:
+            sys.settrace(None)  # the method's first instruction, before its try
+            signal.raise_signal(signal.SIGALRM)
+        return None
+
+    fmu, refs = slave(folder, guid)
+    fmu.instantiate()
+    initialise(fmu, refs)
+    sys.settrace(tracer)
+    try:
+        fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
+        print("outcome: no exception")
+    except HostTimeout as error:
+        print("outcome:", "the host's own object" if error is raised else "a copy")
+    except BaseException as error:
+        print("outcome:", type(error).__name__, error)
+    sys.settrace(None)
+    fmu.reset()
+    initialise(fmu, refs)
+    fmu.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
+    print("after reset phi1", fmu.getReal([refs["phi1"]])[0])
+""")
+
+
+def test_a_host_exception_that_escapes_before_the_calls_try_reaches_the_host_with_its_line(unzipped, tmp_path):
+    """The path a signal takes only by chance, made certain: the host's trace function sends SIGALRM as the bridge's
+    do_step is called, so the host's handler raises its own HostTimeout at the method's first instruction, before
+    its try, and the exception escapes the Python side. The loader
+    asks the bridge (fmi_bridge.escaped_answer) and answers as for any host exception: the log line says the host's
+    own HostTimeout stopped the call, the very object is raised again in the host, and a reset recovers."""
+    folder, guid = unzipped
+    done = subprocess.run([sys.executable, "-c", ESCAPED, str(folder), guid], capture_output=True, text=True,
+                          timeout=120, cwd=tmp_path)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "outcome: the host's own object" in done.stdout, done.stdout[-3000:]
+    said = [line for line in done.stdout.splitlines() if "the host's own HostTimeout" in line]
+    assert len(said) == 1 and "fmi2DoStep" in said[0], done.stdout[-3000:]
+    assert "stopped the call, which was not completed; it is raised again in the host" in said[0]
+    assert "after reset phi1" in done.stdout and "Traceback" not in done.stderr, done.stderr[-3000:]
+
+
 # ----------------------------------------------------------------------------------------------- exiting
 
 EXITING = SLAVE + textwrap.dedent("""
