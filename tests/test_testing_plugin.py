@@ -7,14 +7,26 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import fmpy.util  # noqa: F401 (below)
+import matplotlib.figure  # noqa: F401
 import numpy as np
 import pytest
+import scipy.interpolate  # noqa: F401
+import scipy.ndimage  # noqa: F401
 
+import double_pendulum.testing.cases  # noqa: F401
+import double_pendulum.testing.physics  # noqa: F401
 from double_pendulum.testing import Result, Tolerance, assert_matches_reference
+
+# pytester's in-process runs forget the modules a run imported, and an extension module cannot be loaded twice in a
+# process (numpy.fft's): what the plugin's runs import is imported here once, before them.
 
 pytest_plugins = ["pytester"]
 
-QUIET = ("-p", "no:dash", "-p", "no:cacheprovider")  # dash's plugin warns; nothing written beside the test files
+# the inner runs: no plugin they need not load (each run imports them anew: about 2 s; dash's warns), no cache written
+# beside the test files
+QUIET = ("-p", "no:dash", "-p", "no:hypothesispytest", "-p", "no:xdist", "-p", "no:xdist.looponfail",
+         "-p", "no:cacheprovider")
 
 
 # --- the tube ------------------------------------------------------------------------------------------------
@@ -185,3 +197,63 @@ def test_model_exchange(fmu, simulate):
                                        "--fmu-interface=CS", "-v")
     run.assert_outcomes(passed=1, deselected=5)
     assert "test_any[DoublePendulum-fmi3-CS] PASSED" in run.stdout.str()
+
+
+CASES = '''
+references = "references"
+
+[defaults]
+stop_time = 2.0
+output_interval = 0.01
+tolerance = { time = 0.005, rtol = 1e-4 }
+
+[cases.small_swing]
+start_values = { phi1_0 = 0.1, phi2_0 = 0.1 }
+compare = ["phi1", "phi2"]
+checks = ["energy_budget", "conserved"]
+
+[cases.with_friction]
+start_values = { phi1_0 = 1.5, air_drag = true }
+compare = ["phi2"]
+checks = ["energy_never_rises"]
+'''
+
+
+def test_cases_as_data_write_their_references_then_compare_with_them(pytester, fmu_path, fmu3_path, tmp_path):
+    pytester.makefile(".toml", my_cases=CASES)
+    pytester.makepyfile(test_other="def test_other():\n    pass\n")
+    fmus = (f"--fmu={fmu_path}", f"--fmu={fmu3_path}", "--fmu-interface=CS")
+    run = pytester.runpytest_inprocess(*QUIET, *fmus, "--collect-only", "-q")  # not named: not collected
+    assert run.outlines[0] == "test_other.py::test_other" and "1 test collected" in run.stdout.str()
+
+    refs = tmp_path / "refs"  # the folder the user names
+    run = pytester.runpytest_inprocess(*QUIET, "my_cases.toml", *fmus, f"--regen-references={refs}")
+    run.assert_outcomes(passed=4)
+    assert "--regen-references wrote 4 reference results in the fmi-ls-ref layout" in run.stdout.str()
+    written = sorted(p.relative_to(refs).as_posix() for p in refs.rglob("*.csv"))
+    layout = "extra/org.fmi-standard.fmi-ls-ref/DoublePendulum_out.csv"
+    assert written == [f"{case}/DoublePendulum-{fmi}-CS/{layout}" for case in ("small_swing", "with_friction")
+                       for fmi in ("fmi2", "fmi3")]
+    assert sorted(p.name for p in pytester.path.iterdir()) == ["my_cases.toml", "test_other.py"]
+
+    run = pytester.runpytest_inprocess(*QUIET, "my_cases.toml", *fmus, f"--fmu-references={refs}", "-v")
+    run.assert_outcomes(passed=4)
+    assert "my_cases.toml::small_swing[DoublePendulum-fmi3-CS] PASSED" in run.stdout.str()
+
+    pytester.makefile(".toml", my_cases=CASES.replace("phi1_0 = 0.1,", "phi1_0 = 0.1005,"))  # the case changed
+    run = pytester.runpytest_inprocess(*QUIET, "my_cases.toml", *fmus, f"--fmu-references={refs}")
+    run.assert_outcomes(passed=2, failed=2)
+    text = run.stdout.str()
+    assert "FAILED my_cases.toml::small_swing[DoublePendulum-fmi2-CS]" in text
+    assert re.search(r"phi1: left the tube first at t = 0.01 s \(\d+ of 199 points outside\); largest deviation "
+                     r"0.000[45]\d* rad", text), text
+
+    run = pytester.runpytest_inprocess(*QUIET, "my_cases.toml", *fmus)  # the file's references folder: empty
+    run.assert_outcomes(failed=4)
+    assert (f"{pytester.path / 'references' / 'small_swing' / 'DoublePendulum-fmi2-CS'} holds no reference result"
+            in run.stdout.str() and "write it with pytest my_cases.toml --regen-references" in run.stdout.str())
+
+    pytester.makefile(".toml", bad_cases="[cases.x]\nstop = 1.0\ncompare = ['phi1']\n")
+    run = pytester.runpytest_inprocess(*QUIET, "bad_cases.toml", *fmus)
+    assert run.ret == pytest.ExitCode.INTERRUPTED  # a collection error
+    assert "bad_cases.toml, case 'x': unknown key stop" in run.stdout.str()

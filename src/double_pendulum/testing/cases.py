@@ -33,7 +33,7 @@ from typing import Any
 import pytest
 
 from .running import FmuTarget
-from .session import TARGETS, artefact_folder, fmu_session
+from .session import TARGETS, WRITTEN, artefact_folder, fmu_session
 
 CASE_KEYS = {"start_values", "stop_time", "output_interval", "compare", "tolerance", "tolerances", "checks"}
 FILE_KEYS = {"references", "defaults", "cases"}
@@ -142,6 +142,7 @@ class CaseItem(pytest.Item):
                 f"case {case.name} of {self.path.name}: {values}, to {result.time[-1]:g} s every "
                 f"{result.experiment['output_interval']:g} s (written by pytest --regen-references)")
             self.user_properties.append(("reference", str(written)))
+            self.config.stash.setdefault(WRITTEN, []).append(written)
         elif case.compare:
             if self.references is None:
                 raise CaseError(f"{self.path.name} names no references folder (references = \"DIR\"); write them "

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from .session import SESSION, TARGETS, artefact_folder, fmu_session
+from .session import SESSION, TARGETS, WRITTEN, artefact_folder, fmu_session
 
 if TYPE_CHECKING:
     from .results import Result
@@ -86,6 +86,15 @@ def pytest_sessionfinish(session: pytest.Session) -> None:
         opened.close()
 
 
+def pytest_terminal_summary(terminalreporter: Any, config: pytest.Config) -> None:
+    written = config.stash.get(WRITTEN, [])
+    if written:
+        terminalreporter.write_line(f"--regen-references wrote {len(written)} reference results in the fmi-ls-ref "
+                                    f"layout into {config.getoption('regen_references')}:")
+        for path in written:
+            terminalreporter.write_line(f"  {path}")
+
+
 def _major(version: Any) -> str:
     return str(version).split(".")[0]
 
@@ -136,6 +145,9 @@ class Simulate:
     def __init__(self, fmu: Fmu, artefacts: Callable[[], Path]) -> None:
         self.fmu = fmu
         self._artefacts = artefacts
+
+    def __repr__(self) -> str:
+        return f"<simulate {self.fmu.path.name} {self.fmu.interface}>"
 
     def __call__(self, **arguments: Any) -> Result:
         __tracebackhide__ = True  # a failed run: pytest shows the test's line

@@ -29,7 +29,7 @@ class MissingReference(LookupError):
     """No reference result where one was looked for; the message names the place and says how to make one."""
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, repr=False)
 class Result:
     """Columns of a run or a reference: ``data`` (a structured array, ``time`` [s] first), ``units`` by column
     name, ``label`` (what it is, for messages and plots) and ``experiment`` (start time, stop time and output
@@ -41,6 +41,12 @@ class Result:
     label: str
     experiment: Mapping[str, Any] = dataclasses.field(default_factory=dict)
     artefacts: Callable[[], Path] | None = None
+
+    def __repr__(self) -> str:
+        columns = ", ".join(f"{n} [{self.unit(n)}]" if self.unit(n) else n for n in self.names[:6])
+        more = f" and {len(self.names) - 6} more" if len(self.names) > 6 else ""
+        span = f"t = {self.time[0]:g} to {self.time[-1]:g} s" if len(self) else "no rows"
+        return f"<Result {self.label}: {len(self)} rows, {span}; {columns}{more}>"
 
     @property
     def time(self) -> np.ndarray:

@@ -15,6 +15,8 @@ if TYPE_CHECKING:
 
 TARGETS: pytest.StashKey[list[FmuTarget]] = pytest.StashKey()
 SESSION: pytest.StashKey[FmuSession] = pytest.StashKey()
+WRITTEN: pytest.StashKey[list[Path]] = pytest.StashKey()
+"""The references ``--regen-references`` wrote in this session, for the summary at its end."""
 
 
 def project_fmu(config: pytest.Config) -> Path:

@@ -231,9 +231,8 @@ def plot_tube(result: Result, reference: Result, checks: Sequence[VariableCheck]
         if check.first_out is not None:
             ax.axvline(check.first_out, color="C3", lw=0.8, ls="--")
         ax.set_ylabel(f"{check.name} [{check.unit}]" if check.unit else check.name)
-        ax.legend(loc="upper right", fontsize="x-small")
     axes[-1].set_xlabel("time [s]")
-    figure.suptitle(f"{result.label} against {reference.label}", fontsize="medium")
+    figure.legend(*axes[0].get_legend_handles_labels(), loc="outside upper center", ncols=4, fontsize="small")
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"tube-{re.sub(r'[^A-Za-z0-9_.-]+', '_', '-'.join(c.name for c in shown))[:80]}.png"
     figure.savefig(path, dpi=100)
