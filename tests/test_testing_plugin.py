@@ -257,3 +257,33 @@ def test_cases_as_data_write_their_references_then_compare_with_them(pytester, f
     run = pytester.runpytest_inprocess(*QUIET, "bad_cases.toml", *fmus)
     assert run.ret == pytest.ExitCode.INTERRUPTED  # a collection error
     assert "bad_cases.toml, case 'x': unknown key stop" in run.stdout.str()
+
+
+def test_without_fmu_the_projects_fmu_is_used_and_a_csv_of_ones_own_is_a_reference(pytester, fmu_path):
+    """Outside the project's folder the project's FMU is kept in pytest's cache folder: one there and newer than the
+    sources is used as it is (an older one would be built anew there)."""
+    import shutil
+    import zipfile
+
+    from double_pendulum.fmu.carries.reference_result import FOLDER
+
+    kept = pytester.path / ".pytest_cache" / "d" / "double_pendulum_fmu" / "DoublePendulum.fmu"
+    kept.parent.mkdir(parents=True)
+    shutil.copyfile(fmu_path, kept)
+    with zipfile.ZipFile(fmu_path) as archive:
+        rows = archive.read(f"{FOLDER}/DoublePendulum_out.csv").decode().splitlines()
+    pytester.path.joinpath("my_reference.csv").write_text("".join(",".join(row.split(",")[:2]) + "\n" for row in rows))
+    pytester.makepyfile(test_mine='''
+import pytest
+from double_pendulum.testing import assert_matches_reference
+
+@pytest.mark.fmu_reference("my_reference.csv")
+def test_my_csv(fmu, simulate, reference):
+    assert fmu.path.name == "DoublePendulum.fmu" and fmu.path.parent.name == "double_pendulum_fmu"
+    assert reference.names == ("phi1",) and reference.unit("phi1") == "rad"
+    assert_matches_reference(simulate.like(reference), reference, rtol=1e-9)
+''')
+    before = kept.stat().st_mtime_ns
+    run = pytester.runpytest_inprocess(*QUIET[:-2], "-v")  # pytest's cache folder on
+    assert "test_mine.py::test_my_csv[DoublePendulum-fmi2-CS] PASSED" in run.stdout.str(), run.stdout.str()
+    assert kept.stat().st_mtime_ns == before
