@@ -4,6 +4,7 @@ messages asserted; and the tube comparison on signals whose answer is known."""
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -172,11 +173,24 @@ def test_a_users_tests_pass_and_fail_with_their_reasons(pytester, built_fmus):
     assert sorted(p.name for p in pytester.path.iterdir()) == ["test_mine.py"]
 
 
-def test_a_missing_fmu_is_a_usage_error_naming_it(pytester):
-    pytester.makepyfile(test_mine="def test_one(fmu):\n    pass\n")
-    run = pytester.runpytest_inprocess(*QUIET, "--fmu=models/Mine.fmu")
+def test_misuse_is_a_usage_error_naming_it_and_two_fmus_of_one_name_keep_apart(pytester, fmu_path):
+    pytester.makepyfile(test_mine="import pytest\n\ndef test_one(fmu):\n    pass\n")
+    for options, message in ((["--fmu=models/Mine.fmu"], "--fmu models/Mine.fmu: no such file"),
+                             ([f"--fmu={fmu_path}", f"--fmu={fmu_path}"], f"--fmu {fmu_path}: given twice"),
+                             (["--fmu=test_mine.py"], "--fmu test_mine.py is not a usable FMU (BadZipFile")):
+        run = pytester.runpytest_inprocess(*QUIET, *options)
+        assert run.ret == pytest.ExitCode.USAGE_ERROR and message in run.stderr.str(), (options, run.stderr.str())
+    for folder in ("a", "b"):  # the same file under one name in two folders (hard links: not resolved as one)
+        (pytester.path / folder).mkdir()
+        os.link(fmu_path, pytester.path / folder / fmu_path.name)
+    run = pytester.runpytest_inprocess(*QUIET, "--fmu=a/DoublePendulum.fmu", "--fmu=b/DoublePendulum.fmu",
+                                       "--collect-only", "-q")
+    assert run.outlines[:2] == ["test_mine.py::test_one[a-DoublePendulum-fmi2-CS]",
+                                "test_mine.py::test_one[b-DoublePendulum-fmi2-CS]"], run.outlines
+    pytester.makepyfile(test_mine="import pytest\n\n@pytest.mark.fmu(interface='me')\ndef test_one(fmu):\n    pass\n")
+    run = pytester.runpytest_inprocess(*QUIET, f"--fmu={fmu_path}")
     assert run.ret == pytest.ExitCode.USAGE_ERROR
-    assert "--fmu models/Mine.fmu: no such file" in run.stderr.str()
+    assert "@pytest.mark.fmu(interface='me', fmi_version=None): the interface is ME or CS" in run.stderr.str()
 
 
 def test_the_interface_and_version_select_the_tests(pytester, fmu_path, fmu3_path):

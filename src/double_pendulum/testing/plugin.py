@@ -19,6 +19,7 @@ runs, reads or builds an FMU unless a test asks for one of them or a cases file 
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -73,11 +74,16 @@ def _targets(paths: list[str]) -> list[FmuTarget]:
         if not path.is_file():
             why = "a folder, not an FMU file" if path.is_dir() else "no such file"
             raise pytest.UsageError(f"--fmu {given}: {why}")
+        if any(target.path == path.resolve() for target in targets):
+            raise pytest.UsageError(f"--fmu {given}: given twice")
         try:
-            targets += targets_of(path.resolve())
+            targets += [dataclasses.replace(target, path=path.resolve()) for target in targets_of(path)]
         except ValueError as error:
-            raise pytest.UsageError(f"--fmu {given}: {error}") from None
-    return targets
+            raise pytest.UsageError(f"--fmu {error}") from None
+    ids = [target.id for target in targets]
+    # two files of one name (in two folders): their folder tells them apart in the ids and the references' folders
+    return [dataclasses.replace(target, stem=f"{target.path.parent.name}-{target.path.stem}")
+            if ids.count(target.id) > 1 and target.path is not None else target for target in targets]
 
 
 def pytest_sessionfinish(session: pytest.Session) -> None:
@@ -100,12 +106,17 @@ def _major(version: Any) -> str:
 
 
 def selected(config: pytest.Config, target: FmuTarget, marker: pytest.Mark | None) -> bool:
-    """Whether ``target`` is one the options and the test's ``fmu`` marker ask for."""
+    """Whether ``target`` is one the options and the test's ``fmu`` marker ask for (a marker asking for an
+    interface or version there is none of is a usage error)."""
     interfaces = [config.getoption("fmu_interface")]
     versions = [config.getoption("fmi_version")]
     if marker is not None:
-        interfaces.append(marker.kwargs.get("interface"))
-        versions.append(marker.kwargs.get("fmi_version"))
+        interface, version = marker.kwargs.get("interface"), marker.kwargs.get("fmi_version")
+        if interface not in (None, "ME", "CS") or (version is not None and _major(version) not in ("2", "3")):
+            raise pytest.UsageError(f"@pytest.mark.fmu(interface={interface!r}, fmi_version={version!r}): the "
+                                    "interface is ME or CS, the FMI version 2 or 3")
+        interfaces.append(interface)
+        versions.append(version)
     return (all(i is None or target.interface == i for i in interfaces)
             and all(v is None or _major(target.fmi_version) == _major(v) for v in versions))
 

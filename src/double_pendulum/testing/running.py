@@ -41,11 +41,13 @@ class FmuTarget:
     interface: str
     fmi_version: str
     model: str
+    stem: str | None = None
 
     @property
     def id(self) -> str:
-        """The test id: the file's stem, the FMI version's major and the interface (``DoublePendulum-fmi2-CS``)."""
-        stem = self.path.stem if self.path is not None else self.model
+        """The test id: the file's stem (or ``stem``), the FMI version's major and the interface
+        (``DoublePendulum-fmi2-CS``)."""
+        stem = self.stem or (self.path.stem if self.path is not None else self.model)
         return f"{stem}-fmi{self.fmi_version.split('.')[0]}-{self.interface}"
 
 
