@@ -153,6 +153,7 @@ class Fmu:
             except FmuRunError as error:
                 raise SimulationFailed(f"{self.path.name} ({self.interface}, FMI {self.fmi_version}): simulate("
                                        f"{_shown(arguments)}) failed: {error}") from None
+            data.flags.writeable = False  # shared by every test that asks for this run: none may change it
             units = {name: self.units.get(name, "") for name in ("time", *names)}
             units["time"] = units["time"] or "s"
             self._runs[key] = Result(data, units, f"{self.path.name} {self.interface}",
