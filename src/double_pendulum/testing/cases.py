@@ -146,12 +146,12 @@ class CaseItem(pytest.Item):
         elif case.compare:
             if self.references is None:
                 raise CaseError(f"{self.path.name} names no references folder (references = \"DIR\"); write them "
-                                f"with pytest {self.path.name} --regen-references DIR")
+                                f"with pytest {self.path.name} --regen-references=DIR")
             folder = self.reference_folder(self.references)
             try:
                 reference = reference_in_folder(folder, fmu.units, label=f"reference of {case.name}")
             except MissingReference as error:
-                raise CaseError(f"{error}; write it with pytest {self.path.name} --regen-references "
+                raise CaseError(f"{error}; write it with pytest {self.path.name} --regen-references="
                                 f"{self.references}") from None
             assert_matches_reference(result, reference, case.compare, **case.tolerance, tolerances=case.tolerances)
         if "energy_budget" in case.checks:
