@@ -239,6 +239,9 @@ def test_cases_as_data_write_their_references_then_compare_with_them(pytester, f
     fmus = (f"--fmu={fmu_path}", f"--fmu={fmu3_path}", "--fmu-interface=CS")
     run = pytester.runpytest_inprocess(*QUIET, *fmus, "--collect-only", "-q")  # not named: not collected
     assert run.outlines[0] == "test_other.py::test_other" and "1 test collected" in run.stdout.str()
+    run = pytester.runpytest_inprocess(*QUIET, *fmus, "--fmu-cases", "--collect-only", "-q")  # asked for: collected
+    assert "my_cases.toml::small_swing[DoublePendulum-fmi3-CS]" in run.outlines
+    assert "5/7 tests collected (2 deselected)" in run.stdout.str()  # the cases on Model Exchange: not asked for
 
     refs = tmp_path / "refs"  # the folder the user names
     run = pytester.runpytest_inprocess(*QUIET, "my_cases.toml", *fmus, f"--regen-references={refs}")
