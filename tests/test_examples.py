@@ -23,10 +23,12 @@ def _run(script: str, *args: str, cwd: Path) -> str:
 
 
 def test_every_example_is_linked_from_the_readme_and_guards_its_top_level():
+    """A script guards its top level (the sweep's workers import it again); a test file (test_*.py) is pytest's."""
     readme = (REPO / "README.md").read_text()
     for script in sorted(EXAMPLES.glob("*.py")):
         assert f"](examples/{script.name})" in readme, f"README does not link examples/{script.name}"
-        assert 'if __name__ == "__main__":' in script.read_text(), script.name
+        if not script.name.startswith("test_"):
+            assert 'if __name__ == "__main__":' in script.read_text(), script.name
 
 
 def _users_cwd(folder: Path) -> Path:
@@ -66,3 +68,37 @@ def test_the_driven_pendulum_takes_energy_from_the_motor_at_resonance(built_fmus
     assert at > 10 * abs(off)  # in resonance the motor does the work
     assert "wrote figures/driven/drive_inputs.png" in out
     assert (cwd / "figures" / "driven" / "drive_inputs.png").stat().st_size > 10_000
+
+
+def _pytest(*args: str, cwd: Path) -> str:
+    """pytest run as a user runs it, in a process of its own: the project's addopts (xdist's workers) left out."""
+    done = subprocess.run([sys.executable, "-m", "pytest", "-o", "addopts=", "-p", "no:dash", "-p", "no:cacheprovider",
+                           *args], cwd=cwd, env={**os.environ, "MPLBACKEND": "Agg"}, capture_output=True, text=True)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return done.stdout
+
+
+def test_the_pytest_example_and_its_cases_pass_on_an_fmu_of_ones_own(built_fmus, tmp_path):
+    """examples/test_my_pendulum.py and examples/cases.toml through the plugin, on a user's FMU dated 2020 (read, never
+    built over); the cases' references written into the folder named (tests/test_testing_plugin.py compares with
+    such), nothing else written."""
+    home = users_folder(tmp_path / "home", built_fmus)
+    cwd = _users_cwd(tmp_path / "work")
+    before, before_cwd = folder_state(home), folder_state(cwd)
+    fmu = f"--fmu={home / 'models' / 'Other.fmu'}"
+    out = _pytest(str(EXAMPLES / "test_my_pendulum.py"), str(EXAMPLES / "cases.toml"), fmu, "--regen-references=refs",
+                  "-v", cwd=cwd)
+    for test in ("test_the_fmu_reproduces_the_reference_it_carries[Other-fmi2-CS]",
+                 "test_my_pendulum_loses_energy_only_to_friction[Other-fmi2-CS]",
+                 "test_my_pendulum_swings_at_its_normal_modes[Other-fmi2-CS-slow]",
+                 "test_my_pendulum_swings_at_its_normal_modes[Other-fmi2-CS-fast]"):
+        assert f"test_my_pendulum.py::{test} PASSED" in out, out
+    assert "--regen-references wrote 2 reference results in the fmi-ls-ref layout into refs" in out
+    assert "cases.toml::small_swing[Other-fmi2-CS] PASSED" in out and "6 passed" in out, out
+    assert folder_state(home) == before
+    after_cwd = folder_state(cwd)
+    assert sorted(set(after_cwd) - set(before_cwd)) == sorted(
+        ["refs", *(f"refs/{case}{tail}" for case in ("small_swing", "longer_rod_with_friction") for tail in (
+            "", "/Other-fmi2-CS", "/Other-fmi2-CS/extra", "/Other-fmi2-CS/extra/org.fmi-standard.fmi-ls-ref",
+            "/Other-fmi2-CS/extra/org.fmi-standard.fmi-ls-ref/fmi-ls-manifest.xml",
+            "/Other-fmi2-CS/extra/org.fmi-standard.fmi-ls-ref/DoublePendulum_out.csv"))])
