@@ -370,11 +370,12 @@ static int resolve_api(void *library, char *error, size_t error_size) {
     RESOLVE(GILState_GetThisThreadState, "PyGILState_GetThisThreadState")
     RESOLVE(Thread_get_thread_ident, "PyThread_get_thread_ident")
     RESOLVE(ThreadState_SetAsyncExc, "PyThreadState_SetAsyncExc")
-    RESOLVE(OS_BeforeFork, "PyOS_BeforeFork")
-    RESOLVE(OS_AfterFork_Parent, "PyOS_AfterFork_Parent")
-    RESOLVE(OS_AfterFork_Child, "PyOS_AfterFork_Child")
     RESOLVE(None, "_Py_NoneStruct")
 #undef RESOLVE
+    /* POSIX only (a Windows CPython has no fork): python_runtime_fork_prepare needs all three */
+    *(void **)&api.OS_BeforeFork = platform_symbol(library, "PyOS_BeforeFork");
+    *(void **)&api.OS_AfterFork_Parent = platform_symbol(library, "PyOS_AfterFork_Parent");
+    *(void **)&api.OS_AfterFork_Child = platform_symbol(library, "PyOS_AfterFork_Child");
     /* '#' formats take a Py_ssize_t length: the _SizeT variant where it still exists (3.11, 3.12) */
     *(void **)&api.VaBuildValue = platform_symbol(library, "_Py_VaBuildValue_SizeT");
     if (!api.VaBuildValue) *(void **)&api.VaBuildValue = platform_symbol(library, "Py_VaBuildValue");
@@ -422,7 +423,8 @@ int python_runtime_take_gil(void) {
 
 /* The fork handlers run in the forking thread alone (prepare, then parent or child): no lock of their own. */
 void python_runtime_fork_prepare(void) {
-    if (started_here && api_ready) { /* the GIL first, as every call takes it before any lock of this copy */
+    if (started_here && api_ready && api.OS_BeforeFork && api.OS_AfterFork_Parent && api.OS_AfterFork_Child) {
+        /* the GIL first, as every call takes it before any lock of this copy */
         platform_lock(&taking_gil); /* no thread between its PyThreadState and the GIL */
         fork_gil = api.GILState_Ensure();
         api.OS_BeforeFork();

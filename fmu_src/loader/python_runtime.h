@@ -68,7 +68,7 @@ typedef struct {
     void *(*GILState_GetThisThreadState)(void); /* a PyThreadState *, NULL in a thread Python does not know */
     unsigned long (*Thread_get_thread_ident)(void);
     int (*ThreadState_SetAsyncExc)(unsigned long, PyObject *);
-    void (*OS_BeforeFork)(void);
+    void (*OS_BeforeFork)(void); /* these three: NULL where the CPython has no fork (Windows) */
     void (*OS_AfterFork_Parent)(void);
     void (*OS_AfterFork_Child)(void);
     PyObject *None; /* Py_None (_Py_NoneStruct) */
