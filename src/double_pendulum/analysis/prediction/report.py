@@ -45,14 +45,15 @@ def fmt_horizon(value: float | None, span: float) -> str:
     return f"none in {span:.2f}" if value is None else f"{value:.2f}"
 
 
-def horizon_rows(s: PredictionSummary) -> str:
-    """Rows of :data:`HORIZON_HEADER`: the lower bob's smoothed and per-frame horizons [s] and rms error [mm]."""
+def horizon_rows(s: PredictionSummary, labels: Mapping[str, str] = LABELS) -> str:
+    """Rows of :data:`HORIZON_HEADER`: the lower bob's smoothed and per-frame horizons [s] and rms error [mm], each
+    run named by ``labels``."""
     span = s["prediction_s"]
     rows = []
     for label, h in s["horizons_smoothed_s"].items():
         raw = s["horizons_raw_s"][label]
         rms_mm = 1e3 * s["rms_error_first_second_m"][label]["lower_bob"]
-        cells = [LABELS.get(label, label), fmt_horizon(h["lower_bob_2cm_s"], span),
+        cells = [labels.get(label, label), fmt_horizon(h["lower_bob_2cm_s"], span),
                  fmt_horizon(h["lower_bob_5cm_s"], span), fmt_horizon(raw["lower_bob_5cm_s"], span), f"{rms_mm:.0f}"]
         rows.append("| " + " | ".join(cells) + " |")
     return "\n".join(rows)
