@@ -102,6 +102,10 @@ HEADLINES: dict[str, tuple[Headline, ...]] = {
                  "horizons_smoothed_s/seed_start_frictionless/lower_bob_5cm_s", unit="s",
                  resolution="smoothing/window_s"),
         Headline("the motion at the measured energy", "regime/verdict"),
+        Headline("the same horizon with every uncertain input drawn at once (rods, l1, losses, start, geometry): "
+                 "16-84 % of the runs", "horizon_budget/distribution/range_16_84_s", unit="s after t0",
+                 note="horizon_budget/statement", resolution="smoothing/window_s"),
+        Headline("the uncertain input that moves it most", "horizon_budget/dominant_input"),
     ),
     "free_swing": (
         Headline("two chaotic starts 1e-5 rad apart: lower bobs 1 cm apart after",
@@ -183,6 +187,7 @@ FIGURES: dict[str, tuple[tuple[str, str], ...]] = {
         ("measured_vs_sim.gif", "the camera's two markers and the FMU's pendulum overlaid, in real time"),
         ("lower_bob_paths.png", "the lower bob's measured and simulated paths in the x-y plane"),
         ("prediction_error.png", "how far the simulated lower bob is from the measured one, over time"),
+        ("horizon_budget.png", "what moves the prediction horizon, and its range over every uncertain input"),
     ),
     "free_swing": (
         ("twin_starts.gif", "two chaotic starts a hair's breadth apart stay together, then part (real time)"),

@@ -43,6 +43,15 @@ losses' uncertainty moves it far more: ``loss_uncertainty`` gives each supported
 Lyapunov exponent of the fitted start (frictionless, rods, :data:`LYAPUNOV_S` s; quick: :data:`QUICK_LYAPUNOV_S` s;
 thorough: :data:`THOROUGH_LYAPUNOV_S` s) against the energy the lower rod needs to flip.
 
+The horizon over every uncertain input (:mod:`double_pendulum.analysis.prediction.horizon_budget`, ``horizon_budget``
+in the summary, ``horizon_budget.png``): each input at two values with the others held (the rods' member mass at the
+seed's 70 +- 30 g, the start-fit window at 1 s and 2 s, l1 and each loss coefficient at +-1 standard error; the start
+and geometry fitted again for the rods, l1 and the window), a profile of the start fit's chi2 over the rods' mass
+beside the whole record's error, and :data:`~double_pendulum.analysis.prediction.horizon_budget.ENSEMBLE_SIZE` runs
+with every input drawn at once (median, 16-84 % and 2.5-97.5 %); about 40 s of CPU on a cold cache, then read from
+it (quick: the losses one at a time and a 4-run ensemble over the start, geometry and losses alone). On a user's
+record the rods are not drawn (their file states no uncertainty for them).
+
 Cost: about 29 s of CPU by default once ``loss_identification`` has cached its fits (about 130 s on a first
 run that fits every model itself, plus about 6 s for the damping runs until they are cached). ``thorough`` adds
 the loss ensemble (60 runs, about 40 s, cached), the fit-window check (:data:`WINDOW_SENSITIVITY`, about 35 s),
@@ -61,7 +70,8 @@ is :func:`~double_pendulum.analysis.prediction.own_report.own_report_text`.
 
 Outputs in ``results/measured_vs_sim/``: a CSV per run, ``errors.csv`` (per frame), ``coordinates.png`` (the
 seed's figs. 11-14), ``prediction_error.png``, ``paths.csv`` and drawn from it ``lower_bob_paths.png`` and
-``measured_vs_sim.gif``, with ``thorough`` ``out_of_sample_motion.png``, ``summary.json`` and ``report.md``.
+``measured_vs_sim.gif``, ``horizon_budget.png``, with ``thorough``
+``out_of_sample_motion.png``, ``summary.json`` and ``report.md``.
 """
 
 from __future__ import annotations
@@ -76,6 +86,7 @@ from double_pendulum import plots
 from double_pendulum.analysis.losses.identification import seed_reconstruction
 from double_pendulum.analysis.losses.mechanisms import model_title
 from double_pendulum.analysis.prediction.comparison import (
+    LOSS_MODEL,
     SMOOTHING_S,
     THRESHOLDS_M,
     Prediction,
@@ -100,6 +111,7 @@ from double_pendulum.analysis.prediction.comparison import (
     simulated_coordinates,
     window_sensitivity,
 )
+from double_pendulum.analysis.prediction.horizon_budget import Setting, horizon_budget
 from double_pendulum.analysis.prediction.loss_models import (
     loss_model_predictions,
     loss_model_sensitivity,
@@ -192,6 +204,23 @@ def _plots(out_dir: Path, rec: Reconstruction, i0: int, n_frames: int, predictio
     )
 
 
+def _budget(runner: FmuRunner, rec: Reconstruction, i0: int, n_frames: int, losses: Any, geo: Any,
+            window_frames: int, loss_fits: dict, *, seed: bool, quick: bool) -> dict[str, Any]:  # fmt: skip
+    """The horizon over every uncertain input (:func:`~double_pendulum.analysis.prediction.horizon_budget.
+    horizon_budget`): the main loss model's coefficients with the covariance of its energy fit (its standard errors
+    alone where it is not among ``loss_fits``), l1's standard error from the circle fit, the rods on the seed's
+    record only."""
+    names = list(losses.parameters)
+    theta = np.array([losses.parameters[k]["value"] for k in names])
+    if LOSS_MODEL in loss_fits:
+        fit, factor = loss_fits[LOSS_MODEL]
+        cov = fit.cov(factor)
+    else:
+        cov = np.diag([losses.parameters[k]["stderr"] ** 2 for k in names])
+    setting = Setting(runner, rec, i0, n_frames, losses.values, geo, window_frames)
+    return horizon_budget(setting, LOSS_MODEL, theta, cov, names, rec.geometry.sigma_l1, rods=seed, quick=quick)
+
+
 def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool = False,
         record: UserRecord | None = None) -> dict:  # fmt: skip
     """Predict the seed's track from t0 = 0.8 s, or a user's ``record`` from the end of its release
@@ -214,9 +243,8 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
                    int(np.flatnonzero(rec.track.valid)[-1]) - i0 + 1)  # to the record's last valid frame at most
     ensemble_size = QUICK_ENSEMBLE_SIZE if quick else ENSEMBLE_SIZE
     seed_state = reconstructed_state(rec, i0)
-    starts = fitted_starts(runner, rec, i0, values,
-                           frames_at(QUICK_GEOMETRY_FIT_FRAMES if quick else GEOMETRY_FIT_FRAMES, dt),
-                           frames_at(FIT_FRAMES, dt))  # fmt: skip
+    window_frames = frames_at(QUICK_GEOMETRY_FIT_FRAMES if quick else GEOMETRY_FIT_FRAMES, dt)
+    starts = fitted_starts(runner, rec, i0, values, window_frames, frames_at(FIT_FRAMES, dt))
     geo = starts.geometry
     predictions = run_predictions(runner, rec, i0, n_frames, values, frictionless, seed_state, starts)
     prediction_s = (n_frames - 1) * dt
@@ -227,6 +255,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     spread = chaos_spread(runner, values, geo, predictions[-1], n_frames, ensemble_size, dt=dt)
     uncertainty = loss_uncertainty(runner, rec, i0, n_frames, losses.pendulum, geo, loss_fits, by_model,
                                    list(loss_fits), LOSS_ENSEMBLE_SIZE if thorough else 0)
+    budget = _budget(runner, rec, i0, n_frames, losses, geo, window_frames, loss_fits, seed=seed, quick=quick)
     smoothed = {p.label: p.smoothed_horizons() for p in predictions}
     reached = smoothed["lsq_geometry_identified"]["lower_bob_5cm_s"]
     fitted_l2 = {"l2": geo.geometry.get("l2", losses.pendulum["l2"])}
@@ -249,6 +278,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         "horizons_raw_s": {p.label: p.horizons() for p in predictions},
         "loss_model_sensitivity": loss_model_sensitivity(by_model, n_frames, dt),
         "loss_uncertainty": uncertainty,
+        "horizon_budget": budget,
         "goal": goal_entry(reached, prediction_s, GOAL_S),
         "regime": regime(PendulumParameters(**{**losses.pendulum, **fitted_l2}), geo.state, lyapunov_s),
         "chaos_horizons_s": chaos_horizons(spread),
@@ -270,6 +300,9 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     write_results_csv(out_dir / "errors.csv", errors_table(rec, i0, n_frames, predictions), errors_units(predictions))
     write_results_csv(out_dir / "paths.csv", paths_table(rec, i0, n_frames, predictions[-1]), PATHS_UNITS)
     _plots(out_dir, rec, i0, n_frames, predictions, spread, by_model)
+    if budget["one_at_a_time"]:
+        plots.plot_horizon_budget(budget["one_at_a_time"], budget["distribution"], budget["main_horizon_s"],
+                                  prediction_s, out_dir / "horizon_budget.png")
     summary["wall_time_s"] = time.perf_counter() - wall0
     write_json(out_dir / "summary.json", summary)
     write_text(out_dir / "report.md", report_text(summary) if seed else own_report_text(summary))

@@ -12,6 +12,7 @@ from ..losses.mechanisms import model_title
 from .report import (
     HORIZON_HEADER,
     MAIN_RUN,
+    budget_text,
     geometry_text,
     horizon_claims_text,
     horizon_rows,
@@ -113,6 +114,8 @@ Lower bob; "none in {span:.2f}": not exceeded in the {span:.2f} s compared (``pr
 {loss_models_text(s)}
 
 {_damping_text(s)}
+
+{budget_text(s)}
 
 {regime_text(s)}
 """
