@@ -264,7 +264,7 @@ def budget_text(s: Mapping[str, Any]) -> str:
                   else f"lowest at {1e3 * prof['best']:.0f} +- {1e3 * prof['stderr']:.0f} g")
         text += (f"\n\n**The rods' inertia.** The start and geometry fitted again with each member's mass: the "
                  f"fit's chi2 over the start-fit window rises by (chi2 - chi2_min) / chi2_red = {steps} "
-                 f"({window}); the lower bob's RMS error over the whole prediction is {rms} (lowest at "
+                 f"({window}); the lower bob's RMS error over the whole prediction is {rms} (lowest of these at "
                  f"{1e3 * prof['record_rms_lowest_at_kg']:.0f} g, with the losses fitted for the seed's 70 g). "
                  f"The drawn rods take +-{1e3 * b['rods_stderr_kg']:.0f} g: {b['rods_stderr_from']}.")
     return text
