@@ -98,10 +98,14 @@ HEADLINES: dict[str, tuple[Headline, ...]] = {
                  resolution="smoothing/window_s"),
         Headline("the same, frame by frame: first more than 5 cm off after", "loss_model_sensitivity/raw_5cm_range_s",
                  unit="s", resolution=0.1),  # a first crossing moves by a few 30 fps frames, so 0.1 s
-        Headline("started the seed's way (its start, no friction): within 5 cm for",
+        Headline("started as the seed started (the state reconstructed at t0, no friction): within 5 cm for",
                  "horizons_smoothed_s/seed_start_frictionless/lower_bob_5cm_s", unit="s",
                  resolution="smoothing/window_s"),
         Headline("the motion at the measured energy", "regime/verdict"),
+        Headline("the same horizon with every uncertain input drawn at once (rods, l1, losses, start, geometry): "
+                 "16-84 % of the runs", "horizon_budget/distribution/range_16_84_s", unit="s after t0",
+                 note="horizon_budget/statement", resolution="smoothing/window_s"),
+        Headline("the uncertain input that moves it most", "horizon_budget/dominant_input"),
     ),
     "free_swing": (
         Headline("two chaotic starts 1e-5 rad apart: lower bobs 1 cm apart after",
@@ -183,6 +187,7 @@ FIGURES: dict[str, tuple[tuple[str, str], ...]] = {
         ("measured_vs_sim.gif", "the camera's two markers and the FMU's pendulum overlaid, in real time"),
         ("lower_bob_paths.png", "the lower bob's measured and simulated paths in the x-y plane"),
         ("prediction_error.png", "how far the simulated lower bob is from the measured one, over time"),
+        ("horizon_budget.png", "what moves the prediction horizon, and its range over every uncertain input"),
     ),
     "free_swing": (
         ("twin_starts.gif", "two chaotic starts a hair's breadth apart stay together, then part (real time)"),
@@ -217,7 +222,8 @@ FIGURES: dict[str, tuple[tuple[str, str], ...]] = {
 CONCLUSIONS: dict[str, str] = {
     "measured_vs_sim": "Started from a state fitted to the camera's first frames, the simulated pendulum keeps its "
                        "lower bob within 5 cm of the measured one (smoothed) for {0}, whichever of the loss models "
-                       "the measured energy supports it uses; started the seed's way, for {2}.",
+                       "the measured energy supports it uses; started from the state reconstructed at t0 without "
+                       "friction, for {2}.",
     "chaos": "From a large start the motion is chaotic: a small difference grows e-fold at the rate of the largest "
              "Lyapunov exponent, {0}, and hand releases within 5 mm of each other spread beyond 1 cm after {2}.",
     "energy_decay": "The measured energy decays as E = a exp(b t) with b = {0} (statistical error); the choice of "
@@ -254,6 +260,8 @@ OWN_RECORD_DESCRIPTIONS: dict[str, str] = {
     "energy_decay": "energy decay of your pendulum from your camera track {record}, decay models compared",
     "loss_identification": "loss mechanisms of your pendulum identified from its measured energy in {record} "
                            "(AIC/BIC, shares)",
+    "measured_vs_sim": "FMU prediction of your camera track {record} from the end of its release: the start fitted "
+                       "to your track, the losses to its energy",
 }
 """The one line of a scenario that ran on a user's own record (``run --track``), in place of its description."""
 

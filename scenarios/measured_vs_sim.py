@@ -43,6 +43,15 @@ losses' uncertainty moves it far more: ``loss_uncertainty`` gives each supported
 Lyapunov exponent of the fitted start (frictionless, rods, :data:`LYAPUNOV_S` s; quick: :data:`QUICK_LYAPUNOV_S` s;
 thorough: :data:`THOROUGH_LYAPUNOV_S` s) against the energy the lower rod needs to flip.
 
+The horizon over every uncertain input (:mod:`double_pendulum.analysis.prediction.horizon_budget`, ``horizon_budget``
+in the summary, ``horizon_budget.png``): each input at two values with the others held (the rods' member mass at the
+seed's 70 +- 30 g, the start-fit window at 1 s and 2 s, l1 and each loss coefficient at +-1 standard error; the start
+and geometry fitted again for the rods, l1 and the window), a profile of the start fit's chi2 over the rods' mass
+beside the whole record's error, and :data:`~double_pendulum.analysis.prediction.horizon_budget.ENSEMBLE_SIZE` runs
+with every input drawn at once (median, 16-84 % and 2.5-97.5 %); about 40 s of CPU on a cold cache, then read from
+it (quick: the losses one at a time and a 4-run ensemble over the start, geometry and losses alone). On a user's
+record the rods are not drawn (their file states no uncertainty for them).
+
 Cost: about 29 s of CPU by default once ``loss_identification`` has cached its fits (about 130 s on a first
 run that fits every model itself, plus about 6 s for the damping runs until they are cached). ``thorough`` adds
 the loss ensemble (60 runs, about 40 s, cached), the fit-window check (:data:`WINDOW_SENSITIVITY`, about 35 s),
@@ -51,9 +60,18 @@ other half's motion, :mod:`double_pendulum.analysis.prediction.out_of_sample`: t
 from ``loss_identification --thorough``'s cache) and a :data:`THOROUGH_LYAPUNOV_S` s Lyapunov exponent.
 ``quick``: a 3 s prediction, the geometry fitted to :data:`QUICK_GEOMETRY_FIT_FRAMES` frames.
 
+With a user's own record (``double-pendulum run measured_vs_sim --track FILE.csv --pendulum FILE.toml``,
+:mod:`double_pendulum.analysis.track.user_track`) the same runs are made on it: the pendulum of the user's file (point
+masses unless it gives rods), the losses fitted to that record's energy as ``loss_identification`` fits them on it
+(the same cached fits), t0 at the end of the release (the energy's first maximum, where those fits start), the fit
+windows the same in seconds at the record's frame rate, and the prediction to the end of the record (at most
+:data:`PREDICTION_S`). Its summary names the record (``record``), holds none of the seed's numbers, and its report
+is :func:`~double_pendulum.analysis.prediction.own_report.own_report_text`.
+
 Outputs in ``results/measured_vs_sim/``: a CSV per run, ``errors.csv`` (per frame), ``coordinates.png`` (the
 seed's figs. 11-14), ``prediction_error.png``, ``paths.csv`` and drawn from it ``lower_bob_paths.png`` and
-``measured_vs_sim.gif``, with ``thorough`` ``out_of_sample_motion.png``, ``summary.json`` and ``report.md``.
+``measured_vs_sim.gif``, ``horizon_budget.png``, with ``thorough``
+``out_of_sample_motion.png``, ``summary.json`` and ``report.md``.
 """
 
 from __future__ import annotations
@@ -68,6 +86,7 @@ from double_pendulum import plots
 from double_pendulum.analysis.losses.identification import seed_reconstruction
 from double_pendulum.analysis.losses.mechanisms import model_title
 from double_pendulum.analysis.prediction.comparison import (
+    LOSS_MODEL,
     SMOOTHING_S,
     THRESHOLDS_M,
     Prediction,
@@ -92,6 +111,7 @@ from double_pendulum.analysis.prediction.comparison import (
     simulated_coordinates,
     window_sensitivity,
 )
+from double_pendulum.analysis.prediction.horizon_budget import Setting, horizon_budget
 from double_pendulum.analysis.prediction.loss_models import (
     loss_model_predictions,
     loss_model_sensitivity,
@@ -102,12 +122,14 @@ from double_pendulum.analysis.prediction.loss_models import (
 from double_pendulum.analysis.prediction.loss_uncertainty import ENSEMBLE_SIZE as LOSS_ENSEMBLE_SIZE
 from double_pendulum.analysis.prediction.loss_uncertainty import loss_uncertainty
 from double_pendulum.analysis.prediction.out_of_sample import motion_test
+from double_pendulum.analysis.prediction.own_report import own_report_text
 from double_pendulum.analysis.prediction.paths import PATHS_UNITS, paths_table
 from double_pendulum.analysis.prediction.report import report_text
 from double_pendulum.analysis.prediction.runs import fitted_starts, starts_summary
 from double_pendulum.analysis.prediction.runs import predictions as run_predictions
 from double_pendulum.analysis.suspension.identification import START_FIT_FRAMES
 from double_pendulum.analysis.track.measurement import FRAME_INTERVAL, Reconstruction
+from double_pendulum.analysis.track.user_track import UserRecord
 from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.runs.results_io import read_results_csv, write_json, write_results_csv, write_text
@@ -143,6 +165,12 @@ ENSEMBLE_SIZE = 6
 QUICK_ENSEMBLE_SIZE = 3
 
 
+def frames_at(frames: int, dt: float) -> int:
+    """The number of frames ``dt`` [s] apart that last as long as ``frames`` of the seed's camera
+    (:data:`FRAME_INTERVAL`): the seed's windows at another frame rate (the seed's own: ``frames``)."""
+    return max(1, round(frames * FRAME_INTERVAL / dt))
+
+
 def _plots(out_dir: Path, rec: Reconstruction, i0: int, n_frames: int, predictions: list[Prediction],
            spread: tuple[np.ndarray, np.ndarray], by_model: dict[str, Prediction]) -> None:  # fmt: skip
     """``coordinates.png`` (track and four runs in the track's coordinates over the whole comparison),
@@ -156,7 +184,7 @@ def _plots(out_dir: Path, rec: Reconstruction, i0: int, n_frames: int, predictio
             continue  # in the error plot only: the coordinates would crowd
         ts, coords = simulated_coordinates(rec, p)
         runs[run_title(p.label)] = (ts, coords)
-    span = (n_frames - 1) * FRAME_INTERVAL
+    span = (n_frames - 1) * rec.track.dt
     starts = {"start time t0 of the predictions": float(rec.t[i0])}
     plots.plot_track_comparison(t, measured, runs, out_dir / "coordinates.png", starts=starts, colours=colours,
                                 title=f"bob coordinates: measured track and FMU predictions from t0, the whole "
@@ -176,39 +204,66 @@ def _plots(out_dir: Path, rec: Reconstruction, i0: int, n_frames: int, predictio
     )
 
 
-def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool = False) -> dict:
-    """Predict the track from t0 = 0.8 s from every start; write CSVs, plots, summary and report.
+def _budget(runner: FmuRunner, rec: Reconstruction, i0: int, n_frames: int, losses: Any, geo: Any,
+            window_frames: int, loss_fits: dict, *, seed: bool, quick: bool) -> dict[str, Any]:  # fmt: skip
+    """The horizon over every uncertain input (:func:`~double_pendulum.analysis.prediction.horizon_budget.
+    horizon_budget`): the main loss model's coefficients with the covariance of its energy fit (its standard errors
+    alone where it is not among ``loss_fits``), l1's standard error from the circle fit, the rods on the seed's
+    record only."""
+    names = list(losses.parameters)
+    theta = np.array([losses.parameters[k]["value"] for k in names])
+    if LOSS_MODEL in loss_fits:
+        fit, factor = loss_fits[LOSS_MODEL]
+        cov = fit.cov(factor)
+    else:
+        cov = np.diag([losses.parameters[k]["stderr"] ** 2 for k in names])
+    setting = Setting(runner, rec, i0, n_frames, losses.values, geo, window_frames)
+    return horizon_budget(setting, LOSS_MODEL, theta, cov, names, rec.geometry.sigma_l1, rods=seed, quick=quick)
+
+
+def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool = False,
+        record: UserRecord | None = None) -> dict:  # fmt: skip
+    """Predict the seed's track from t0 = 0.8 s, or a user's ``record`` from the end of its release
+    (:mod:`double_pendulum.analysis.track.user_track`: no comparison with the seed), from every start; write CSVs,
+    plots, summary and report.
 
     ``thorough``: also the fit-window check (:data:`WINDOW_SENSITIVITY`) and the Lyapunov exponent over
     :data:`THOROUGH_LYAPUNOV_S` s (ignored with ``quick``)."""
     thorough = thorough and not quick
     wall0 = time.perf_counter()
     out_dir = Path(out_dir)
-    rec = seed_reconstruction()
+    seed = record is None
+    rec = seed_reconstruction() if seed else record.reconstruction()
+    dt = rec.track.dt
     losses = identified_losses(rec, quick=quick)  # the whole record also in quick mode: 8 s leave them unidentified
     values = losses.values
-    frictionless = {k: losses.pendulum[k] for k in ("l1", "l2", "m1", "m2")}  # the seed's point masses
-    i0 = nearest_frame(rec, SEED_T0)
-    n_frames = round((QUICK_PREDICTION_S if quick else PREDICTION_S) / FRAME_INTERVAL) + 1
+    frictionless = {k: losses.pendulum[k] for k in ("l1", "l2", "m1", "m2")}  # point masses, as the seed's
+    i0 = nearest_frame(rec, SEED_T0 if seed else losses.t0_s)
+    n_frames = min(round((QUICK_PREDICTION_S if quick else PREDICTION_S) / dt) + 1,
+                   int(np.flatnonzero(rec.track.valid)[-1]) - i0 + 1)  # to the record's last valid frame at most
     ensemble_size = QUICK_ENSEMBLE_SIZE if quick else ENSEMBLE_SIZE
     seed_state = reconstructed_state(rec, i0)
-    starts = fitted_starts(runner, rec, i0, values, QUICK_GEOMETRY_FIT_FRAMES if quick else GEOMETRY_FIT_FRAMES)
+    window_frames = frames_at(QUICK_GEOMETRY_FIT_FRAMES if quick else GEOMETRY_FIT_FRAMES, dt)
+    starts = fitted_starts(runner, rec, i0, values, window_frames, frames_at(FIT_FRAMES, dt))
     geo = starts.geometry
     predictions = run_predictions(runner, rec, i0, n_frames, values, frictionless, seed_state, starts)
-    headlines = {p.label: headline_horizon(p, (n_frames - 1) * FRAME_INTERVAL) for p in predictions[3:]}
+    prediction_s = (n_frames - 1) * dt
+    headlines = {p.label: headline_horizon(p, prediction_s) for p in predictions[3:]}
     loss_fits = supported_loss_fits(rec, quick=quick)
     by_model = loss_model_predictions(runner, rec, i0, n_frames, losses.pendulum, geo,
                                       supported_loss_values(loss_fits), done=(values, predictions[-1]))
-    spread = chaos_spread(runner, values, geo, predictions[-1], n_frames, ensemble_size)
+    spread = chaos_spread(runner, values, geo, predictions[-1], n_frames, ensemble_size, dt=dt)
     uncertainty = loss_uncertainty(runner, rec, i0, n_frames, losses.pendulum, geo, loss_fits, by_model,
                                    list(loss_fits), LOSS_ENSEMBLE_SIZE if thorough else 0)
-    prediction_s = (n_frames - 1) * FRAME_INTERVAL
+    budget = _budget(runner, rec, i0, n_frames, losses, geo, window_frames, loss_fits, seed=seed, quick=quick)
     smoothed = {p.label: p.smoothed_horizons() for p in predictions}
     reached = smoothed["lsq_geometry_identified"]["lower_bob_5cm_s"]
     fitted_l2 = {"l2": geo.geometry.get("l2", losses.pendulum["l2"])}
     lyapunov_s = QUICK_LYAPUNOV_S if quick else THOROUGH_LYAPUNOV_S if thorough else LYAPUNOV_S
     summary: dict[str, Any] = {
         "scenario": "measured_vs_sim",
+        "source": "seed Table 1 (data/seed_table1.csv)" if seed else f"{record.name}: a user's own record",
+        **({} if seed else {"record": record.describe(), "lengths_fitted_m": record.fitted_lengths()}),
         "quick": quick,
         "thorough": thorough,
         "t0_s": float(rec.t[i0]),
@@ -221,8 +276,9 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
         "smoothing": {"method": "centred moving median of the per-frame position error", "window_s": SMOOTHING_S},
         "horizons_smoothed_s": smoothed,
         "horizons_raw_s": {p.label: p.horizons() for p in predictions},
-        "loss_model_sensitivity": loss_model_sensitivity(by_model, n_frames),
+        "loss_model_sensitivity": loss_model_sensitivity(by_model, n_frames, dt),
         "loss_uncertainty": uncertainty,
+        "horizon_budget": budget,
         "goal": goal_entry(reached, prediction_s, GOAL_S),
         "regime": regime(PendulumParameters(**{**losses.pendulum, **fitted_l2}), geo.state, lyapunov_s),
         "chaos_horizons_s": chaos_horizons(spread),
@@ -233,7 +289,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     }
     if thorough:
         summary["fit_window_sensitivity"] = window_sensitivity(runner, rec, i0, values, n_frames,
-                                                               WINDOW_SENSITIVITY, warm=geo)
+                                                               [frames_at(f, dt) for f in WINDOW_SENSITIVITY], warm=geo)
         summary["out_of_sample_motion"], curves = motion_test(runner, rec, i0, n_frames, losses.pendulum, geo, by_model,
                                                               summary["track_rod_length_floor"]["rms_m"])
         plots.plot_out_of_sample_motion(curves, summary["out_of_sample_motion"]["split_after_t0_s"], THRESHOLDS_M[-1],
@@ -244,7 +300,10 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     write_results_csv(out_dir / "errors.csv", errors_table(rec, i0, n_frames, predictions), errors_units(predictions))
     write_results_csv(out_dir / "paths.csv", paths_table(rec, i0, n_frames, predictions[-1]), PATHS_UNITS)
     _plots(out_dir, rec, i0, n_frames, predictions, spread, by_model)
+    if budget["one_at_a_time"]:
+        plots.plot_horizon_budget(budget["one_at_a_time"], budget["distribution"], budget["main_horizon_s"],
+                                  prediction_s, out_dir / "horizon_budget.png")
     summary["wall_time_s"] = time.perf_counter() - wall0
     write_json(out_dir / "summary.json", summary)
-    write_text(out_dir / "report.md", report_text(summary))
+    write_text(out_dir / "report.md", report_text(summary) if seed else own_report_text(summary))
     return summary

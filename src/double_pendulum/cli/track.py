@@ -9,21 +9,15 @@ from typing import Any
 
 from .common import CliError
 
-TRACK_SCENARIOS: tuple[str, ...] = ("energy_decay", "loss_identification")
+TRACK_SCENARIOS: tuple[str, ...] = ("energy_decay", "loss_identification", "measured_vs_sim")
 """The scenarios that analyse a camera track and take a user's (``--track``)."""
-NOT_YET: dict[str, str] = {
-    "measured_vs_sim": "measured_vs_sim does not take --track yet: its prediction of the motion is tuned to the "
-                       "seed's record (its loss models, start windows and camera geometry); run energy_decay and "
-                       "loss_identification on your track",
-}
-"""Scenarios that analyse the seed's track but not yet a user's, and why."""
 
 
 def add_track_options(parser: argparse.ArgumentParser) -> None:
     """``--track``, ``--pendulum``, ``--columns``, ``--scale``, ``--fps``."""
     group = parser.add_argument_group(
-        "your own record", "analyse your own camera track instead of the seed's (energy_decay, loss_identification; "
-        "see docs/data-analysis.md, 'Analyse your own pendulum')")
+        "your own record", "analyse your own camera track instead of the seed's (energy_decay, loss_identification, "
+        "measured_vs_sim; see docs/data-analysis.md, 'Analyse your own pendulum')")
     group.add_argument("--track", metavar="FILE.csv", help="your track: a CSV file with the time and both bobs' x, y "
                        "(columns t_s, x1_m, y1_m, x2_m, y2_m unless --columns names others)")
     group.add_argument("--pendulum", metavar="FILE.toml", help="your pendulum (needed with --track): m1, m2 [kg]; "
@@ -51,8 +45,6 @@ def read_record(args: argparse.Namespace, names: tuple[str, ...]) -> Any:
         raise CliError(f"--track: 'all' runs every scenario; the ones that analyse a camera track: "
                        f"{', '.join(TRACK_SCENARIOS)}")
     for name in names:
-        if name in NOT_YET:
-            raise CliError(NOT_YET[name])
         if name not in TRACK_SCENARIOS:
             raise CliError(f"--track: {name} does not analyse a camera track; the scenarios that do: "
                            f"{', '.join(TRACK_SCENARIOS)}")

@@ -17,6 +17,7 @@ from .decay import plot_circle_fit, plot_energy_decay
 from .losses import plot_energy_fit, plot_loss_shares, plot_out_of_sample, plot_profiles
 from .prediction import (
     animate_prediction,
+    plot_horizon_budget,
     plot_lower_bob_paths,
     plot_out_of_sample_motion,
     plot_prediction_errors,
@@ -62,6 +63,7 @@ __all__ = [
     "plot_work_precision",
     "plot_track_comparison",
     "plot_prediction_errors",
+    "plot_horizon_budget",
     "run_colours",
     "plot_lower_bob_paths",
     "Swing",

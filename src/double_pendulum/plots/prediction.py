@@ -186,3 +186,40 @@ def plot_out_of_sample_motion(
     axes[0, 0].set_ylabel(f"position error of the lower bob [cm]\n(moving median over {smoothing_s:g} s)")
     legend_below(fig, *axes[0, 0].get_legend_handles_labels(), ncols=3, fontsize=8)
     return save(fig, path)
+
+
+def plot_horizon_budget(rows: Sequence[Mapping[str, object]], distribution: Mapping[str, object], base_s: float,
+                        span_s: float, path: str | Path, *, title: str = "") -> Path:  # fmt: skip
+    """What moves the prediction horizon: a bar per input (``rows``: ``input``, ``low``/``high`` and ``kind`` as
+    text, ``low_s``/``high_s`` the horizons [s] at the input's two values), from the main run's horizon ``base_s``
+    [s], largest first; behind them the horizon's distribution over every input (``distribution``: ``median_s``,
+    ``range_16_84_s``, ``range_2_97_s``) and the end of the record ``span_s`` [s], where horizons are censored."""
+    n = len(rows)
+    fig, ax = plt.subplots(figsize=(11, 1.6 + 0.62 * n), layout="constrained")
+    lo2, hi2 = distribution["range_2_97_s"]
+    lo, hi = distribution["range_16_84_s"]
+    ax.axvspan(lo2, hi2, color="0.88", lw=0, label=f"every input drawn: 2.5-97.5 % ({lo2:.1f} to {hi2:.1f} s)")
+    ax.axvspan(lo, hi, color="0.72", lw=0, label=f"every input drawn: 16-84 % ({lo:.1f} to {hi:.1f} s), "
+               f"{distribution['n']} runs")
+    ax.axvline(distribution["median_s"], color="0.35", lw=1.2, ls="-.",
+               label=f"their median ({distribution['median_s']:.1f} s)")
+    for i, r in enumerate(rows):
+        for key, colour, dy in (("low", "tab:blue", 0.19), ("high", "tab:red", -0.19)):
+            y, end = n - 1 - i + dy, float(r[f"{key}_s"])
+            ax.barh(y, end - base_s, left=base_s, height=0.34, color=colour, alpha=0.8,
+                    label=("the input's low value" if key == "low" else "the input's high value") if i == 0 else None)
+            right = end >= base_s
+            ax.text(end + (0.15 if right else -0.15), y, f"{r[key]}: "
+                    + ("beyond the record" if end >= span_s else f"{end:.1f} s"), va="center",
+                    ha="left" if right else "right", fontsize=8)  # fmt: skip
+    ax.axvline(base_s, color="k", lw=1.2, label=f"the main run ({base_s:.1f} s)")
+    ax.axvline(span_s, color="k", lw=0.9, ls="--",
+               label=f"end of the record ({span_s:.1f} s): a horizon here is censored")
+    ax.set_yticks(range(n)[::-1], [f"{r['input']}\n({r['kind']})" for r in rows], fontsize=8)
+    ax.set_xlim(0, span_s * 1.25)
+    ax.set_xlabel("horizon: lower bob within 5 cm of the track, smoothed [s after t0]")
+    ax.set_title(title or "what moves the prediction horizon: bars, each input at two values with the others held;"
+                          "\ngrey, the horizons with every input drawn at once")
+    ax.grid(alpha=0.3, axis="x")
+    legend_below(fig, *ax.get_legend_handles_labels(), ncols=3, fontsize=8)
+    return save(fig, path)

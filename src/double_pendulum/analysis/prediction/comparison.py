@@ -223,6 +223,8 @@ class IdentifiedLosses:
     parameters: dict[str, dict[str, Any]]
     record_s: float
     n_runs: int
+    t0_s: float = 0.0
+    """Start [s] of the fitted record: the end of the release (the energy's first maximum)."""
 
     @property
     def values(self) -> dict[str, Any]:
@@ -231,7 +233,7 @@ class IdentifiedLosses:
 
 
 def identified_losses(rec: Reconstruction, window_s: float | None = None, *, quick: bool = False) -> IdentifiedLosses:
-    """Fit :data:`LOSS_MODEL` to the measured energy decay of ``rec`` (a reconstruction with rods),
+    """Fit :data:`LOSS_MODEL` to the measured energy decay of ``rec`` (a reconstruction, with rods where it has them),
     in-process, the way the ``loss_identification`` scenario's run in the same mode (``quick``) fits it
     (:func:`~double_pendulum.analysis.losses.identification.identified_fit`: the same start, run budget and
     integration settings, so the cached fit of either scenario serves the other); ``window_s``: only the
@@ -248,6 +250,7 @@ def identified_losses(rec: Reconstruction, window_s: float | None = None, *, qui
         parameters=comparison.parameter_table(fit, factor),
         record_s=float(problem.t[-1] - problem.t[0]),
         n_runs=fit.n_runs,
+        t0_s=float(problem.t0),
     )
 
 
@@ -266,7 +269,7 @@ def least_squares_start(
     ``tolerance``: the iteration's relative stopping tolerance on chi2 and the parameters."""
     w = track_window(rec, i0, n_frames)
     guess, geometry_guess = (w.guess, None) if warm is None else (warm.state, warm.geometry)
-    return fit_start_state(runner, w.t0, w.offsets, w.positions, w.sigma_positions, guess, values,
+    return fit_start_state(runner, w.t0, w.offsets, w.positions, w.sigma_positions, guess, values, dt=rec.track.dt,
                            geometry=geometry, geometry_guess=geometry_guess, tolerance=tolerance)
 
 
@@ -306,6 +309,7 @@ def predict(
         prediction_start_values(values, state, geometry),
         float(rec.t[i0]),
         n_frames,
+        dt=rec.track.dt,
         outputs=RUN_OUTPUTS,
     )
     window = track_window(rec, i0, n_frames)
@@ -314,7 +318,7 @@ def predict(
         label=label,
         state=np.asarray(state, dtype=float),
         result=result,
-        t=window.offsets * FRAME_INTERVAL,
+        t=window.offsets * rec.track.dt,
         e1=np.hypot(d[:, 0], d[:, 1]),
         e2=np.hypot(d[:, 2], d[:, 3]),
         geometry=geometry,
@@ -330,10 +334,11 @@ def chaos_spread(
     size: int,
     seed: int = ENSEMBLE_SEED,
     max_workers: int | None = 1,
+    dt: float = FRAME_INTERVAL,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Median distance [m] of the lower bob between runs drawn from the fit's covariance (state and
-    any fitted geometry) and the central run, per frame (times [s] since t0): how fast the fit's own
-    uncertainty grows. ``max_workers``: worker processes (1: here, with ``runner``; a few runs of about a
+    any fitted geometry) and the central run, per frame (times [s] since t0, frames ``dt`` [s] apart): how fast the
+    fit's own uncertainty grows. ``max_workers``: worker processes (1: here, with ``runner``; a few runs of about a
     second each cost less than starting workers; None: one per core)."""
     rng = np.random.default_rng(seed)
     draws = rng.multivariate_normal(fit.values, fit.covariance, size=size)
@@ -343,15 +348,16 @@ def chaos_spread(
     for x in draws:
         start, shifts = split_geometry(dict(zip(fit.names[4:], x[4:])))
         start_values = {**PREDICTION_SETTINGS, **values, **start, **state_start_values(x[:4])}
-        items.append((start_values, shifts, fit.t0, n_frames, ref))
+        items.append((start_values, shifts, fit.t0, n_frames, ref, dt))
     distances = runner_map(_spread_distance, items, runner, max_workers=max_workers, label="start-state ensemble")
-    return np.arange(n_frames) * FRAME_INTERVAL, np.median(np.array(distances), axis=0)
+    return np.arange(n_frames) * dt, np.median(np.array(distances), axis=0)
 
 
-def _spread_distance(runner: FmuRunner, item: tuple[dict[str, Any], dict[str, float], float, int, np.ndarray]):
+def _spread_distance(runner: FmuRunner,
+                     item: tuple[dict[str, Any], dict[str, float], float, int, np.ndarray, float]):  # fmt: skip
     """Worker: the lower bob's distance [m] per frame of one ensemble run from the central prediction."""
-    start, shifts, t0, n_frames, ref = item
-    r = simulate_frames(runner, start, t0, n_frames)
+    start, shifts, t0, n_frames, ref, dt = item
+    r = simulate_frames(runner, start, t0, n_frames, dt=dt)
     return np.linalg.norm(shift_outputs(output_matrix(r), POSITION_OUTPUTS, shifts)[:, 2:] - ref, axis=1)
 
 
@@ -389,7 +395,7 @@ def _window_fit(runner: FmuRunner, item: tuple[Any, ...]) -> dict[str, Any]:
     rec, i0, values, n_frames, frames, geometry, warm = item
     fit = least_squares_start(runner, rec, i0, values, frames, geometry, warm)
     p = predict(runner, f"lsq{frames}", values, fit.state, rec, i0, n_frames, fit.geometry)
-    return {"fit_frames": frames, "fit_window_s": frames * FRAME_INTERVAL, "chi2_red": fit.chi2_red,
+    return {"fit_frames": frames, "fit_window_s": frames * rec.track.dt, "chi2_red": fit.chi2_red,
             "rms_residual_m": fit.rms_residual, "geometry": dict(fit.geometry),
             "geometry_units": fit.as_dict()["geometry_units"], **p.smoothed_horizons()}
 
@@ -447,7 +453,7 @@ def rod_length_floor(rec: Reconstruction, i0: int, n_frames: int) -> tuple[np.nd
     Returns the times [s] since frame ``i0`` and the deviations.
     """
     offsets, signed = _signed_rod2_deviation(rec, i0, n_frames)
-    return offsets * FRAME_INTERVAL, np.abs(signed)
+    return offsets * rec.track.dt, np.abs(signed)
 
 
 def rod_floor_summary(rec: Reconstruction, i0: int, n_frames: int) -> RodLengthFloor:

@@ -84,11 +84,13 @@ def loss_model_predictions(
     return out
 
 
-def loss_model_sensitivity(predictions: Mapping[str, Prediction], n_frames: int) -> dict[str, Any]:
+def loss_model_sensitivity(predictions: Mapping[str, Prediction], n_frames: int,
+                           dt: float = FRAME_INTERVAL) -> dict[str, Any]:  # fmt: skip
     """The lower bob's 5 cm horizons [s] of each loss model's prediction (:func:`~.comparison.headline_horizon`:
     smoothed, censored or not, and per frame) and their ranges over the models; a per-frame horizon of None
-    (never crossed) counts as the record's length in the range, with ``raw_censored_models`` naming those."""
-    span = (n_frames - 1) * FRAME_INTERVAL
+    (never crossed) counts as the record's length in the range, with ``raw_censored_models`` naming those; ``dt``
+    [s]: the record's frame interval."""
+    span = (n_frames - 1) * dt
     per_model = {model: headline_horizon(p, span, THRESHOLD_M) for model, p in predictions.items()}
     smoothed = [h["horizon_s"] for h in per_model.values()]
     raw = [span if h["raw_horizon_s"] is None else h["raw_horizon_s"] for h in per_model.values()]

@@ -40,7 +40,7 @@ import numpy as np
 from ...fmu.running.runner import FmuRunner
 from ...runs.result_cache import cached
 from ..losses.fitting import ModelFit
-from ..track.measurement import FRAME_INTERVAL, Reconstruction
+from ..track.measurement import Reconstruction
 from ..track.start_state import StartStateFit, split_geometry
 from .comparison import headline_horizon, predict
 from .loss_models import loss_values
@@ -160,7 +160,7 @@ def loss_uncertainty(
     """The damping-level sensitivity of ``models`` and, with ``ensemble_size`` > 0, the ensemble of every model in
     ``fits`` (model -> (fit, correlation factor F)); ``central``: each model's prediction at its fitted losses
     (:func:`~.loss_models.loss_model_predictions`)."""
-    span = (n_frames - 1) * FRAME_INTERVAL
+    span = (n_frames - 1) * rec.track.dt
 
     def run_losses(values: Mapping[str, Any]) -> Any:
         return predict(runner, "damping", {**pendulum, **values}, start.state, rec, i0, n_frames, start.geometry)

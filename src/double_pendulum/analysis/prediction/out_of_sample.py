@@ -126,7 +126,7 @@ def motion_test(
     halves = half_predictions(runner, rec, i0, n_frames, pendulum, start, hfits, list(whole))
     energy = out_of_sample(problem, hfits)["directions"]
     best = {name: d["ranking"]["tie"] for name, d in energy.items()}
-    out = motion_out_of_sample(halves, whole, split_after_t0(problem.t, float(rec.t[i0])), tie_m, best)
+    out = motion_out_of_sample(halves, whole, split_after_t0(problem.t, float(rec.t[i0]), rec.track.dt), tie_m, best)
     return out, error_curves(halves)
 
 
@@ -163,8 +163,8 @@ def error_curves(halves: Mapping[str, Mapping[str, Prediction]]) -> dict[str, di
     return {half: {m: (p[half].t, smoothed(p[half].t, p[half].e2)) for m, p in halves.items()} for half in HALVES}
 
 
-def split_after_t0(problem_t: np.ndarray, t0: float) -> float:
+def split_after_t0(problem_t: np.ndarray, t0: float, dt: float = FRAME_INTERVAL) -> float:
     """The energy record's split (its middle frame, as :func:`..losses.holdout.half_slice`) in seconds after the
-    prediction's t0 [s], on the frame grid."""
+    prediction's t0 [s], on the frame grid of ``dt`` [s]."""
     t_split = float(problem_t[len(problem_t) // 2])
-    return round((t_split - t0) / FRAME_INTERVAL) * FRAME_INTERVAL
+    return round((t_split - t0) / dt) * dt

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..track.measurement import FRAME_INTERVAL, Reconstruction
+from ..track.measurement import Reconstruction
 from ..track.start_state import POSITION_OUTPUTS, output_matrix, shift_outputs, split_geometry, track_window
 from .comparison import Prediction
 
@@ -37,7 +37,7 @@ def paths_table(rec: Reconstruction, i0: int, n_frames: int, prediction: Predict
     rows = len(window.offsets)
     columns: dict[str, np.ndarray] = {
         "time": rec.t[i0 + window.offsets],
-        "t_since_t0": window.offsets * FRAME_INTERVAL,
+        "t_since_t0": window.offsets * rec.track.dt,
         **{f"{name}_measured": window.positions[:, k] for k, name in enumerate(POSITION_OUTPUTS)},
         **{f"{name}_simulated": simulated[:, k] for k, name in enumerate(POSITION_OUTPUTS)},
         "pivot_x_simulated": np.full(rows, pivot[0]),

@@ -45,14 +45,15 @@ def fmt_horizon(value: float | None, span: float) -> str:
     return f"none in {span:.2f}" if value is None else f"{value:.2f}"
 
 
-def horizon_rows(s: PredictionSummary) -> str:
-    """Rows of :data:`HORIZON_HEADER`: the lower bob's smoothed and per-frame horizons [s] and rms error [mm]."""
+def horizon_rows(s: PredictionSummary, labels: Mapping[str, str] = LABELS) -> str:
+    """Rows of :data:`HORIZON_HEADER`: the lower bob's smoothed and per-frame horizons [s] and rms error [mm], each
+    run named by ``labels``."""
     span = s["prediction_s"]
     rows = []
     for label, h in s["horizons_smoothed_s"].items():
         raw = s["horizons_raw_s"][label]
         rms_mm = 1e3 * s["rms_error_first_second_m"][label]["lower_bob"]
-        cells = [LABELS.get(label, label), fmt_horizon(h["lower_bob_2cm_s"], span),
+        cells = [labels.get(label, label), fmt_horizon(h["lower_bob_2cm_s"], span),
                  fmt_horizon(h["lower_bob_5cm_s"], span), fmt_horizon(raw["lower_bob_5cm_s"], span), f"{rms_mm:.0f}"]
         rows.append("| " + " | ".join(cells) + " |")
     return "\n".join(rows)
@@ -225,6 +226,48 @@ def loss_uncertainty_text(s: PredictionSummary) -> str:
     ens = "; ".join(f"{model_title(m)}: {_stats_text(e['smoothed_5cm'])} smoothed, {_stats_text(e['raw_5cm'])} "
                     "per frame" for m, e in u["ensemble"].items())  # fmt: skip
     return text + f" Drawn from the losses' and the start's covariance ({u['ensemble_definition']}): {ens}."
+
+
+def _end(value: float, span: float) -> str:
+    """A horizon [s] as text, 'beyond the record' at the record's end ``span`` [s] (censored)."""
+    return "beyond the record" if value >= span else f"{value:.1f} s"
+
+
+def budget_text(s: Mapping[str, Any]) -> str:
+    """The horizon over every uncertain input (:mod:`.horizon_budget`): the one-at-a-time changes, the rods'
+    profile and the distribution's median and ranges."""
+    b = s["horizon_budget"]
+    span, d = b["span_s"], b["distribution"]
+    lo, hi = d["range_16_84_s"]
+    lo2, hi2 = d["range_2_97_s"]
+    names = [f"the {n}" if n != "l1" else n for n in b["inputs_drawn"]]
+    drawn = ", ".join(names[:-1]) + f" and {names[-1]}"
+    text = (f"**The horizon over every uncertain input.** {d['n']} runs, each drawing {drawn} from their covariance "
+            f"at once: the 5 cm horizon (smoothed) has the median {_end(d['median_s'], span)}, 16-84 % from "
+            f"{_end(lo, span)} to {_end(hi, span)}, 2.5-97.5 % from {_end(lo2, span)} to {_end(hi2, span)} "
+            f"({d['censored_fraction']:.0%} of the runs never leave 5 cm within the record).")
+    if b["rod_profile"] is None and b["dominant_input"] is None:
+        return text + (" (A quick run: a smoke test of the ensemble and of the losses one at a time; the other "
+                       "inputs run by default.)")
+    rows = "\n".join(f"| {r['input']} | {r['kind']} | {r['low']}: {_end(r['low_s'], span)} | "
+                     f"{r['high']}: {_end(r['high_s'], span)} |" for r in b["one_at_a_time"])  # fmt: skip
+    text += (f" What moves it (``horizon_budget.png``; the main run: {_end(b['main_horizon_s'], span)}), each input "
+             "at two values with the others held, the start and geometry fitted again where the input is part of "
+             f"the model (rods, l1, window); largest change first:\n\n| input | values | low | high |\n"
+             f"|---|---|---|---|\n{rows}\n\nThe uncertain input that moves it most: {b['dominant_input']}.")
+    prof = b["rod_profile"]
+    if prof:
+        steps = ", ".join(f"{1e3 * r['member_kg']:.0f} g: {dc:+.1f}" for r, dc in
+                          zip(prof["rows"], prof["delta_chi2_over_chi2_red"]))  # fmt: skip
+        rms = ", ".join(f"{1e3 * r['member_kg']:.0f} g: {1e3 * r['rms_error_m']:.0f} mm" for r in prof["rows"])
+        window = ("lowest at the edge of the masses tried, so it bounds the mass on one side only" if prof["at_edge"]
+                  else f"lowest at {1e3 * prof['best']:.0f} +- {1e3 * prof['stderr']:.0f} g")
+        text += (f"\n\n**The rods' inertia.** The start and geometry fitted again with each member's mass: the "
+                 f"fit's chi2 over the start-fit window rises by (chi2 - chi2_min) / chi2_red = {steps} "
+                 f"({window}); the lower bob's RMS error over the whole prediction is {rms} (lowest of these at "
+                 f"{1e3 * prof['record_rms_lowest_at_kg']:.0f} g, with the losses fitted for the seed's 70 g). "
+                 f"The drawn rods take +-{1e3 * b['rods_stderr_kg']:.0f} g: {b['rods_stderr_from']}.")
+    return text
 
 
 def _short_horizon(score: Mapping[str, Any]) -> str:
@@ -406,6 +449,8 @@ censored):
 {loss_models_text(s)}
 
 {loss_uncertainty_text(s)}
+
+{budget_text(s)}
 
 {motion_out_of_sample_text(s)}
 

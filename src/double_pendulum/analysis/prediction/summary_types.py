@@ -227,10 +227,85 @@ class MotionOutOfSample(TypedDict):
     text: str
 
 
+class BudgetRow(TypedDict):
+    """One input of :func:`~.horizon_budget.one_at_a_time`: its two values (text), what they are, the horizons [s]
+    there and the main run's, and the larger change [s]."""
+
+    input: str
+    low: str
+    high: str
+    kind: str
+    low_s: float
+    high_s: float
+    base_s: float
+    largest_change_s: float
+
+
+class ProfileRow(TypedDict):
+    """The start and geometry fitted with one rods' member mass [kg]: chi2, its prediction's horizon [s] and RMS
+    error over the whole prediction [m]."""
+
+    member_kg: float
+    chi2: float
+    chi2_red: float
+    rms_residual_m: float
+    geometry: dict[str, float]
+    horizon_s: float
+    censored: bool
+    rms_error_m: float
+
+
+class RodProfile(TypedDict):
+    """The profile over the rods' member mass (:func:`~.horizon_budget.rod_profile`)."""
+
+    rows: list[ProfileRow]
+    lowest_at: float
+    at_edge: bool
+    delta_chi2_over_chi2_red: list[float]
+    best: float | None
+    stderr: float | None
+    record_rms_lowest_at_kg: float
+    record_rms_best_kg: float | None
+
+
+class HorizonDistribution(TypedDict):
+    """The horizons [s] of the Monte Carlo over every input, their median and ranges (:func:`~.horizon_budget.
+    horizon_interval`)."""
+
+    median_s: float
+    range_16_84_s: list[float]
+    range_2_97_s: list[float]
+    width_16_84_s: float
+    n: int
+    censored_fraction: float
+    top_censored: bool
+    members_s: list[float]
+
+
+class HorizonBudget(TypedDict):
+    """The horizon over every uncertain input (:mod:`.horizon_budget`)."""
+
+    main_horizon_s: float
+    span_s: float
+    one_at_a_time: list[BudgetRow]
+    rod_profile: RodProfile | None
+    rods_stderr_kg: float | None
+    rods_stderr_from: str | None
+    l1_stderr_m: float
+    distribution: HorizonDistribution
+    inputs_drawn: list[str]
+    dominant_input: str | None
+    statement: str
+    null_means: dict[str, str]
+
+
 class PredictionSummary(TypedDict):
     """``measured_vs_sim``'s ``summary.json``: the runs from t0, their horizons, the floors, the regime."""
 
     scenario: str
+    source: str
+    record: NotRequired[dict[str, Any]]
+    lengths_fitted_m: NotRequired[dict[str, float]]
     quick: bool
     thorough: bool
     t0_s: float
@@ -252,6 +327,7 @@ class PredictionSummary(TypedDict):
     horizons_raw_s: dict[str, Horizons]
     loss_model_sensitivity: LossModelSensitivity
     loss_uncertainty: LossUncertainty
+    horizon_budget: HorizonBudget
     goal: Goal
     regime: Regime
     chaos_horizons_s: dict[str, float | None]
