@@ -11,8 +11,8 @@ every row recorded, each line whole, in :func:`~double_pendulum.runs.results_io.
 An interrupt (Ctrl-C) can land while a batch is written: :meth:`RowStream.finish` cuts the file back to the last
 batch written whole and writes that batch again from the recorder, which still holds it (a batch leaves the
 recorder only after it is in the file); a batch that reached the file whole is kept, and taken out of the recorder
-if it is still there, whichever statement the interrupt fell on. :func:`read_spread` reads a long file back for a figure, at most a given
-number of rows spread evenly over it.
+if it is still there, whichever statement the interrupt fell on. :func:`read_spread` reads a long file back for a
+figure, at most a given number of rows spread evenly over it.
 """
 
 from __future__ import annotations
