@@ -15,6 +15,7 @@ import numpy as np
 from ...model.parameters import SEED_RIGID_LINKS
 from ..suspension.identification import MeasuredDecay, measured_decay
 from ..track.measurement import Reconstruction, load_track, reconstruct
+from ..track.tilt import seed_record_geometry
 from . import claims as loss_claims
 from .comparison import (
     air_share_at_defaults,
@@ -77,9 +78,12 @@ def measured_loss(md: MeasuredDecay) -> float:
     return a * (math.exp(b * md.frames.t[0]) - math.exp(b * md.frames.t[-1]))
 
 
-def seed_reconstruction() -> Reconstruction:
-    """The seed's track reconstructed with the rigid links :data:`SEED_RIGID_LINKS`."""
-    return reconstruct(load_track(), rods=SEED_RIGID_LINKS)
+def seed_reconstruction(*, tilt: bool = True) -> Reconstruction:
+    """The seed's track reconstructed with the rigid links :data:`SEED_RIGID_LINKS`, in the record's one geometry
+    (:func:`~..track.tilt.seed_record_geometry`): turned back by the camera's tilt against gravity; ``tilt=False``:
+    the untilted track as the camera saw it (the named variant, same pivot and lengths)."""
+    rg = seed_record_geometry()
+    return reconstruct(load_track(), rg.geometry if tilt else rg.untilted, rods=SEED_RIGID_LINKS)
 
 
 def measured(rec: Reconstruction | None = None, window_s: float | None = None) -> MeasuredDecay:
