@@ -14,6 +14,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ...runs.results_io import report_opening
+from .air_profile import air_share_text
 from .holdout import holdout_section
 from .mechanisms import model_title
 from .summary_types import LossesSummary
@@ -292,6 +293,16 @@ def _air_on_decay_text(air: Mapping[str, Any]) -> str:
             f"{air['share_on_measured_decay']:.0%} of the measured loss. ")
 
 
+def untilted_text(u: Mapping[str, Any] | None) -> str:
+    """What the camera's tilt changes in the comparison (the thorough run's untilted identification); "" without."""
+    if not u:
+        return ("The energy is that of the track turned back by the camera's tilt against gravity (`energy_decay`'s "
+                "`tilt`); `--thorough` repeats the comparison on the untilted track.")
+    ties = "; ".join(f"{k}: {', '.join(v)}" for k, v in u["ties"].items())
+    return (f"On the untilted track (the camera's tilt not removed) the models within 2 of the lowest were: {ties} "
+            "(the criteria as in the noise-model section below).")
+
+
 def report_text(s: LossesSummary) -> str:
     """The whole report."""
     from .claims import SEPARATING_MEASUREMENTS, per_joint_text
@@ -331,6 +342,10 @@ neither b nor p). Errors of fitted numbers are multiplied by sqrt(F). {_factor_t
 {s['supported_models']['text']}
 
 {_pair_text(s)}
+
+{air_share_text(s.get('air_share_profile'), s.get('untilted_track'))}
+
+{untilted_text(s.get('untilted_track'))}
 
 {noise_section(s)}
 
