@@ -152,9 +152,14 @@ def exponent(t: np.ndarray, e: np.ndarray, sigma: np.ndarray | None = None, *, p
         return None
 
     at_one = delta(1.0)
-    return {"p": p_hat, "p_stderr": float(free["stderr"][2]), "rho": free["rho"],
+    e0, k = float(free["theta"][0]), float(free["theta"][1])
+    stop = e0 ** (1.0 - p_hat) / ((1.0 - p_hat) * k) if p_hat < 1.0 else None
+    return {"p": p_hat, "p_stderr": float(free["stderr"][2]), "rho": free["rho"], "E0_J": e0, "k": k,
+            "stop_time_s": stop,
             "interval_68": [bound(1.0, -1), bound(1.0, 1)], "interval_95": [bound(4.0, -1), bound(4.0, 1)],
             "delta_neg2_log_l_at_p_1": at_one, "p_below_1_sigma": (1.0 - p_hat) / float(free["stderr"][2]),
-            "definition": "p of dE/dt = -k E^p fitted with AR(1) residuals (joint maximum likelihood); intervals where "
+            "definition": "p of dE/dt = -k E^p fitted with AR(1) residuals (joint maximum likelihood; E0 [J] at the "
+                          "first fitted frame, k [J^(1-p)/s]; stop_time_s: where the law reaches E = 0 from it, "
+                          "E0^(1-p) / ((1-p) k), None for p >= 1); intervals where "
                           "Delta(-2 ln L) <= 1 and <= 4 with every other parameter and rho re-fitted; None: beyond "
                           "0 < p < 3"}  # fmt: skip
