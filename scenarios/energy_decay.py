@@ -129,7 +129,10 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False, record: UserRecord |
         "weighting_variants": weighting_variants(rec, m),
         **({"seed": seed_comparison(main)} if seed else {}),
         "null_means": {"chi2_red": "not defined for this fit: its errors are relative weights (scaled to the "
-                                   "scatter), not absolute errors"},
+                                   "scatter), not absolute errors",
+                       "interval_68": "tilt/*/exponent: that end of p's profile interval lies beyond 0 < p < 3",
+                       "interval_95": "tilt/*/exponent: that end of p's profile interval lies beyond 0 < p < 3",
+                       "stop_time_s": "tilt/*/exponent: p >= 1, the decay law never reaches E = 0"},
         "error_budget": error_budget(rec, errors.sigma, seed=seed),
         "tilt": tilt_effect(geometry, rec, untilted),
     }

@@ -360,6 +360,9 @@ def identify_losses(
                        "out_of_sample": "not run: the half-record test runs with --thorough (and --quick, one model "
                                         "as a smoke run); it would add about 85 % to the default run's time",
                        "air_share_profile": "not profiled in the quick run",
+                       "share_interval": "air_share_profile: no share of that model comes within Delta(-2 ln L) <= 4 "
+                                         "of the best fit, or (an end) the profile stays below it beyond the "
+                                         "profiled points",
                        "untilted_track": "the identification on the untilted track runs with --thorough only (about "
                                          "50 s more CPU)",
                        "profile_likelihood": "empty: profiled with --thorough only (its intervals matched the "
