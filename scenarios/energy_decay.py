@@ -15,6 +15,10 @@ section 4.2, with the package's own energy function. Outputs in ``results/energy
   ``error_budget/noise_model``; the range over named variants apart; the halves in sigma) and the
   non-stationarity study (``error_budget/stationarity``: calibration drift, the energy's biases, b in windows
   against the energy; :mod:`double_pendulum.analysis.decay.stationarity`);
+- ``summary.json``'s ``tilt``: the record's one geometry (the camera's tilt against gravity fitted to the energy,
+  pivot, l1, l2 and their covariance, :mod:`double_pendulum.analysis.track.tilt`; every figure above is on the track
+  turned back by it) and, for the tilted and the untilted track side by side, b, the halves, the decay models
+  re-fitted under AR(1) noise and the free exponent p (:mod:`double_pendulum.analysis.decay.shape`);
 - ``report.md``: the figures and why they differ from the seed's a = 0.813 J, b = -0.024 1/s.
 
 With a user's own record (``double-pendulum run energy_decay --track FILE.csv --pendulum FILE.toml``,
@@ -44,6 +48,7 @@ from double_pendulum.analysis.decay.fit import (
 )
 from double_pendulum.analysis.decay.own_report import own_report_text
 from double_pendulum.analysis.decay.report import report_text
+from double_pendulum.analysis.decay.shape import tilt_effect
 from double_pendulum.analysis.decay.summary import (
     TRACK_CSV_UNITS,
     decay_curves,
@@ -58,6 +63,7 @@ from double_pendulum.analysis.decay.summary import (
     weighting_variants,
 )
 from double_pendulum.analysis.track.measurement import SEED_TOTAL_MASS_KG, Reconstruction, load_track, reconstruct
+from double_pendulum.analysis.track.tilt import seed_record_geometry
 from double_pendulum.analysis.track.user_track import UserRecord
 from double_pendulum.runs.results_io import write_json, write_results_csv, write_text
 
@@ -93,7 +99,9 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False, record: UserRecord |
     comparison with the seed), and write CSV, plots, summary and report (``runner``, ``quick`` unused)."""
     out_dir = Path(out_dir)
     seed = record is None
-    rec = reconstruct(load_track()) if seed else record.reconstruction()
+    geometry = seed_record_geometry() if seed else record.record_geometry
+    rec = reconstruct(load_track(), geometry.geometry) if seed else record.reconstruction()
+    untilted = reconstruct(load_track(), geometry.untilted) if seed else record.reconstruction(tilt=False)
     m = rec.free_motion
     t, e = rec.t[m], rec.energy[m]
     errors = calibrate_error_model(t, e, rec.sigma_energy[m], rec.momentum[m])
@@ -121,8 +129,12 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False, record: UserRecord |
         "weighting_variants": weighting_variants(rec, m),
         **({"seed": seed_comparison(main)} if seed else {}),
         "null_means": {"chi2_red": "not defined for this fit: its errors are relative weights (scaled to the "
-                                   "scatter), not absolute errors"},
+                                   "scatter), not absolute errors",
+                       "interval_68": "tilt/*/exponent: that end of p's profile interval lies beyond 0 < p < 3",
+                       "interval_95": "tilt/*/exponent: that end of p's profile interval lies beyond 0 < p < 3",
+                       "stop_time_s": "tilt/*/exponent: p >= 1, the decay law never reaches E = 0"},
         "error_budget": error_budget(rec, errors.sigma, seed=seed),
+        "tilt": tilt_effect(geometry, rec, untilted),
     }
     write_results_csv(out_dir / "track.csv", track_table(rec, on_all_frames(errors.sigma, m)), TRACK_CSV_UNITS)
     _plots(rec, m, errors.sigma, fits, out_dir, seed)

@@ -1,7 +1,8 @@
 """Scenario ``loss_identification``: which loss mechanisms drain the seed's pendulum (issue 12, item 3).
 
 Fits the simulated energy of the seed's pendulum (rigid links, start state from the track) to the
-measured energy over the whole 21 s record for combinations of air drag (free factor),
+measured energy (the track turned back by the camera's tilt against gravity,
+:mod:`double_pendulum.analysis.track.tilt`) over the whole 21 s record for combinations of air drag (free factor),
 load-proportional bearing friction, bearing drag torque, viscous joint damping and a damped
 suspension, and compares them by AIC/BIC with the residuals' correlation accounted for
 (:mod:`double_pendulum.analysis.losses.identification`). Outputs in ``results/loss_identification/``:
@@ -17,7 +18,9 @@ suspension, and compares them by AIC/BIC with the residuals' correlation account
   ``noise_model``: AIC and BIC from an AR(1) likelihood of each model's residuals beside those with the common
   factor F, and which models tie under each (:mod:`double_pendulum.analysis.losses.noise`); ``out_of_sample``:
   the half-record test's scores and rankings (``--thorough`` and ``--quick`` only: in the default run it
-  would take 109 s to 203 s of wall time);
+  would take 109 s to 203 s of wall time); ``air_share_profile``: air drag's share as a profile-likelihood
+  interval (:mod:`double_pendulum.analysis.losses.air_profile`, not in the quick run); ``untilted_track``: the same
+  comparison and profile on the untilted track (``--thorough`` only, about 50 s more CPU);
 - ``report.md``.
 
 Default: the one- and two-mechanism models but air+drag2

@@ -66,6 +66,7 @@ from double_pendulum.analysis.suspension.plan import FULL, NULL_MEANS, QUICK, TH
 from double_pendulum.analysis.suspension.report import report_text
 from double_pendulum.analysis.sweep import runner_map
 from double_pendulum.analysis.track.measurement import load_track, reconstruct
+from double_pendulum.analysis.track.tilt import seed_record_geometry
 from double_pendulum.fmu.running.runner import FmuRunner
 from double_pendulum.runs.progress import step
 from double_pendulum.runs.results_io import write_json, write_results_csv, write_text
@@ -126,7 +127,7 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
 
     # identification of c at the default k, M_s; the map b(k, c); c refitted along its valley
     step("fitting the release state and the damping c to the measured energy (sequential FMU runs)")
-    rec = reconstruct(load_track())
+    rec = reconstruct(load_track(), seed_record_geometry().geometry)
     model = identify_suspension(runner, rec, quick=quick, m_s=plan.m_s_main)
     md, ident, spectrum = model.measured, model.identification, model.spectrum
     base = {**pendulum_values(rec), **LOSSES, **model.start.start_values()}

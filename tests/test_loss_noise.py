@@ -121,3 +121,27 @@ def test_the_half_problems_split_the_frames_and_keep_the_start(synthetic_problem
     assert len(first.t) + len(second.t) == len(synthetic_problem.t) and first.t[-1] < second.t[0]
     assert first.base == second.base == synthetic_problem.base and first.t0 == second.t0 == 0.0
     assert second.duration == synthetic_problem.duration and first.duration < synthetic_problem.duration
+
+
+def test_the_air_share_interval_follows_the_profile_and_admits_no_air_only_within_the_level():
+    """air_share_intervals on a known profile: Delta = k^2 at air factor 1 + 0.1 k with the share 0.2 + 0.05 k gives
+    the share's interval 0.1 to 0.3 (k = -+2); a model without air drag 3 behind adds share 0 to the union, one 5
+    behind does not; a model whose own optimum is beyond the level has no interval."""
+    from double_pendulum.analysis.losses.air_profile import AirPoint, air_share_intervals
+
+    def fit(model: str, theta: list[float], chi2: float, share: float) -> fitting.ModelFit:
+        return fitting.ModelFit(model, np.array(theta), chi2, 100, np.eye(len(theta)), np.zeros(100), 1.0, 1,
+                                extra={"shares": {"air drag": share}})  # fmt: skip
+
+    factor, best = 2.0, 50.0
+    fits = [fit("air+drag", [1.0, 1e-3], best, 0.2), fit("air+viscous", [0.5, 1e-4], best + 2 * 4.5, 0.05)]
+    ks = [-3.0, -2.0, -1.0, 1.0, 2.0, 3.0]
+    items = [AirPoint("air+drag", 0, 1.0 + 0.1 * k, (1.0 + 0.1 * k, 1e-3)) for k in ks]
+    results = [(best + factor * k * k, 0.2 + 0.05 * k) for k in ks]
+    for no_air, union_low in ((3.0, 0.0), (5.0, 0.1)):
+        rows = [{"model": f.model, "chi2": f.chi2, "converged": True} for f in fits]
+        rows.append({"model": "viscous", "chi2": best + factor * no_air, "converged": True})
+        out = air_share_intervals(fits, rows, factor, items, results)
+        assert out["models"]["air+drag"]["share_interval"] == pytest.approx([0.1, 0.3])
+        assert out["models"]["air+viscous"]["share_interval"] is None  # its optimum is 4.5 behind
+        assert out["share_interval"] == pytest.approx([union_low, 0.3])

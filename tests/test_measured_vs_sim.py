@@ -20,6 +20,7 @@ from double_pendulum.analysis.track.start_state import (
     simulate_frames,
     state_start_values,
 )
+from double_pendulum.analysis.track.tilt import seed_record_geometry
 from double_pendulum.model.parameters import PendulumParameters
 from double_pendulum.runs.results_io import read_results_csv
 
@@ -216,7 +217,10 @@ def test_quick_run_compares_both_starts_with_the_track(quick_results):
     # the least-squares start follows the first second of the track better than the reconstruction's
     rms = summary["rms_error_first_second_m"]
     assert rms["lsq_start_identified"]["lower_bob"] < rms["seed_start_identified"]["lower_bob"]
-    assert rms["lsq_geometry_identified"]["lower_bob"] < rms["lsq_start_identified"]["lower_bob"]
+    # the track is turned back by the camera's tilt fitted to the energy (analysis/track/tilt.py): the rotation the
+    # motion fits on top of it is zero within its errors (the motion agrees with the energy's tilt)
+    geo = summary["starts"]["least_squares_geometry"]
+    assert abs(geo["geometry"]["view_rotation"]) < 3.0 * geo["geometry_stderr"]["view_rotation"]
     labels = ["seed_start_frictionless", "seed_start_identified", "lsq_start_identified",
               "lsq_fixed_geometry_identified", "lsq_pivot_shift_identified", "lsq_geometry_identified"]
     for key in ("horizons_smoothed_s", "horizons_raw_s"):
@@ -230,12 +234,14 @@ def test_quick_run_compares_both_starts_with_the_track(quick_results):
     assert summary["regime"]["verdict"] in ("regular", "chaotic")
     assert summary["model"]["loss_model"] == "air+drag"
     # the FMU's positions (pivot rest position at the origin) plus the fitted pivot land on the track at t0
-    rec = reconstruct(load_track())
+    # (the positions about the pivot, turned back by the camera's tilt: the reconstruction measured_vs_sim reads)
+    rec = reconstruct(load_track(), seed_record_geometry().geometry)
     i0 = summary["start_frame"]
     run = read_results_csv(tmp_path / "lsq_start_identified.csv")  # no pivot offset fitted
     pivot = summary["pivot_origin_m"]
+    assert (pivot["x"], pivot["y"]) == pytest.approx((rec.geometry.pivot.xc, rec.geometry.pivot.yc))
     assert run["time"][0] == pytest.approx(rec.t[i0])
-    assert np.hypot(run["x2"][0] + pivot["x"] - rec.track.x2[i0], run["y2"][0] + pivot["y"] - rec.track.y2[i0]) < 0.01
+    assert np.hypot(run["x2"][0] - rec.x2[i0], run["y2"][0] - rec.y2[i0]) < 0.01
     errors = read_results_csv(tmp_path / "errors.csv")
     t, e2 = errors["t_since_t0"], errors["e2_lsq_start_identified"]
     assert summary["horizons_raw_s"]["lsq_start_identified"]["lower_bob_5cm_s"] == tc.horizon(t, e2, 0.05)

@@ -73,7 +73,9 @@ def plot_loss_shares(rows: list[Mapping[str, Any]], path: str | Path, *, support
         ax.axhline(y[tied - 1] - 0.5, color="k", ls="--", lw=0.9)
     ax.set(xlim=(0, 1), xlabel="share of the energy dissipated over the record [1]",
            title=f"Share of each loss in each fitted model (lowest AIC on top; the {tied} above the dashed line\n"
-                 f"lie within dAIC {supported_daic:g} of it: the record does not rank them)")  # fmt: skip
+                 f"lie within dAIC {supported_daic:g} of it: the record does not rank them)" if tied > 1 else
+                 f"Share of each loss in each fitted model (lowest AIC on top;\n"
+                 f"the others, below the dashed line, dAIC {supported_daic:g} or more behind it)")  # fmt: skip
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1 - 0.6 / len(rows)), ncol=3, fontsize=8)
     return save(fig, path)
 

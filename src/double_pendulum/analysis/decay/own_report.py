@@ -9,7 +9,7 @@ from typing import Any
 from ...runs.results_io import report_opening
 from ..track.measurement import SG_POLYORDER, SG_WINDOW
 from .error_budget import budget_table
-from .report import comparison_rows, plus_minus, variant_rows
+from .report import comparison_rows, plus_minus, tilt_section, variant_rows
 
 
 def _lengths(s: dict[str, Any]) -> str:
@@ -87,6 +87,7 @@ The same fit with other energies and weights:
 
 {comparison_rows(s)}
 
+{tilt_section(s)}
 ## Error budget of a and b
 
 {budget_table(s['error_budget'])}

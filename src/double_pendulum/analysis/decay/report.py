@@ -324,9 +324,34 @@ What would settle it, and the record cannot:
 """
 
 
+def tilt_section(s: DecaySummary) -> str:
+    """The camera's tilt against gravity and what removing it changes (``tilt`` of the summary)."""
+    tilt = s["tilt"]
+    rows = ["| track | b [1/s] | halves apart [sigma, AR(1) / bootstrap] | p (AR(1)) | p's 95 % interval | "
+            "exponential's dAIC (AR(1)) |", "|---|---|---|---|---|---|"]
+    for name in ("tilted", "untilted"):
+        t = tilt[name]
+        h, x = t["halves"], t["exponent"]
+        lo, hi = (f"{v:.2f}" if v is not None else "beyond" for v in x["interval_95"])
+        rows.append(f"| {name} | {t['b_per_s']:.4f} | {abs(h['difference_in_sigma_ar1']):.1f} / "
+                    f"{abs(h['difference_in_sigma_bootstrap']):.1f} | {x['p']:.2f} +- {x['p_stderr']:.2f} | "
+                    f"{lo} to {hi} | "
+                    f"{t['ar1_models']['models']['exponential']['delta_aic']:.1f} |")
+    return f"""## The camera's tilt
+
+{tilt['text']}
+
+{chr(10).join(rows)}
+
+The tilted track is the main analysis; the untilted one is the track as the camera saw it. p is the exponent of
+dE/dt = -k E^p fitted under an AR(1) noise model (p = 1: the exponential); its interval is where the profile
+likelihood stays within Delta(-2 ln L) = 4.
+"""
+
+
 def report_text(summary: DecaySummary) -> str:
     """The Markdown report: figures from ``summary`` and the discussion of the differences to the seed."""
-    sections = (_geometry_section, _energy_section, _fit_section, _budget_section, _stationarity_section,
+    sections = (_geometry_section, tilt_section, _energy_section, _fit_section, _budget_section, _stationarity_section,
                 _comparison_section, _discussion_section)
     body = "\n".join(section(summary) for section in sections)
     return _opening(summary) + body

@@ -66,4 +66,5 @@ class DecaySummary(TypedDict):
     seed: dict[str, Any]
     null_means: dict[str, Any]
     error_budget: dict[str, Any]
+    tilt: dict[str, Any]
     quick: bool

@@ -15,7 +15,9 @@ import numpy as np
 from ...model.parameters import SEED_RIGID_LINKS
 from ..suspension.identification import MeasuredDecay, measured_decay
 from ..track.measurement import Reconstruction, load_track, reconstruct
+from ..track.tilt import seed_record_geometry
 from . import claims as loss_claims
+from .air_profile import AIR_MODELS, EXTEND_STEPS, LEVEL, air_point, air_points, air_share_intervals
 from .comparison import (
     air_share_at_defaults,
     common_factor,
@@ -77,9 +79,12 @@ def measured_loss(md: MeasuredDecay) -> float:
     return a * (math.exp(b * md.frames.t[0]) - math.exp(b * md.frames.t[-1]))
 
 
-def seed_reconstruction() -> Reconstruction:
-    """The seed's track reconstructed with the rigid links :data:`SEED_RIGID_LINKS`."""
-    return reconstruct(load_track(), rods=SEED_RIGID_LINKS)
+def seed_reconstruction(*, tilt: bool = True) -> Reconstruction:
+    """The seed's track reconstructed with the rigid links :data:`SEED_RIGID_LINKS`, in the record's one geometry
+    (:func:`~..track.tilt.seed_record_geometry`): turned back by the camera's tilt against gravity; ``tilt=False``:
+    the untilted track as the camera saw it (the named variant, same pivot and lengths)."""
+    rg = seed_record_geometry()
+    return reconstruct(load_track(), rg.geometry if tilt else rg.untilted, rods=SEED_RIGID_LINKS)
 
 
 def measured(rec: Reconstruction | None = None, window_s: float | None = None) -> MeasuredDecay:
@@ -182,6 +187,45 @@ def _air_model_on_measured_decay(fits: Sequence[Any], rows: Sequence[Mapping[str
     return None
 
 
+def air_share_profile(problem: FitProblem, fits: Sequence[ModelFit], rows: Sequence[Mapping[str, Any]],
+                      factor: float, pool: Any = None, max_workers: int | None = None) -> dict[str, Any]:
+    """Air drag's share as a profile-likelihood interval (:mod:`.air_profile`) over the converged models of ``rows``
+    with air drag beside a bearing loss; the points fitted on ``pool``."""
+    from ..sweep import parallel_map  # noqa: PLC0415 - process pools only when identifying
+
+    best = min(r["chi2"] for r in rows if r["converged"])  # a model whose own optimum lies beyond the level: no share
+    converged_models = [r["model"] for r in rows if r["converged"] and r["model"] in AIR_MODELS
+                        and (r["chi2"] - best) / factor <= LEVEL]  # fmt: skip
+    items = air_points(fits, factor, converged_models)
+    results, _ = parallel_map(air_point, items, shared=problem, max_workers=max_workers, label="air share profile",
+                              pool=pool)  # fmt: skip
+    first = air_share_intervals(fits, rows, factor, items, results)
+    open_top = [m for m, d in first["models"].items() if d["share_interval"] and d["share_interval"][1] is None]
+    if open_top:  # a flat profile: further points above the optimum
+        more = air_points(fits, factor, open_top, EXTEND_STEPS)
+        extra, _ = parallel_map(air_point, more, shared=problem, max_workers=max_workers, label="air share profile",
+                                pool=pool)  # fmt: skip
+        items, results = [*items, *more], [*results, *extra]
+    return air_share_intervals(fits, rows, factor, items, results)
+
+
+def untilted_identification(rec: Reconstruction, pool: Any = None, max_workers: int | None = None) -> dict[str, Any]:
+    """The default identification's comparison on another reconstruction (the untilted track): the models within
+    delta AIC 2 under F and under AR(1), each model's delta AIC, delta BIC and air share, and the air share's
+    profile interval (the thorough run's named variant)."""
+    problem = problem_from_track(rec, measured(rec))
+    fits, _ = fit_models(FULL_MODELS, problem, max_workers, pool, max_runs=run_budget(False))
+    factor = common_factor(problem)
+    rows = comparison_rows(fits, factor)
+    noise = noise_model_summary(rows, {f.model: f.residuals for f in fits}, problem.sigma, factor)
+    return {"tilt_deg": math.degrees(rec.geometry.tilt), "correlation_factor_F": factor,
+            "supported_models": loss_claims.supported_models(rows), "ties": noise["ties"],
+            "air_share_range": noise["air_share_range"],
+            "models": {r["model"]: {"delta_aic": r["delta_aic"], "delta_bic": r["delta_bic"], "shares": r["shares"],
+                                    "converged": r["converged"]} for r in rows},
+            "air_share_profile": air_share_profile(problem, fits, rows, factor, pool, max_workers)}  # fmt: skip
+
+
 def goal_checks(numbers: Mapping[str, float], halves: Mapping[str, Any]) -> dict[str, Any]:
     """The issue's goal: b_sim within 2 % of b_measured, p_sim within 2 p_measured_stderr, no trend."""
     b_dev = numbers["b_sim_per_s"] / numbers["b_measured_per_s"] - 1.0
@@ -230,6 +274,11 @@ def identify_losses(
         for r in rows:
             r["ar1"] = {k: noise["criteria"][r["model"]][k] for k in ("rho", "aic", "bic", "delta_aic", "delta_bic")
                         } if r["model"] in noise["criteria"] else None  # fmt: skip
+        air = None if quick else air_share_profile(problem, fits, rows, factor, pool, max_workers)
+        untilted = None
+        if thorough:  # the same identification on the untilted track: what the tilt changes (about 50 s of CPU)
+            untilted = untilted_identification(seed_reconstruction(tilt=False) if seed
+                                               else record.reconstruction(tilt=False), pool, max_workers)
         holdout = None
         if quick or thorough:  # the default run: +86 % wall time (109 s to 203 s), so thorough (and quick) only
             holdout = out_of_sample(problem, half_fits(problem, fits, rows, quick, pool, max_workers))
@@ -277,6 +326,8 @@ def identify_losses(
         "supported_from_factor": loss_claims.supported_from_factor(rows, factor),
         "noise_model": noise,
         "out_of_sample": holdout,
+        "air_share_profile": air,
+        "untilted_track": untilted,
         "residual_halves": halves,
         "goal": goal_checks(numbers, halves),
         "measured_loss_J": loss,
@@ -308,6 +359,12 @@ def identify_losses(
                        "ar1": "models[...].ar1 of a model that did not converge: no likelihood of an optimum",
                        "out_of_sample": "not run: the half-record test runs with --thorough (and --quick, one model "
                                         "as a smoke run); it would add about 85 % to the default run's time",
+                       "air_share_profile": "not profiled in the quick run",
+                       "share_interval": "air_share_profile: no share of that model comes within Delta(-2 ln L) <= 4 "
+                                         "of the best fit, or (an end) the profile stays below it beyond the "
+                                         "profiled points",
+                       "untilted_track": "the identification on the untilted track runs with --thorough only (about "
+                                         "50 s more CPU)",
                        "profile_likelihood": "empty: profiled with --thorough only (its intervals matched the "
                                              "curvature errors in the runs so far)",
                        **({} if seed else {

@@ -35,9 +35,18 @@ def own_report_text(s: Mapping[str, Any]) -> str:
     else:
         air = sup["air_share_range"]
         names = "; ".join(model_title(m) for m in sup["models"])
-        sentences = [lost, f"{len(sup['models'])} of the {len(s['models'])} candidate loss models follow the measured "
-                     f"energy about equally well (within delta AIC 2): {names}"
-                     + (f"; air drag's share of the loss among them {air[0]:.0%} to {air[1]:.0%}." if air else ".")]
+        many = len(sup["models"]) > 1
+        sentences = [lost, (f"{len(sup['models'])} of the {len(s['models'])} candidate loss models follow the measured "
+                            f"energy about equally well (within delta AIC 2): {names}" if many else
+                            f"One of the {len(s['models'])} candidate loss models follows the measured energy best, by "
+                            f"more than delta AIC 2: {names}")
+                     + (f"; air drag's share of the loss {'among them ' if many else ''}{air[0]:.0%} to {air[1]:.0%}."
+                        if air else ".")]  # fmt: skip
+        profile = s.get("air_share_profile")
+        if profile and profile["share_interval"] and None not in profile["share_interval"]:
+            lo, hi = profile["share_interval"]
+            sentences.append(f"The shares of air drag the record allows (any model within Delta(-2 ln L) <= 4 of the "
+                             f"best fit): {lo:.0%} to {hi:.0%}.")
     sentences.append(f"The model with the lowest AIC, {model_title(s['top_model'])}, decays at b = "
                      f"{s['b_sim_per_s']:.4f} 1/s against the measured {s['b_measured_per_s']:.4f} +- "
                      f"{s['b_measured_stderr']:.4f} 1/s.")

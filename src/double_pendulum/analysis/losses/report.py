@@ -14,6 +14,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ...runs.results_io import report_opening
+from .air_profile import air_share_text
 from .holdout import holdout_section
 from .mechanisms import model_title
 from .summary_types import LossesSummary
@@ -235,10 +236,19 @@ def _opening(s: LossesSummary) -> str:
         lost + "Simulating the pendulum with different assumed losses (air drag, friction torques in the joints, a "
         "damped springy pivot) and adjusting each loss's strength until the simulated energy follows the measured "
         "one, this report asks which losses can explain it.",
-        f"{len(sup['models'])} of the {len(s['models'])} candidates follow the measurement about equally well "
-        f"({names}), so the record shows how fast the energy falls but not which losses cause it"
-        + (f": air drag's share of the loss can be anything from {air[0]:.0%} to {air[1]:.0%}." if air else "."),
+        (f"{len(sup['models'])} of the {len(s['models'])} candidates follow the measurement about equally well "
+         f"({names}), so the record shows how fast the energy falls but not which losses cause it"
+         + (f": air drag's share of the loss can be anything from {air[0]:.0%} to {air[1]:.0%}." if air else "."))
+        if len(sup["models"]) > 1 else
+        (f"One of the {len(s['models'])} candidates follows the measurement best, by a margin the usual criterion "
+         f"(AIC, 2) counts: {names}" + (f", with air drag taking {air[0]:.0%} of the loss." if air else ".")),
     ]
+    profile = s.get("air_share_profile")
+    if profile and profile["share_interval"]:
+        lo, hi = profile["share_interval"]
+        if lo is not None and hi is not None:
+            sentences.append(f"Asked which shares of air drag the record allows at all (any model within a likelihood "
+                             f"margin of 4 of the best fit), it answers {lo:.0%} to {hi:.0%}.")
     nm = s.get("noise_model")
     if nm and sorted(nm["ties"]["bic_ar1"]) != sorted(sup["models"]):
         bic, air_bic = nm["ties"]["bic_ar1"], nm["air_share_range"]["bic_ar1"]
@@ -251,8 +261,9 @@ def _opening(s: LossesSummary) -> str:
         sentences.append(f"A damped springy pivot as the main loss, the seed's explanation, fits clearly worse at the "
                          f"stiffness and mass assumed here ({s['suspension_fixed']['k_N_per_m']:g} N/m, "
                          f"{s['suspension_fixed']['M_s_kg']:g} kg): no damping makes it fit better than a rigid pivot.")
+    verdict = "the candidates tie" if len(sup["models"]) > 1 else "one leads"
     sentences.append("How sure: every fit is judged on the same record it was fitted to, and the verdict "
-                     "that the candidates tie holds unless the frames' errors are far more correlated than the "
+                     f"that {verdict} holds unless the frames' errors are far more correlated than the "
                      f"data indicate (neighbouring frames' errors are alike, so n frames count as "
                      f"n / {s['correlation_factor_F']:.2f} independent ones).")
     return report_opening(title, sentences, _terms(s))
@@ -290,6 +301,16 @@ def _air_on_decay_text(air: Mapping[str, Any]) -> str:
     return (f"Along a motion that decays as measured (the fitted {air['measured_decay_model']}, its air work divided "
             f"by its fitted air factor) the same coefficients dissipate {air['W_air_on_measured_decay_J']:.3f} J, "
             f"{air['share_on_measured_decay']:.0%} of the measured loss. ")
+
+
+def untilted_text(u: Mapping[str, Any] | None) -> str:
+    """What the camera's tilt changes in the comparison (the thorough run's untilted identification); "" without."""
+    if not u:
+        return ("The energy is that of the track turned back by the camera's tilt against gravity (`energy_decay`'s "
+                "`tilt`); `--thorough` repeats the comparison on the untilted track.")
+    ties = "; ".join(f"{k}: {', '.join(v)}" for k, v in u["ties"].items())
+    return (f"On the untilted track (the camera's tilt not removed) the models within 2 of the lowest were: {ties} "
+            "(the criteria as in the noise-model section below).")
 
 
 def report_text(s: LossesSummary) -> str:
@@ -331,6 +352,10 @@ neither b nor p). Errors of fitted numbers are multiplied by sqrt(F). {_factor_t
 {s['supported_models']['text']}
 
 {_pair_text(s)}
+
+{air_share_text(s.get('air_share_profile'), s.get('untilted_track'))}
+
+{untilted_text(s.get('untilted_track'))}
 
 {noise_section(s)}
 

@@ -173,6 +173,8 @@ class LossesSummary(TypedDict):
     supported_from_factor: dict[str, float | None]
     noise_model: NoiseModel | None
     out_of_sample: dict[str, Any] | None
+    air_share_profile: dict[str, Any] | None
+    untilted_track: dict[str, Any] | None
     residual_halves: ResidualHalves
     goal: Goal
     measured_loss_J: float

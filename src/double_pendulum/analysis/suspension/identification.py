@@ -59,6 +59,7 @@ from ...model.parameters import SuspensionParameters
 from ..decay.fit import FitResult, calibrate_error_model, fit_model, record_correlation_factor
 from ..track.measurement import FRAME_INTERVAL, Reconstruction, load_track, reconstruct
 from ..track.start_state import StartStateFit, fit_start_state, track_window
+from ..track.tilt import seed_record_geometry
 from .response import ForceSpectrum, pivot_force_spectrum
 
 LOSSES: dict[str, bool] = {"air_drag": True, "rod_drag": True, "bearing_friction": True}
@@ -395,7 +396,7 @@ def identify_suspension(
     ``k`` and ``m_s``, so repeated calls in one process (the tests' fixtures and ``suspension_transfer``)
     fit it once.
     """
-    rec = reconstruct(load_track()) if rec is None else rec
+    rec = reconstruct(load_track(), seed_record_geometry().geometry) if rec is None else rec
     key = (_file_digest(runner.fmu_path), _track_digest(rec), quick, k, m_s)
     if key not in _IDENTIFIED:
         _IDENTIFIED.clear()  # one entry is all a run needs

@@ -16,9 +16,10 @@ quantities the friction analysis needs:
        \varphi_1 = \operatorname{atan2}(x_1, -y_1),\qquad
        \varphi_2 = \operatorname{atan2}(x_2 - x_1, -(y_2 - y_1))
 
-   (unwrapped), their rates by central differences (the seed's method, 4.2.1) and by a
-   Savitzky-Golay derivative filter (:data:`SG_WINDOW`, :data:`SG_POLYORDER`), the energy per frame
-   with :func:`double_pendulum.model.energy.total_energy` and two uncertainties of that energy: the
+   (unwrapped; the positions first turned back by the camera's tilt against gravity,
+   :attr:`Geometry.tilt`, which :mod:`.tilt` fits), their rates by central differences (the seed's
+   method, 4.2.1) and by a Savitzky-Golay derivative filter (:data:`SG_WINDOW`, :data:`SG_POLYORDER`),
+   the energy per frame with :func:`double_pendulum.model.energy.total_energy` and two uncertainties of that energy: the
    seed's eq. 25 and the propagated position noise (:func:`sigma_energy_propagated`).
 
 Lengths in m, times in s, angles in rad, energies in J.
@@ -104,6 +105,9 @@ class Geometry:
 
     ``pivot`` is the circle fit of the upper bob (centre = pivot in the track's coordinates,
     radius = l1); ``l2`` is the mean distance between the bobs with ``sigma_l2`` = std / sqrt(n).
+    ``tilt`` [rad]: the camera's rotation against gravity (counter-clockwise, as
+    :data:`~.start_state.VIEW_ROTATION`): :func:`reconstruct` turns the positions back by it about the pivot,
+    so every angle is measured from gravity's vertical (:mod:`.tilt` fits it; 0: the untilted track).
     """
 
     pivot: CircleFit
@@ -111,6 +115,7 @@ class Geometry:
     sigma_l2: float
     l2_std: float
     n_frames: int
+    tilt: float = 0.0
 
     @property
     def l1(self) -> float:
@@ -293,6 +298,15 @@ def fit_circle(x: np.ndarray, y: np.ndarray) -> CircleFit:
     sxc, syc, sr = np.sqrt(np.diag(cov))
     rms = math.sqrt(float(np.mean(resid * resid)))
     return CircleFit(float(xc), float(yc), abs(float(radius)), float(sxc), float(syc), float(sr), rms)
+
+
+def circle_covariance(x: np.ndarray, y: np.ndarray, fit: CircleFit) -> np.ndarray:
+    """Covariance of (xc, yc, radius) [m^2] of :func:`fit_circle`'s result ``fit`` through (x, y) [m]:
+    s^2 (J^T J)^-1 at the optimum (independent residuals of equal variance, as its standard errors)."""
+    p = np.array([fit.xc, fit.yc, fit.radius])
+    jac = _circle_jacobian(p, np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    resid = _circle_residuals(p, np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    return float(resid @ resid) / (len(resid) - 3) * np.linalg.inv(jac.T @ jac)
 
 
 def fit_geometry(track: Track) -> Geometry:
@@ -506,6 +520,15 @@ def same_pendulum(rec: Reconstruction) -> dict[str, object]:
             "rods": {k: getattr(p, k) for k in ("m_rod1", "m_rod2", "L_rod1", "L_rod2")}}  # fmt: skip
 
 
+def untilt(x: np.ndarray, y: np.ndarray, tilt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Positions (x, y) [m] about the pivot turned clockwise by ``tilt`` [rad]: a camera turned counter-clockwise
+    by ``tilt`` against gravity, undone (each angle ``phi`` then falls by ``tilt``). ``tilt = 0``: unchanged."""
+    if not tilt:
+        return x, y
+    c, s = math.cos(tilt), math.sin(tilt)
+    return c * x + s * y, -s * x + c * y
+
+
 def _touches_invalid(valid: np.ndarray, half_width: int) -> np.ndarray:
     """True where a flagged frame lies within ``half_width`` frames."""
     bad = (~valid).astype(float)
@@ -545,8 +568,8 @@ def reconstruct(
         **({} if g is None else {"g": g}),
     )
     s1, s2 = estimate_position_noise(track, geometry) if sigma_pos is None else sigma_pos
-    x1, y1 = track.x1 - geometry.pivot.xc, track.y1 - geometry.pivot.yc
-    x2, y2 = track.x2 - geometry.pivot.xc, track.y2 - geometry.pivot.yc
+    x1, y1 = untilt(track.x1 - geometry.pivot.xc, track.y1 - geometry.pivot.yc, geometry.tilt)
+    x2, y2 = untilt(track.x2 - geometry.pivot.xc, track.y2 - geometry.pivot.yc, geometry.tilt)
     phi1, phi2 = angles(x1, y1, x2, y2)
     cd = central_difference_coefficients(track.dt)
     sg = savgol_derivative_coefficients(window, polyorder, track.dt)

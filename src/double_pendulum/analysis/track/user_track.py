@@ -40,6 +40,7 @@ import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +48,7 @@ import numpy as np
 
 from ...model.parameters import ParameterError, PendulumParameters
 from .measurement import Geometry, Reconstruction, Track, fit_geometry, flag_bad_frames, reconstruct, robust_sigma
+from .tilt import RecordGeometry, record_geometry
 
 DEFAULT_COLUMNS: dict[str, str] = {"t": "t_s", "x1": "x1_m", "y1": "y1_m", "x2": "x2_m", "y2": "y2_m"}
 """The quantities of a track and their columns in the seed's table (``data/seed_table1.csv``)."""
@@ -360,10 +362,20 @@ class UserRecord:
         g = fit_geometry(self.track.track)
         return {"l1": g.l1, "l1_stderr": g.sigma_l1, "l2": g.l2, "l2_stderr": g.sigma_l2}
 
-    def reconstruction(self) -> Reconstruction:
-        """The track reconstructed with the user's masses, lengths (:meth:`geometry`), rods and g."""
+    @cached_property
+    def record_geometry(self) -> RecordGeometry:
+        """The record's one geometry (:func:`~.tilt.record_geometry`): :meth:`geometry` and the camera's tilt against
+        gravity fitted to the energy of the user's pendulum, with their covariance."""
         p = self.pendulum
-        return reconstruct(self.track.track, self.geometry(), m1=p.m1, m2=p.m2, rods=p.rods, g=p.other.get("g"))
+        return record_geometry(self.track.track, self.geometry(), m1=p.m1, m2=p.m2, rods=p.rods, g=p.other.get("g"))
+
+    def reconstruction(self, *, tilt: bool = True) -> Reconstruction:
+        """The track reconstructed with the user's masses, lengths (:meth:`geometry`), rods and g, turned back by the
+        camera's tilt (:attr:`record_geometry`); ``tilt=False``: the untilted track as the camera saw it."""
+        p = self.pendulum
+        rg = self.record_geometry
+        return reconstruct(self.track.track, rg.geometry if tilt else rg.untilted, m1=p.m1, m2=p.m2, rods=p.rods,
+                           g=p.other.get("g"))  # fmt: skip
 
     def describe(self) -> dict[str, Any]:
         """The record and the pendulum as the summaries state them."""
