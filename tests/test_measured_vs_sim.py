@@ -251,14 +251,14 @@ def test_quick_run_compares_both_starts_with_the_track(quick_results):
         assert (tmp_path / f"{name}.png").stat().st_size > 10_000
     report = (tmp_path / "report.md").read_text()
     assert "Prediction horizons" in report
-    # a horizon that reaches the end of the prediction is censored and claimed as "> span (censored)"
+    # a horizon that reaches the end of the prediction is censored and claimed as "not reached in the span compared"
     for suffix, label in (("", "lsq_geometry_identified"), ("_fixed_geometry", "lsq_fixed_geometry_identified"),
                           ("_pivot_shift", "lsq_pivot_shift_identified")):
         crossing = tc.horizon(t, tc.smoothed(t, errors[f"e2_{label}"]), 0.05)
         assert summary[f"horizon_5cm_censored{suffix}"] == (crossing is None)
         assert summary[f"horizon_5cm_s{suffix}"] == (summary["prediction_s"] if crossing is None else crossing)
         if crossing is None:
-            assert f"> {summary['prediction_s']:.1f} s (censored)" in report
+            assert f"not reached in the {summary['prediction_s']:.2f} s compared (censored)" in report
     assert set(summary["starts"]["least_squares_pivot_shift"]["geometry"]) == set(tc.PIVOT_SHIFT_GEOMETRY)
     assert "geometry" not in summary["starts"]["least_squares_fixed_geometry"] or not summary["starts"][
         "least_squares_fixed_geometry"]["geometry"]

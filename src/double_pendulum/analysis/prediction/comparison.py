@@ -371,7 +371,7 @@ def null_means(prediction_s: float) -> dict[str, str]:
     """What a null horizon in the summary means, by summary key."""
     never = f"the error or spread did not exceed the threshold within the {prediction_s:.1f} s prediction window"
     return {"horizons_smoothed_s": never, "horizons_raw_s": never, "chaos_horizons_s": never,
-            "fit_window_sensitivity": never}
+            "fit_window_sensitivity": never, "horizon_5cm_details": never}
 
 
 def window_sensitivity(
