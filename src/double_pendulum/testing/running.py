@@ -19,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ..fmu.running.choice import fmu_to_run
+from ..fmu.running.choice import fmu_to_run, read_fmu_description
 from ..fmu.running.runner import FmuRunError, FmuRunner
 from .results import MissingReference, Result, reference_in_folder
 
@@ -53,17 +53,9 @@ class FmuTarget:
 
 def targets_of(path: Path) -> list[FmuTarget]:
     """Every interface of the FMU file ``path`` as a target (its model description read, nothing extracted);
-    ``ValueError`` saying why where it is not a usable FMU."""
-    import zipfile
-
-    from fmpy import read_model_description
-
-    try:
-        md = read_model_description(str(path))
-    except (zipfile.BadZipFile, KeyError, OSError) as error:
-        raise ValueError(f"{path} is not a usable FMU ({type(error).__name__}: {error})") from None
-    except Exception as error:  # fmpy's own validation errors
-        raise ValueError(f"{path} is not a usable FMU: {' '.join(str(error).split())}") from None
+    ``ValueError`` (:class:`~double_pendulum.fmu.running.choice.FmuPathError`) saying why where it is not a usable
+    FMU."""
+    md = read_fmu_description(path)
     return [FmuTarget(path, short, md.fmiVersion, md.modelName)
             for short, attribute in (("CS", "coSimulation"), ("ME", "modelExchange"))
             if getattr(md, attribute) is not None]

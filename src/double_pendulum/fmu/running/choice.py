@@ -48,20 +48,26 @@ def given_fmu(path: str | Path) -> Path:
     return path
 
 
-def read_pendulum_fmu(path: str | Path) -> Any:
-    """fmpy's model description of the FMU file ``path`` (:func:`given_fmu`), which must be usable and carry
-    :data:`PENDULUM_VARIABLES` (else :class:`FmuPathError` saying why)."""
+def read_fmu_description(path: str | Path) -> Any:
+    """fmpy's model description of the FMU file ``path``, any FMU's; :class:`FmuPathError` naming the path and why
+    where it is not a usable FMU (not a zip, no modelDescription.xml, fmpy's validation fails)."""
     import zipfile
 
     from fmpy import read_model_description
 
-    path = given_fmu(path)
     try:
-        md = read_model_description(str(path))
+        return read_model_description(str(path))
     except (zipfile.BadZipFile, KeyError, OSError) as error:
         raise FmuPathError(f"{path} is not a usable FMU ({type(error).__name__}: {error})") from None
     except Exception as error:  # fmpy's own validation errors
         raise FmuPathError(f"{path} is not a usable FMU: {' '.join(str(error).split())}") from None
+
+
+def read_pendulum_fmu(path: str | Path) -> Any:
+    """fmpy's model description of the FMU file ``path`` (:func:`given_fmu`), which must be usable and carry
+    :data:`PENDULUM_VARIABLES` (else :class:`FmuPathError` saying why)."""
+    path = given_fmu(path)
+    md = read_fmu_description(path)
     names = {variable.name for variable in md.modelVariables}
     missing = [name for name in PENDULUM_VARIABLES if name not in names]
     if missing:
