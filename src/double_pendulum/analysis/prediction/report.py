@@ -195,9 +195,13 @@ def loss_models_text(s: PredictionSummary) -> str:
     """The main start under every loss model the record supports equally: each model's 5 cm horizons, the ranges."""
     sens = s["loss_model_sensitivity"]
     span = s["prediction_s"]
-    if sens["n_models"] < 2:
+    if sens["n_models"] < 2 and s.get("quick"):
         return ("**Under the other loss models.** Not run: this mode fits one loss model, so the horizons' spread over "
                 "the models the record supports equally is unknown here.")
+    if sens["n_models"] < 2:
+        return ("**Under the other loss models.** None is run: of the loss models ``loss_identification`` fits, only "
+                "this one lies within dAIC 2 of the best on this record, so there is no spread over equally supported "
+                "models to show. The others are not ruled out for the motion: their energy fits lie 2 or more behind.")
     rows = "; ".join(f"{model_title(m)}: {claim_horizon(h['horizon_s'], h['censored'])} smoothed, "
                      f"{fmt_horizon(h['raw_horizon_s'], span)} s per frame" for m, h in sens["models"].items())
     return (f"**Under the other loss models.** The energy record supports {sens['n_models']} loss models equally "
@@ -216,11 +220,18 @@ def loss_uncertainty_text(s: PredictionSummary) -> str:
     rows = "; ".join(f"{model_title(m)}: {d['smoothed_s_per_percent']:+.1f} s smoothed"
                      f"{' or more' if d['slope_is_lower_bound'] else ''}, {d['raw_s_per_percent']:+.1f} s per frame"
                      for m, d in u["damping_sensitivity"].items())  # fmt: skip
-    text = ("**The losses' uncertainty.** The horizons above take each model's fitted losses as exact, and the horizon "
-            "is very sensitive to the damping level: 1 % more damping (every loss coefficient times 1.01; central "
-            f"difference of +-1 %) changes the 5 cm horizon by about ({rows}; \"or more\": a censored end, the "
-            "size is a lower bound), so an uncertainty of the fitted damping of a few tenths of a per cent "
-            "already moves it by a second.")
+    censored = all(all(level["censored"] for level in d["levels"].values()) for d in u["damping_sensitivity"].values())
+    if censored:
+        text = ("**The losses' uncertainty.** The horizons above take each model's fitted losses as exact. With 1 % "
+                "less and 1 % more damping (every loss coefficient times 0.99 and 1.01) the 5 cm horizon still reaches "
+                f"the end of the record ({', '.join(map(model_title, u['damping_sensitivity']))}): censored at every "
+                "level, so how far 1 % of damping moves it is not known from this record.")
+    else:
+        text = ("**The losses' uncertainty.** The horizons above take each model's fitted losses as exact, and the "
+                "horizon is very sensitive to the damping level: 1 % more damping (every loss coefficient times "
+                f"1.01; central difference of +-1 %) changes the 5 cm horizon by about ({rows}; \"or more\": a "
+                "censored end, the size is a lower bound), so an uncertainty of the fitted damping of a few tenths of a per cent "
+                "already moves it by a second.")
     if "ensemble" not in u:
         return text + " The ensemble over the losses' covariance runs with ``--thorough``."
     ens = "; ".join(f"{model_title(m)}: {_stats_text(e['smoothed_5cm'])} smoothed, {_stats_text(e['raw_5cm'])} "
