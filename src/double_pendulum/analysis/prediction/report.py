@@ -230,8 +230,8 @@ def loss_uncertainty_text(s: PredictionSummary) -> str:
         text = ("**The losses' uncertainty.** The horizons above take each model's fitted losses as exact, and the "
                 "horizon is very sensitive to the damping level: 1 % more damping (every loss coefficient times "
                 f"1.01; central difference of +-1 %) changes the 5 cm horizon by about ({rows}; \"or more\": a "
-                "censored end, the size is a lower bound), so an uncertainty of the fitted damping of a few tenths of a per cent "
-                "already moves it by a second.")
+                "censored end, the size is a lower bound), so an uncertainty of the fitted damping of a few tenths "
+                "of a per cent already moves it by a second.")
     if "ensemble" not in u:
         return text + " The ensemble over the losses' covariance runs with ``--thorough``."
     ens = "; ".join(f"{model_title(m)}: {_stats_text(e['smoothed_5cm'])} smoothed, {_stats_text(e['raw_5cm'])} "
