@@ -101,7 +101,8 @@ def horizon_interval(horizons: Sequence[float], span_s: float) -> dict[str, Any]
     p2, p16, p50, p84, p97 = (float(x) for x in np.percentile(h, PERCENTILES))
     return {"median_s": p50, "range_16_84_s": [p16, p84], "range_2_97_s": [p2, p97], "width_16_84_s": p84 - p16,
             "n": int(len(h)), "censored_fraction": float(np.mean(h >= span_s)),
-            "top_censored": bool(p84 >= span_s)}  # fmt: skip
+            "top_censored": bool(p84 >= span_s),
+            "range_16_84_claim": f"{p16:.1f} s to beyond the record" if p84 >= span_s else f"{p16:.1f} to {p84:.1f} s"}
 
 
 def monte_carlo(run: Callable[[Mapping[str, np.ndarray]], float], blocks: Mapping[str, Block], size: int,

@@ -95,19 +95,34 @@ def loss_model_sensitivity(predictions: Mapping[str, Prediction], n_frames: int,
     smoothed = [h["horizon_s"] for h in per_model.values()]
     raw = [span if h["raw_horizon_s"] is None else h["raw_horizon_s"] for h in per_model.values()]
     margins = [h["margin_below_threshold_m"] for h in per_model.values()]
+    smoothed_censored = [m for m, h in per_model.items() if h["censored"]]
+    raw_censored = [m for m, h in per_model.items() if h["raw_horizon_s"] is None]
     return {
         "models": per_model,
         "n_models": len(per_model),
         "smoothed_5cm_range_s": [float(np.min(smoothed)), float(np.max(smoothed))],
-        "smoothed_censored_models": [m for m, h in per_model.items() if h["censored"]],
+        "smoothed_censored_models": smoothed_censored,
+        "smoothed_5cm_claim": range_claim(smoothed, len(smoothed_censored), span),
         "raw_5cm_range_s": [float(np.min(raw)), float(np.max(raw))],
-        "raw_censored_models": [m for m, h in per_model.items() if h["raw_horizon_s"] is None],
+        "raw_censored_models": raw_censored,
+        "raw_5cm_claim": range_claim(raw, len(raw_censored), span),
         "margin_range_m": [float(np.min(margins)), float(np.max(margins))],
         "statement": "the start and camera geometry fitted to the first 1.5 s, run with each loss model the measured "
                      "energy supports equally (loss_identification): the range is what the record cannot pin down. "
                      "A horizon that reaches the end of the record is censored (only known to exceed it). In-sample: "
                      "the losses are fitted to the same record.",
     }
+
+
+def range_claim(horizons: Sequence[float], n_censored: int, span: float) -> str:
+    """The horizons [s] over the models as they may be claimed, in words: censored ones (``n_censored`` of them,
+    given as the record's length ``span`` [s]) are only known to exceed the record."""
+    lo, hi = float(np.min(horizons)), float(np.max(horizons))
+    if n_censored == len(horizons):
+        return f"the whole {span:.1f} s compared (censored: never exceeded within the record)"
+    if n_censored:
+        return f"{lo:.1f} s to the whole {span:.1f} s compared (censored)"
+    return f"{lo:.1f} s" if hi - lo < 0.05 else f"{lo:.1f} to {hi:.1f} s"
 
 
 def smoothed_error_band(predictions: Mapping[str, Prediction]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

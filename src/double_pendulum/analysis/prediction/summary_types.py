@@ -92,8 +92,10 @@ class LossModelSensitivity(TypedDict):
     n_models: int
     smoothed_5cm_range_s: list[float]
     smoothed_censored_models: list[str]
+    smoothed_5cm_claim: str
     raw_5cm_range_s: list[float]
     raw_censored_models: list[str]
+    raw_5cm_claim: str
     margin_range_m: list[float]
     statement: str
 
@@ -279,6 +281,7 @@ class HorizonDistribution(TypedDict):
     n: int
     censored_fraction: float
     top_censored: bool
+    range_16_84_claim: str
     members_s: list[float]
 
 
