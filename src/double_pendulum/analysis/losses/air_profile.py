@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from typing import Any
 
+from .comparison import ProfileItem
 from .fitting import FitProblem, ModelFit, fit_loss_model
 from .mechanisms import parameters_of
 from .noise import AIR_LABEL
@@ -47,14 +47,9 @@ PROFILE_RUNS = 12
 """Run budget of each profile point's fit (one free loss parameter: two or three Gauss-Newton steps)."""
 
 
-@dataclass(frozen=True)
-class AirPoint:
-    """A profile point: the model, the air factor's index and held value, the warm start of the others."""
-
-    model: str
-    index: int
-    value: float
-    start: tuple[float, ...]
+AirPoint = ProfileItem
+"""A profile point: the model, the air factor's index and held value, the warm start of the others (the profile
+points of :mod:`.comparison`'s kind)."""
 
 
 def air_point(item: AirPoint, problem: FitProblem) -> tuple[float, float]:
