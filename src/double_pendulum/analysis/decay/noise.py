@@ -9,13 +9,13 @@ the measured residuals are correlated over about a swing. Two descriptions of th
 - **AR(1).** :math:`z_i = \rho z_{i-1} + s\,\varepsilon_i` with independent standard normal
   :math:`\varepsilon_i`, so :math:`\mathrm{var}\,z = s^2/(1-\rho^2)` and
   :math:`\mathrm{corr}(z_i, z_j) = \rho^{|i-j|}`. rho is the lag-one autocorrelation of the fit's
-  residuals (:func:`ar1_coefficient`, Yule-Walker). Two uses:
+  residuals (:func:`~double_pendulum.analysis.ar1.ar1_coefficient`, Yule-Walker). Two uses:
 
   * the error of the weighted least-squares (WLS) estimate itself under that noise, the sandwich
     :math:`C_\theta = (J^T J)^{-1} J^T \Sigma J (J^T J)^{-1}` with the normalised Jacobian
     :math:`J_{ij} = \partial f_i/\partial\theta_j / \sigma_i` and
     :math:`\Sigma_{ij} = \hat v\,\rho^{|i-j|}`, :math:`\hat v = \sum z_i^2/(n-2)`
-    (:func:`ar1_sandwich_errors`);
+    (:func:`ar1_sandwich_errors`, through :func:`~double_pendulum.analysis.ar1.ar1_sandwich`);
   * the generalised least-squares fit with that likelihood (:func:`ar1_gls_fit`, Prais-Winsten):
     minimise :math:`\sum_i w_i^2` with the prewhitened residuals :math:`w_1 = \sqrt{1-\rho^2}\,z_1`,
     :math:`w_i = z_i - \rho z_{i-1}`, which is -2 ln L up to terms free of (a, b) at fixed rho
@@ -41,8 +41,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.signal import lfilter
 
+from ..ar1 import ar1_coefficient, ar1_sandwich
 from .fit import AUTOCORRELATION_LAG_S, exponential, fit_model, residual_autocorrelation
 
 BOOTSTRAP_RESAMPLES = 1000
@@ -51,14 +51,6 @@ BOOTSTRAP_SEED = 20240935
 """Seed of the bootstrap's random generator (the summary is reproducible)."""
 GAUSS_NEWTON_STEPS = 6
 """Gauss-Newton steps of each bootstrap refit from the fitted values (converged to < 1e-10 relative)."""
-
-
-def ar1_coefficient(residuals: np.ndarray) -> float:
-    r"""Lag-one autocorrelation :math:`\hat\rho = \sum_i r_i r_{i-1} / \sum_i r_i^2` of the mean-removed
-    ``residuals`` (the Yule-Walker estimate of the AR(1) coefficient, |rho| < 1)."""
-    r = np.asarray(residuals, dtype=float)
-    r = r - r.mean()
-    return float(r[1:] @ r[:-1] / (r @ r))
 
 
 def exponential_jacobian(t: np.ndarray, a: float, b: float) -> np.ndarray:
@@ -80,21 +72,8 @@ def ar1_sandwich_errors(
     t = np.asarray(t, dtype=float)
     w = _weights(sigma, len(t))
     z = (np.asarray(energy, dtype=float) - exponential(t, a, b)) / w
-    v = float(z @ z) / (len(t) - 2)
-    jac = exponential_jacobian(t, a, b) / w[:, None]
-    bread = np.linalg.inv(jac.T @ jac)
-    cov = v * bread @ (jac.T @ ar1_correlation_times(jac, rho)) @ bread
+    cov = ar1_sandwich(exponential_jacobian(t, a, b) / w[:, None], z, rho)
     return float(math.sqrt(cov[0, 0])), float(math.sqrt(cov[1, 1]))
-
-
-def ar1_correlation_times(x: np.ndarray, rho: float) -> np.ndarray:
-    r"""R x for the AR(1) correlation matrix :math:`R_{ij} = \rho^{|i-j|}` (along axis 0), in O(n):
-    :math:`(R x)_i = f_i + g_i - x_i` with the recursions :math:`f_i = x_i + \rho f_{i-1}` (forward) and
-    :math:`g_i = x_i + \rho g_{i+1}` (backward)."""
-    x = np.asarray(x, dtype=float)
-    f = lfilter([1.0], [1.0, -rho], x, axis=0)
-    g = lfilter([1.0], [1.0, -rho], x[::-1], axis=0)[::-1]
-    return f + g - x
 
 
 def prewhiten(z: np.ndarray, rho: float) -> np.ndarray:

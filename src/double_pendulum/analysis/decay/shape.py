@@ -12,8 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from ..ar1 import ar1_coefficient
 from ..track.measurement import Reconstruction
-from ..track.tilt import RecordGeometry, lag_one
+from ..track.tilt import RecordGeometry
 from .ar1_models import compare, exponent
 from .error_budget import halves
 from .fit import calibrate_error_model, exponential
@@ -31,7 +32,7 @@ def decay_shape(rec: Reconstruction) -> dict[str, Any]:
     return {"tilt_deg": math.degrees(rec.geometry.tilt), "b_per_s": noise["b_per_s"],
             "b_stderr_ar1_per_s": noise["ar1"]["b_per_s_stderr"],
             "b_stderr_bootstrap_per_s": noise["bootstrap"]["b_per_s_stderr"], "rho": noise["rho"],
-            "energy_scatter_rms_J": float(np.sqrt(np.mean(resid**2))), "energy_scatter_lag_one": lag_one(resid),
+            "energy_scatter_rms_J": float(np.sqrt(np.mean(resid**2))), "energy_scatter_lag_one": ar1_coefficient(resid),
             "halves": halves(t, e, sigma), "ar1_models": compare(t, e, sigma),
             "exponent": exponent(t, e, sigma)}  # fmt: skip
 

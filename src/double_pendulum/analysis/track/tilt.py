@@ -20,7 +20,8 @@ the pendulum on top of the smooth decay. :func:`fit_tilt` finds :math:`\theta` [
 (exact in :math:`\theta`: the package's energy function on the turned angles; a [J], b [1/s]; equal weights,
 the frames after the hand release). The decay's shape hardly matters: the tilt's term changes sign every swing,
 the decay does not. Its standard error is the sandwich of the least-squares fit under AR(1) residuals of the
-fit's own lag-one correlation (:func:`ar1_sandwich`), as the decay fit's (:mod:`~double_pendulum.analysis.decay.noise`).
+fit's own lag-one correlation (:func:`~double_pendulum.analysis.ar1.ar1_sandwich`), as the decay fit's
+(:mod:`~double_pendulum.analysis.decay.noise`).
 
 **One geometry** (:func:`record_geometry`): the tilt, the pivot (x, y) and l1 from the circle fit of the upper bob,
 l2 from the bobs' distance (:func:`~.measurement.fit_geometry`), with one covariance. The circle fit and l2
@@ -43,10 +44,10 @@ from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.signal import lfilter
 
 from ...model.energy import total_energy
 from ...model.parameters import SEED_RIGID_LINKS
+from ..ar1 import ar1_coefficient, ar1_sandwich
 from .measurement import Geometry, Reconstruction, Track, circle_covariance, fit_geometry, load_track, reconstruct
 
 GEOMETRY_NAMES: tuple[str, ...] = ("tilt", "pivot_x", "pivot_y", "l1", "l2")
@@ -55,29 +56,6 @@ coordinates [m], the rods' lengths [m]."""
 GEOMETRY_UNITS = {"tilt": "rad", "pivot_x": "m", "pivot_y": "m", "l1": "m", "l2": "m"}
 N_PARTS = 4
 """Consecutive parts of the record in which the tilt is fitted again (its stability over the record)."""
-
-
-def ar1_correlation_times(x: np.ndarray, rho: float) -> np.ndarray:
-    r"""R x for :math:`R_{ij} = \rho^{|i-j|}` along axis 0, in O(n) (forward and backward recursions)."""
-    f = lfilter([1.0], [1.0, -rho], x, axis=0)
-    g = lfilter([1.0], [1.0, -rho], x[::-1], axis=0)[::-1]
-    return f + g - x
-
-
-def lag_one(r: np.ndarray) -> float:
-    """Lag-one autocorrelation of the mean-removed series ``r`` (Yule-Walker)."""
-    r = np.asarray(r, dtype=float) - np.mean(r)
-    return float(r[1:] @ r[:-1] / (r @ r))
-
-
-def ar1_sandwich(jac: np.ndarray, resid: np.ndarray) -> np.ndarray:
-    r"""Covariance of a least-squares estimate with Jacobian ``jac`` (n, k) and residuals ``resid`` (n) if the
-    residuals are AR(1) with their own lag-one correlation rho:
-    :math:`(J^TJ)^{-1} J^T \Sigma J (J^TJ)^{-1}`, :math:`\Sigma_{ij} = v\rho^{|i-j|}`, :math:`v = |r|^2/(n-k)`."""
-    n, k = jac.shape
-    v = float(resid @ resid) / (n - k)
-    bread = np.linalg.inv(jac.T @ jac)
-    return v * bread @ (jac.T @ ar1_correlation_times(jac, lag_one(resid))) @ bread
 
 
 @dataclass(frozen=True)
@@ -122,12 +100,12 @@ def fit_tilt(rec: Reconstruction, frames: np.ndarray | None = None) -> TiltFit:
     held = least_squares(lambda x: e0 - x[0] * np.exp(x[1] * t), start, method="lm")
     free = least_squares(lambda x: energy(x[2]) - x[0] * np.exp(x[1] * t), [*held.x, 0.0], method="lm",
                          x_scale=[1.0, 0.01, 0.01])  # fmt: skip
-    cov = ar1_sandwich(free.jac, free.fun)
+    cov = ar1_sandwich(free.jac, free.fun, ar1_coefficient(free.fun))
     independent = float(free.fun @ free.fun) / (len(t) - 3) * np.linalg.inv(free.jac.T @ free.jac)
     return TiltFit(tilt=rec.geometry.tilt + float(free.x[2]), stderr=math.sqrt(cov[2, 2]),
                    stderr_independent=math.sqrt(independent[2, 2]), a=float(free.x[0]), b=float(free.x[1]),
-                   rms=float(np.sqrt(np.mean(free.fun**2))), rho=lag_one(free.fun),
-                   rms_untilted=float(np.sqrt(np.mean(held.fun**2))), rho_untilted=lag_one(held.fun),
+                   rms=float(np.sqrt(np.mean(free.fun**2))), rho=ar1_coefficient(free.fun),
+                   rms_untilted=float(np.sqrt(np.mean(held.fun**2))), rho_untilted=ar1_coefficient(held.fun),
                    n=len(t))  # fmt: skip
 
 
