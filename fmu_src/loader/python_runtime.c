@@ -432,25 +432,21 @@ void python_runtime_fork_prepare(void) {
     platform_lock(&load_lock);
 }
 
-void python_runtime_fork_parent(void) {
+/* After the fork, in either process: let go of what prepare took, with Python's own after-fork step between. */
+static void after_fork(void (*python_after_fork)(void)) {
     platform_unlock(&load_lock);
     if (fork_gil < 0) return;
-    api.OS_AfterFork_Parent();
+    python_after_fork();
     int gil = fork_gil;
     fork_gil = -1;
     api.GILState_Release(gil);
     platform_unlock(&taking_gil);
 }
 
-void python_runtime_fork_child(void) {
-    platform_unlock(&load_lock);
-    if (fork_gil < 0) return;
-    api.OS_AfterFork_Child(); /* the child's only thread holds the GIL, the other threads' states are gone */
-    int gil = fork_gil;
-    fork_gil = -1;
-    api.GILState_Release(gil);
-    platform_unlock(&taking_gil);
-}
+void python_runtime_fork_parent(void) { after_fork(api.OS_AfterFork_Parent); }
+
+/* In the child Python forgets the threads it does not have; its only thread holds the GIL until after_fork. */
+void python_runtime_fork_child(void) { after_fork(api.OS_AfterFork_Child); }
 
 const char *python_runtime_stdlib(void) {
     platform_lock(&load_lock);
