@@ -29,7 +29,7 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from .comparison import ProfileItem
+from .comparison import ProfileItem, inside_bounds, profile_point
 from .fitting import FitProblem, ModelFit, fit_loss_model
 from .mechanisms import parameters_of
 from .noise import AIR_LABEL
@@ -69,12 +69,8 @@ def air_points(fits: Sequence[ModelFit], factor: float, models: Sequence[str] = 
         i = [p.name for p in params].index("air_factor")
         cov = fit.cov(factor)
         s = math.sqrt(cov[i, i])
-        values = sorted({min(max(fit.theta[i] + k * s, params[i].bounds[0] * 1.01), params[i].bounds[1] / 1.01)
-                         for k in steps} - {float(fit.theta[i])})  # fmt: skip
-        for value in values:
-            shift = cov[:, i] / cov[i, i] * (value - fit.theta[i])
-            start = [min(max(v, q.bounds[0] * 1.01), q.bounds[1] / 1.01) for v, q in zip(fit.theta + shift, params)]
-            items.append(AirPoint(fit.model, i, float(value), tuple(map(float, start))))
+        values = sorted({inside_bounds(fit.theta[i] + k * s, params[i]) for k in steps} - {float(fit.theta[i])})
+        items += [profile_point(fit, cov, i, value) for value in values]
     return items
 
 

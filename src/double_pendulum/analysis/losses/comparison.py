@@ -182,20 +182,26 @@ def profile_item(item: ProfileItem, problem: FitProblem) -> float:
     return fit.chi2
 
 
-def profile_items(fit: ModelFit, factor: float, steps: Sequence[float] = PROFILE_STEPS) -> list[ProfileItem]:
-    """Profile points of every parameter (kept inside its bounds); warm starts of the others shifted
-    along the covariance (the linear prediction of the profile)."""
-    cov = fit.cov(factor)
+def inside_bounds(value: float, parameter: Any) -> float:
+    """``value`` kept 1 % inside ``parameter``'s bounds (where a fit may start)."""
+    return min(max(value, parameter.bounds[0] * 1.01), parameter.bounds[1] / 1.01)
+
+
+def profile_point(fit: ModelFit, cov: np.ndarray, i: int, value: float) -> ProfileItem:
+    """The profile point of ``fit``'s parameter ``i`` held at ``value``: the warm start of the others shifted along
+    the covariance ``cov`` (the linear prediction of the profile), kept inside their bounds."""
     params = parameters_of(fit.model)
-    items = []
-    for i, p in enumerate(params):
-        s = math.sqrt(cov[i, i])
-        for step in steps:
-            value = min(max(fit.theta[i] + step * s, p.bounds[0] * 1.01), p.bounds[1] / 1.01)
-            shift = cov[:, i] / cov[i, i] * (value - fit.theta[i])
-            start = [min(max(v, q.bounds[0] * 1.01), q.bounds[1] / 1.01) for v, q in zip(fit.theta + shift, params)]
-            items.append(ProfileItem(fit.model, i, float(value), tuple(map(float, start))))
-    return items
+    shift = cov[:, i] / cov[i, i] * (value - fit.theta[i])
+    start = [inside_bounds(v, q) for v, q in zip(fit.theta + shift, params)]
+    return ProfileItem(fit.model, i, float(value), tuple(map(float, start)))
+
+
+def profile_items(fit: ModelFit, factor: float, steps: Sequence[float] = PROFILE_STEPS) -> list[ProfileItem]:
+    """Profile points of every parameter (kept inside its bounds) at ``steps`` standard errors from the optimum
+    (:func:`profile_point`)."""
+    cov = fit.cov(factor)
+    return [profile_point(fit, cov, i, inside_bounds(fit.theta[i] + step * math.sqrt(cov[i, i]), p))
+            for i, p in enumerate(parameters_of(fit.model)) for step in steps]
 
 
 def profile_summary(fit: ModelFit, factor: float, items: Sequence[ProfileItem], chi2s: Sequence[float]) -> dict:
