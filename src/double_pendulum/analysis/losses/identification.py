@@ -18,6 +18,7 @@ from ..track.measurement import Reconstruction, load_track, reconstruct
 from ..track.tilt import seed_record_geometry
 from . import claims as loss_claims
 from .air_profile import AIR_MODELS, EXTEND_STEPS, LEVEL, air_point, air_points, air_share_intervals
+from .ar1_refit import refit_models
 from .comparison import (
     air_share_at_defaults,
     common_factor,
@@ -59,9 +60,7 @@ def half_fits(problem: FitProblem, fits: Sequence[ModelFit], rows: Sequence[Mapp
     """The out-of-sample test's fits (:func:`.holdout.holdout_fits`): every converged model of ``fits`` (``rows``:
     their :func:`.comparison.comparison_rows`) fitted to each half, with the mode's run budget (quick: the quick
     one, else :data:`.fitting.SHORT_RUN_BUDGET`)."""
-    converged = {r["model"] for r in rows if r["converged"]}
-    ranked = [f for f in fits if f.model in converged]
-    return holdout_fits(problem, ranked, run_budget(quick) or SHORT_RUN_BUDGET, pool, max_workers)
+    return holdout_fits(problem, converged(fits, rows), run_budget(quick) or SHORT_RUN_BUDGET, pool, max_workers)
 
 
 def thorough_half_fits(rec: Reconstruction) -> tuple[FitProblem, list[HoldoutFit]]:
@@ -71,6 +70,12 @@ def thorough_half_fits(rec: Reconstruction) -> tuple[FitProblem, list[HoldoutFit
     problem = problem_from_track(rec, measured(rec))
     fits, _ = fit_models(THOROUGH_MODELS, problem, max_workers=1, short=False, max_runs=run_budget(False))
     return problem, half_fits(problem, fits, comparison_rows(fits, common_factor(problem)), False, max_workers=1)
+
+
+def converged(fits: Sequence[ModelFit], rows: Sequence[Mapping[str, Any]]) -> list[ModelFit]:
+    """The fits of the comparison ``rows``' converged models (those the criteria rank)."""
+    ok = {r["model"] for r in rows if r["converged"]}
+    return [f for f in fits if f.model in ok]
 
 
 def measured_loss(md: MeasuredDecay) -> float:
@@ -217,10 +222,11 @@ def untilted_identification(rec: Reconstruction, pool: Any = None, max_workers: 
     fits, _ = fit_models(FULL_MODELS, problem, max_workers, pool, max_runs=run_budget(False))
     factor = common_factor(problem)
     rows = comparison_rows(fits, factor)
-    noise = noise_model_summary(rows, {f.model: f.residuals for f in fits}, problem.sigma, factor)
+    noise = noise_model_summary(rows, {f.model: f.residuals for f in fits}, problem.sigma, factor,
+                                refit_models(converged(fits, rows), problem, pool, max_workers))
     return {"tilt_deg": math.degrees(rec.geometry.tilt), "correlation_factor_F": factor,
             "supported_models": loss_claims.supported_models(rows), "ties": noise["ties"],
-            "air_share_range": noise["air_share_range"],
+            "air_share_range": noise["air_share_range"], "noise_model": noise,
             "models": {r["model"]: {"delta_aic": r["delta_aic"], "delta_bic": r["delta_bic"], "shares": r["shares"],
                                     "converged": r["converged"]} for r in rows},
             "air_share_profile": air_share_profile(problem, fits, rows, factor, pool, max_workers)}  # fmt: skip
@@ -254,8 +260,10 @@ def identify_losses(
     unidentified); the fits are cached (:func:`fit_loss_model`), and ``measured_vs_sim`` obtains its
     ``air+drag`` by :func:`identified_fit` from the same problem (:func:`problem_from_track` in the same
     mode: the same start, budget and settings), so it reads this mode's fit. The AR(1) criteria
-    (:func:`.noise.noise_model_summary`) need no runs; the out-of-sample test (:mod:`.holdout`: every converged
-    model fitted to each half, 12 runs a fit, quick: the quick budget) runs in the thorough and the quick mode only."""
+    (:func:`.noise.noise_model_summary`) come from every converged model re-fitted under the AR(1) likelihood
+    (:func:`.ar1_refit.refit_models`, default and thorough mode; quick: at the least-squares optimum); the
+    out-of-sample test (:mod:`.holdout`: every converged model fitted to each half, 12 runs a fit, quick: the
+    quick budget) runs in the thorough and the quick mode only."""
     from ..sweep import parallel_map, worker_pool  # noqa: PLC0415 - process pools only when identifying
 
     seed = record is None
@@ -270,7 +278,8 @@ def identify_losses(
         factor = common_factor(problem)
         rows = comparison_rows(fits, factor)
         best = next(f for f in fits if f.model == rows[0]["model"])
-        noise = noise_model_summary(rows, {f.model: f.residuals for f in fits}, problem.sigma, factor)
+        refits = None if quick else refit_models(converged(fits, rows), problem, pool, max_workers)
+        noise = noise_model_summary(rows, {f.model: f.residuals for f in fits}, problem.sigma, factor, refits)
         for r in rows:
             r["ar1"] = {k: noise["criteria"][r["model"]][k] for k in ("rho", "aic", "bic", "delta_aic", "delta_bic")
                         } if r["model"] in noise["criteria"] else None  # fmt: skip

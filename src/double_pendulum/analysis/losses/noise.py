@@ -31,10 +31,11 @@ With k the fitted numbers of the model (its loss parameters and kappa) plus the 
 size). For a slow misfit, whitening at one rho divides a chi2 difference by about :math:`(1+\rho)/(1-\rho)`, the AR(1)
 counterpart of F (:func:`ar1_factor`).
 
-The likelihood is evaluated at the least-squares optimum of each fit (the fits minimise chi2, not :math:`Q`): a
-lower bound on the AR(1) likelihood's maximum, the same approximation for every model. Whether AR(1) describes
-the residuals is checked by the autocorrelation of the innovations :math:`e_i` (:func:`innovation_autocorrelation`:
-near 0 at every lag if it does).
+Evaluated at the least-squares optimum of each fit (the fits minimise chi2, not :math:`Q`), the likelihood is a
+lower bound on its maximum; :mod:`.ar1_refit` fits every model again under it, and :func:`noise_model_summary`
+takes the criteria from those re-fits where it is given them (the default and thorough identifications), with the
+least-squares optimum's beside them. Whether AR(1) describes the residuals is checked by the autocorrelation of the
+innovations :math:`e_i` (:func:`innovation_autocorrelation`: near 0 at every lag if it does).
 """
 
 from __future__ import annotations
@@ -140,24 +141,36 @@ AIR_LABEL = "air drag"
 """The air-drag entry of a comparison row's ``shares``."""
 
 
-def air_range(rows: Sequence[Mapping[str, Any]], models: Sequence[str]) -> list[float] | None:
+def air_range(rows: Sequence[Mapping[str, Any]], models: Sequence[str],
+              shares_by_model: Mapping[str, Mapping[str, float]] | None = None) -> list[float] | None:
     """The smallest and largest air-drag share [1] among ``models`` (0 for one without air drag); None if none
-    of them has air drag."""
-    shares = [next(r["shares"] for r in rows if r["model"] == m) for m in models]
+    of them has air drag. The shares are the rows' (the least-squares fits'), or ``shares_by_model``'s where given
+    (the AR(1) re-fits')."""
+    shares = [shares_by_model[m] if shares_by_model and m in shares_by_model
+              else next(r["shares"] for r in rows if r["model"] == m) for m in models]
     air = [s.get(AIR_LABEL, 0.0) for s in shares]
     return [min(air), max(air)] if any(AIR_LABEL in s for s in shares) else None
 
 
 def noise_model_summary(rows: Sequence[Mapping[str, Any]], residuals: Mapping[str, np.ndarray],
-                        sigma: np.ndarray, factor: float) -> dict[str, Any]:
+                        sigma: np.ndarray, factor: float, refits: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The AR(1) criteria (:func:`ar1_criteria`) of every converged model of the comparison ``rows`` (their
     normalised residuals ``residuals`` by model, the frames' errors ``sigma`` [J]) and which models tie (within 2)
     under each of the four criteria, AIC and BIC with the common factor F = ``factor`` and with the AR(1)
     likelihood, each with its range of the air-drag share; models that reduce to a nested one are no candidates
-    (:func:`.comparison.reduces_to`)."""
+    (:func:`.comparison.reduces_to`). ``refits`` (:class:`.ar1_refit.Ar1Refit` by model): the AR(1) criteria and
+    their air shares are the re-fits' (``refitted``), each model's ``least_squares`` entry the criteria at its
+    least-squares optimum, ``refit`` its re-fit; without them the criteria are the least-squares optimum's."""
     ranked = [r for r in rows if r["converged"]]
-    crit = ar1_criteria({r["model"]: residuals[r["model"]] for r in ranked}, {r["model"]: r["k"] for r in ranked},
-                        sigma)  # fmt: skip
+    ks = {r["model"]: r["k"] for r in ranked}
+    refitted = refits is not None and all(r["model"] in refits for r in ranked)
+    at_lsq = ar1_criteria({r["model"]: residuals[r["model"]] for r in ranked}, ks, sigma)
+    crit = (ar1_criteria({m: refits[m].residuals for m in ks}, ks, sigma) if refitted else at_lsq)  # fmt: skip
+    if refitted:
+        for m, c in crit.items():
+            c["least_squares"] = {k: at_lsq[m][k] for k in ("rho", "neg2_log_likelihood", "delta_aic", "delta_bic")}
+            c["refit"] = refits[m].as_dict()
+    refit_shares = {m: refits[m].shares for m in ks} if refitted else None
     eligible = [r["model"] for r in ranked if not r.get("reduces_to")]
     by_f = {r["model"]: r for r in ranked}
     tied = {"aic_F": ties(by_f, "delta_aic", eligible=eligible), "bic_F": ties(by_f, "delta_bic", eligible=eligible),
@@ -166,9 +179,14 @@ def noise_model_summary(rows: Sequence[Mapping[str, Any]], residuals: Mapping[st
     best = min(crit, key=lambda m: crit[m]["aic"])
     rhos = [c["rho"] for c in crit.values()]
     out = {"model": "AR(1) residuals, rho and s^2 fitted to each model's normalised residuals",
-           "criteria": crit, "rho_range": [min(rhos), max(rhos)], "rho_of_lowest_aic": crit[best]["rho"],
-           "equivalent_factor": ar1_factor(crit[best]["rho"]), "common_factor_F": factor, "ties": tied,
-           "air_share_range": {k: air_range(rows, v) for k, v in tied.items()}}  # fmt: skip
+           "refitted": refitted, "criteria": crit, "rho_range": [min(rhos), max(rhos)],
+           "rho_of_lowest_aic": crit[best]["rho"], "equivalent_factor": ar1_factor(crit[best]["rho"]),
+           "common_factor_F": factor, "ties": tied,
+           "air_share_range": {k: air_range(rows, v, refit_shares if k.endswith("ar1") else None)
+                               for k, v in tied.items()}}  # fmt: skip
+    if refitted:
+        out["ties_at_least_squares"] = {k: ties(at_lsq, f"delta_{k[:3]}", eligible=eligible)
+                                        for k in ("aic_ar1", "bic_ar1")}  # fmt: skip
     out["text"] = noise_text(out)
     return out
 
@@ -183,15 +201,32 @@ def noise_text(s: Mapping[str, Any]) -> str:
     def one(key: str) -> str:
         models = s["ties"][key]
         air = s["air_share_range"][key]
-        share = "no air drag" if air is None else f"air drag's share {air[0]:.0%} to {air[1]:.0%}"
+        share = ("no air drag" if air is None else f"air drag's share {air[0]:.0%}"
+                 if f"{air[0]:.0%}" == f"{air[1]:.0%}" else f"air drag's share {air[0]:.0%} to {air[1]:.0%}")
         return f"{CRITERIA_WORDS[key]}: {len(models)} ({', '.join(models)}; {share})"
 
     lo, hi = s["rho_range"]
     agree = len({tuple(sorted(v)) for v in s["ties"].values()}) == 1
-    return (f"Fitted as AR(1), the residuals of the models have lag-1 correlation rho {lo:.2f} to {hi:.2f} (the lowest "
+    return (refit_text(s) + f"Fitted as AR(1), the residuals of the models have lag-1 correlation rho {lo:.2f} to "
+            f"{hi:.2f} (the lowest "
             f"AIC's: {s['rho_of_lowest_aic']:.2f}, a variance factor (1+rho)/(1-rho) = {s['equivalent_factor']:.2f} "
             f"against F = {s['common_factor_F']:.2f} from the lag window). Models within 2 of the lowest: "
             + "; ".join(one(k) for k in CRITERIA_WORDS) + ". "
             + ("All four criteria give the same tie." if agree else
                "The criteria disagree, so which models tie, and the air share, depend on the criterion: the "
                "range over all of them is what the record supports."))
+
+
+def refit_text(s: Mapping[str, Any]) -> str:
+    """What re-fitting every model under the AR(1) likelihood changed: its gain in -2 ln L and the ties."""
+    if not s.get("refitted"):
+        return ("The AR(1) likelihood is evaluated at each model's least-squares optimum (a lower bound on its "
+                "maximum; no model was re-fitted under it). ")
+    gains = [c["refit"]["gain_neg2_log_likelihood"] for c in s["criteria"].values()]
+    changed = [k for k in ("aic_ar1", "bic_ar1") if sorted(s["ties"][k]) != sorted(s["ties_at_least_squares"][k])]
+    return (f"Every model is re-fitted under the AR(1) likelihood, which raises it over the least-squares optimum's "
+            f"(-2 ln L lower by {min(gains):.2f} to {max(gains):.2f}); "
+            + ("the models within 2 are the same as at the least-squares optimum under both AR(1) criteria. "
+               if not changed else "the re-fit changes which models tie under "
+               + " and ".join(f"{CRITERIA_WORDS[k]} (at the least-squares optimum: "
+                              f"{', '.join(s['ties_at_least_squares'][k])})" for k in changed) + ". "))

@@ -183,20 +183,25 @@ def noise_section(s: LossesSummary) -> str:
     nm = s.get("noise_model")
     if not nm:
         return ""
-    lines = ["| model | dAIC (F) | dBIC (F) | rho | dAIC (AR(1)) | dBIC (AR(1)) | innovations' autocorrelation, "
-             "lags 1-3 |", "|---|---|---|---|---|---|---|"]
+    refitted = bool(nm.get("refitted"))
+    gain = " re-fit's gain in -2 ln L |" if refitted else ""
+    lines = [f"| model | dAIC (F) | dBIC (F) | rho | dAIC (AR(1)) | dBIC (AR(1)) |{gain} innovations' "
+             "autocorrelation, lags 1-3 |", "|---|---|---|---|---|---|" + ("---|" if refitted else "") + "---|"]
     for r in s["models"]:
         c = nm["criteria"].get(r["model"])
         if c is None:
             continue
         acf = ", ".join(f"{v:+.2f}" for v in c["innovation_autocorrelation"])
+        g = f" {c['refit']['gain_neg2_log_likelihood']:.2f} |" if refitted else ""
         lines.append(f"| {model_title(r['model'])} | {r['delta_aic']:.1f} | {r['delta_bic']:.1f} | {c['rho']:.2f} "
-                     f"| {c['delta_aic']:.1f} | {c['delta_bic']:.1f} | {acf} |")
+                     f"| {c['delta_aic']:.1f} | {c['delta_bic']:.1f} |{g} {acf} |")
     n = next(iter(nm["criteria"].values()))["n_eff"]
+    where = ("maximised by fitting every model again under it (its loss parameters, kappa and rho together)"
+             if refitted else "evaluated at each least-squares optimum")
     return f"""## The noise model: AR(1) residuals, AIC and BIC from its likelihood
 
 The fits' residuals are modelled as an AR(1) process, r_i = rho r_(i-1) + e_i, with rho and the variance fitted to
-each model's residuals; its exact Gaussian likelihood, evaluated at each least-squares optimum, gives AIC =
+each model's residuals; its exact Gaussian likelihood, {where}, gives AIC =
 -2 ln L + 2 k and BIC = -2 ln L + k ln n_eff (n_eff = n (1 - rho)/(1 + rho) = {n:.0f} frames; k counts the loss
 parameters, kappa, rho and the variance). Beside them the criteria with the common factor F. All four are in-sample.
 
