@@ -55,9 +55,9 @@ record the rods are not drawn (their file states no uncertainty for them).
 Cost: about 29 s of CPU by default once ``loss_identification`` has cached its fits (about 130 s on a first
 run that fits every model itself, plus about 6 s for the damping runs until they are cached). ``thorough`` adds
 the loss ensemble (60 runs, about 40 s, cached), the fit-window check (:data:`WINDOW_SENSITIVITY`, about 35 s),
-the out-of-sample test of the motion (each supported model fitted to one half of the energy record predicts the
-other half's motion, :mod:`double_pendulum.analysis.prediction.out_of_sample`: ten runs, with the half fits read
-from ``loss_identification --thorough``'s cache) and a :data:`THOROUGH_LYAPUNOV_S` s Lyapunov exponent.
+the out-of-sample test of the motion (each model AIC or BIC keeps within 2, fitted to one half of the energy
+record, predicts the other half's motion, :mod:`double_pendulum.analysis.prediction.out_of_sample`, with the half
+fits read from ``loss_identification --thorough``'s cache) and a :data:`THOROUGH_LYAPUNOV_S` s Lyapunov exponent.
 ``quick``: a 3 s prediction, the geometry fitted to :data:`QUICK_GEOMETRY_FIT_FRAMES` frames.
 
 With a user's own record (``double-pendulum run measured_vs_sim --track FILE.csv --pendulum FILE.toml``,
@@ -290,11 +290,15 @@ def run(runner: FmuRunner, out_dir: Path, *, quick: bool = False, thorough: bool
     if thorough:
         summary["fit_window_sensitivity"] = window_sensitivity(runner, rec, i0, values, n_frames,
                                                                [frames_at(f, dt) for f in WINDOW_SENSITIVITY], warm=geo)
-        summary["out_of_sample_motion"], curves = motion_test(runner, rec, i0, n_frames, losses.pendulum, geo, by_model,
-                                                              summary["track_rod_length_floor"]["rms_m"])
+        # the motion test's models: those AIC or BIC keeps (AIC alone may keep one, and a test of one compares none)
+        more = {m: v for m, v in supported_loss_values(supported_loss_fits(rec, bic_too=True)).items()
+                if m not in by_model}  # fmt: skip
+        contenders = {**by_model, **loss_model_predictions(runner, rec, i0, n_frames, losses.pendulum, geo, more)}
+        summary["out_of_sample_motion"], curves = motion_test(runner, rec, i0, n_frames, losses.pendulum, geo,
+                                                              contenders, summary["track_rod_length_floor"]["rms_m"])
         plots.plot_out_of_sample_motion(curves, summary["out_of_sample_motion"]["split_after_t0_s"], THRESHOLDS_M[-1],
                                         SMOOTHING_S, out_dir / "out_of_sample_motion.png", titles=model_title,
-                                        whole=smoothed_error_band(by_model))  # fmt: skip
+                                        whole=smoothed_error_band(contenders))  # fmt: skip
     for p in predictions:
         write_results_csv(out_dir / f"{p.label}.csv", p.result, runner.units)
     write_results_csv(out_dir / "errors.csv", errors_table(rec, i0, n_frames, predictions), errors_units(predictions))

@@ -36,15 +36,21 @@ THRESHOLD_M = 0.05
 """The error [m] whose first crossing is compared across the loss models."""
 
 
-def supported_loss_fits(rec: Reconstruction, *, quick: bool = False) -> dict[str, tuple[fitting.ModelFit, float]]:
-    """The fit of every model within delta AIC 2 of the lowest and the record's correlation factor F (its
-    covariance is ``fit.cov(F)``), by model name, fitted to the whole record of ``rec`` as ``loss_identification``
-    fits them in that mode (quick: its one model)."""
+def supported_loss_fits(rec: Reconstruction, *, quick: bool = False,
+                        bic_too: bool = False) -> dict[str, tuple[fitting.ModelFit, float]]:  # fmt: skip
+    """The fit of every model within delta AIC 2 of the lowest (``bic_too``: or within delta BIC 2 of the lowest
+    BIC, the models some criterion keeps) and the record's correlation factor F (its covariance is
+    ``fit.cov(F)``), by model name, fitted to the whole record of ``rec`` as ``loss_identification`` fits them in
+    that mode (quick: its one model)."""
     problem = fitting.problem_from_track(rec, identification.measured(rec), quick=quick)
     models = mechanisms.QUICK_MODELS if quick else mechanisms.FULL_MODELS
     fits, _ = fitting.fit_models(models, problem, max_workers=1, max_runs=fitting.run_budget(quick))
     factor = comparison.common_factor(problem)
-    supported = claims.supported_models(comparison.comparison_rows(fits, factor))["models"]
+    rows = comparison.comparison_rows(fits, factor)
+    supported = set(claims.supported_models(rows)["models"])
+    if bic_too:
+        supported |= {r["model"] for r in rows if r["converged"] and not r.get("reduces_to")
+                      and r["delta_bic"] < claims.SUPPORTED_DAIC}  # fmt: skip
     return {f.model: (f, factor) for f in fits if f.model in supported}
 
 

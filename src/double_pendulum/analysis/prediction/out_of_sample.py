@@ -4,9 +4,10 @@ lower bob's path through the FMU.
 :mod:`..losses.holdout` fits every loss model to one half of the measured energy and predicts the other half's
 energy. This module takes the same half fits (:func:`~..losses.identification.thorough_half_fits`, read from the
 cache after ``loss_identification --thorough``) and runs the main start of ``measured_vs_sim`` (the least-squares
-start and camera geometry at t0) through the FMU with each supported model's losses fitted to one half. The split
-is the energy record's (its middle frame), :math:`t_s` after t0. Per model and half fitted to, on the frames of
-the other half (the held-out frames, which the loss fit never saw):
+start and camera geometry at t0) through the FMU with the losses, fitted to one half, of each model that AIC or
+BIC keeps within 2 of its lowest (AIC alone may keep one). The split is the energy record's (its middle frame),
+:math:`t_s` after t0. Per model and half fitted to, on the frames of the other half (the held-out frames, which
+the loss fit never saw):
 
 * the RMS of the lower bob's per-frame position error :math:`e_2 = |r_2^{sim} - r_2^{track}|` [m];
 * the median of the smoothed error (:func:`~.comparison.smoothed`) [m];
