@@ -30,9 +30,12 @@ class Identifiability(TypedDict):
 
 
 class NoiseModel(TypedDict):
-    """The loss fits under AR(1) residuals (:mod:`.noise`): criteria by model, the ties, the air share's range."""
+    """The loss fits under AR(1) residuals (:mod:`.noise`): criteria by model (from the AR(1) re-fits where
+    ``refitted``, :mod:`.ar1_refit`), the ties (and the ties at the least-squares optimum beside them), the air
+    share's range."""
 
     model: str
+    refitted: bool
     criteria: dict[str, dict[str, Any]]
     rho_range: list[float]
     rho_of_lowest_aic: float
@@ -40,6 +43,7 @@ class NoiseModel(TypedDict):
     common_factor_F: float
     ties: dict[str, list[str]]
     air_share_range: dict[str, Any]
+    ties_at_least_squares: NotRequired[dict[str, list[str]]]
     text: str
 
 
