@@ -7,9 +7,9 @@ r"""The AR(1) noise model every analysis of the record shares: residuals :math:`
   :math:`(J^T J)^{-1} J^T \Sigma J (J^T J)^{-1}`, :math:`\Sigma_{ij} = \hat v\,\rho^{|i-j|}`,
   :math:`\hat v = |r|^2/(n-k)`.
 
-It sits below the studies that use it (:mod:`.track.tilt` for the camera's tilt, :mod:`.decay.noise` for the decay
-rate), so each reads the same one. Residuals and Jacobians are normalised by the per-frame errors where there are
-any; rho is dimensionless.
+It sits below the studies that use it (:mod:`.track.tilt` for the camera's tilt, :mod:`.track.rods` and
+:mod:`.track.energy_noise` for the rods' mass, :mod:`.decay.noise` for the decay rate), so each reads the same one.
+Residuals and Jacobians are normalised by the per-frame errors where there are any; rho is dimensionless.
 """
 
 from __future__ import annotations
@@ -36,11 +36,13 @@ def ar1_correlation_times(x: np.ndarray, rho: float) -> np.ndarray:
     return f + g - x
 
 
-def ar1_sandwich(jac: np.ndarray, resid: np.ndarray, rho: float) -> np.ndarray:
+def ar1_sandwich(jac: np.ndarray, resid: np.ndarray, rho: float, hessian: np.ndarray | None = None) -> np.ndarray:
     r"""Covariance of a least-squares estimate with (normalised) Jacobian ``jac`` (n, k) and residuals ``resid``
     (n) under AR(1) residuals of coefficient ``rho``: :math:`(J^TJ)^{-1} J^T \Sigma J (J^TJ)^{-1}`,
-    :math:`\Sigma_{ij} = v\rho^{|i-j|}`, :math:`v = |r|^2/(n-k)`."""
+    :math:`\Sigma_{ij} = v\rho^{|i-j|}`, :math:`v = |r|^2/(n-k)`. ``hessian``: half the Hessian of the
+    objective in place of :math:`J^TJ` in the bread (an objective that is not a plain sum of squares, such as
+    the corrected least squares of :mod:`.track.rods`)."""
     n, k = jac.shape
     v = float(resid @ resid) / (n - k)
-    bread = np.linalg.inv(jac.T @ jac)
+    bread = np.linalg.inv(jac.T @ jac if hessian is None else hessian)
     return v * bread @ (jac.T @ ar1_correlation_times(jac, rho)) @ bread

@@ -44,6 +44,7 @@ from ...data import data_path
 from ...model.energy import kinetic_energy, potential_energy, total_energy
 from ...model.kinematics import velocities
 from ...model.parameters import PendulumParameters
+from ..ar1 import ar1_coefficient, ar1_sandwich
 
 FPS = 29.97
 """Frame rate of the seed's video [1/s]."""
@@ -300,12 +301,16 @@ def fit_circle(x: np.ndarray, y: np.ndarray) -> CircleFit:
     return CircleFit(float(xc), float(yc), abs(float(radius)), float(sxc), float(syc), float(sr), rms)
 
 
-def circle_covariance(x: np.ndarray, y: np.ndarray, fit: CircleFit) -> np.ndarray:
+def circle_covariance(x: np.ndarray, y: np.ndarray, fit: CircleFit, *, ar1: bool = False) -> np.ndarray:
     """Covariance of (xc, yc, radius) [m^2] of :func:`fit_circle`'s result ``fit`` through (x, y) [m]:
-    s^2 (J^T J)^-1 at the optimum (independent residuals of equal variance, as its standard errors)."""
+    s^2 (J^T J)^-1 at the optimum (independent residuals of equal variance, as its standard errors); ``ar1``: the
+    sandwich under AR(1) residuals of their own lag-one correlation, the points in the order of the frames
+    (:func:`~double_pendulum.analysis.ar1.ar1_sandwich`)."""
     p = np.array([fit.xc, fit.yc, fit.radius])
     jac = _circle_jacobian(p, np.asarray(x, dtype=float), np.asarray(y, dtype=float))
     resid = _circle_residuals(p, np.asarray(x, dtype=float), np.asarray(y, dtype=float))
+    if ar1:
+        return ar1_sandwich(jac, resid, ar1_coefficient(resid))
     return float(resid @ resid) / (len(resid) - 3) * np.linalg.inv(jac.T @ jac)
 
 
