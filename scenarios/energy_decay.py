@@ -63,6 +63,7 @@ from double_pendulum.analysis.decay.summary import (
     weighting_variants,
 )
 from double_pendulum.analysis.track.measurement import SEED_TOTAL_MASS_KG, Reconstruction, load_track, reconstruct
+from double_pendulum.analysis.track.rods import seed_rods_summary
 from double_pendulum.analysis.track.tilt import seed_record_geometry
 from double_pendulum.analysis.track.user_track import UserRecord
 from double_pendulum.runs.results_io import write_json, write_results_csv, write_text
@@ -134,7 +135,8 @@ def run(runner: Any, out_dir: Path, *, quick: bool = False, record: UserRecord |
                        "interval_95": "tilt/*/exponent: that end of p's profile interval lies beyond 0 < p < 3",
                        "stop_time_s": "tilt/*/exponent: p >= 1, the decay law never reaches E = 0"},
         "error_budget": error_budget(rec, errors.sigma, seed=seed),
-        "tilt": tilt_effect(geometry, rec, untilted),
+        "tilt": {**tilt_effect(geometry, rec, untilted),
+                 **({"rods_from_energy": seed_rods_summary()} if seed else {})},
     }
     write_results_csv(out_dir / "track.csv", track_table(rec, on_all_frames(errors.sigma, m)), TRACK_CSV_UNITS)
     _plots(rec, m, errors.sigma, fits, out_dir, seed)

@@ -7,6 +7,7 @@ Each case runs in a child process of its own (a fresh interpreter: the FMU start
 from __future__ import annotations
 
 import json
+import os
 import random
 import re
 import signal
@@ -78,12 +79,23 @@ INTERRUPTED = SLAVE + textwrap.dedent("""
 
 
 def interrupted_trial(folder: Path, guid: str, mode: str, delay: float, tmp_path: Path) -> tuple[str, str]:
+    """One child interrupted after ``delay`` [s]. A child still running 60 s later is stopped with SIGABRT, on which
+    its faulthandler (PYTHONFAULTHANDLER) prints every thread's Python stack, and the failure shows where it hung
+    (once, on 2026-12-08, a step-mode child printed nothing within 60 s under a load of 4 on 2 cores; 290 trials
+    under load after it did not hang)."""
     child = subprocess.Popen([sys.executable, "-c", INTERRUPTED, str(folder), guid, mode], stdout=subprocess.PIPE,
-                             stderr=subprocess.PIPE, text=True, cwd=tmp_path)
+                             stderr=subprocess.PIPE, text=True, cwd=tmp_path,
+                             env={**os.environ, "PYTHONFAULTHANDLER": "1"})  # fmt: skip
     assert child.stdout.readline().strip() == "ready"
     time.sleep(delay)
     child.send_signal(signal.SIGINT)
-    out, err = child.communicate(timeout=60)
+    try:
+        out, err = child.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        child.send_signal(signal.SIGABRT)
+        out, err = child.communicate(timeout=60)
+        raise AssertionError(f"{mode} child hung 60 s after SIGINT at {delay:.2f} s; its stacks:\n{out}\n"
+                             f"{err[-6000:]}") from None
     assert child.returncode == 0, (mode, delay, out, err[-3000:])
     return out, err
 

@@ -275,3 +275,38 @@ def seed_record_rods() -> RecordRods:
     """The seed's record: its tilt and each rod member's mass with their covariance, the seed's bobs, its plates'
     lengths (:data:`~double_pendulum.model.parameters.SEED_RIGID_LINKS`; members started at 70 g)."""
     return record_tilt_and_rods(load_track(), rods=SEED_RIGID_LINKS)
+
+
+NOISE_SCALES = (0.8, 1.2)
+"""Factors on the position noise's standard deviations of :func:`noise_sensitivity`."""
+NOISE_RHOS = (0.0, 0.3, 0.7)
+"""Lag-one coefficients of :func:`noise_sensitivity`'s position noise (0: white)."""
+
+
+def noise_sensitivity(track: Track, rods_fit: RecordRods, **pendulum: Any) -> dict[str, Any]:
+    """What the noise model, taken as right by the stated error, carries into the member's mass: the fit of
+    ``rods_fit`` again with the position noise's standard deviations times :data:`NOISE_SCALES` and with its rho at
+    :data:`NOISE_RHOS` (masses in g), the range over them, and the member's mass fitted to each half of the record
+    (the frames before and after the middle one) with its fit's own error [g]; ``pendulum``: the bobs, plates and g
+    as :func:`~.measurement.reconstruct` takes them."""
+    rec = reconstruct(track, rods_fit.geometry, **pendulum)
+    noise = rods_fit.fit.noise
+    cases = {f"sd x{s:g}": dataclasses.replace(noise, sigma1=s * noise.sigma1, sigma2=s * noise.sigma2)
+             for s in NOISE_SCALES}  # fmt: skip
+    cases.update({f"rho {r:g}": dataclasses.replace(noise, rho=r) for r in NOISE_RHOS})
+    masses = {name: 1e3 * fit_tilt_and_rods(rec, noise=n).member_kg for name, n in cases.items()}
+    frames = np.flatnonzero(rec.free_motion)
+    halves = {}
+    for name, part in zip(("first", "second"), np.array_split(frames, 2)):
+        f = fit_tilt_and_rods(rec, part, noise=noise)
+        halves[name] = {"rod_member_g": 1e3 * f.member_kg, "rod_member_stderr_g": 1e3 * math.sqrt(f.cov[1, 1])}
+    return {"rod_member_g": masses, "range_g": [min(masses.values()), max(masses.values())],
+            "noise": {"sigma1_mm": 1e3 * noise.sigma1, "sigma2_mm": 1e3 * noise.sigma2, "rho": noise.rho},
+            "halves": halves}  # fmt: skip
+
+
+def seed_rods_summary() -> dict[str, Any]:
+    """The seed's record's tilt and rod members' mass (:func:`seed_record_rods`) with what the noise model carries
+    into the mass (:func:`noise_sensitivity`), JSON-ready."""
+    r = seed_record_rods()
+    return {**r.as_dict(), "noise_sensitivity": noise_sensitivity(load_track(), r, rods=SEED_RIGID_LINKS)}
