@@ -6,7 +6,9 @@ import contextlib
 import json
 import os
 import shutil
+import signal
 import tempfile
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -161,6 +163,30 @@ def cross_check_tree(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, in
     folder = session_shared(tmp_path_factory, "cross_check", run)
     command = json.loads((folder / "command.json").read_text())
     return folder / "tree", command["code"], command["out"]
+
+
+@pytest.fixture(autouse=True)
+def sigint_handler_kept(request: pytest.FixtureRequest) -> Iterator[None]:
+    """No test leaves this process another Ctrl-C handler than it found: one that does is named in a warning and the
+    handler put back. An ignored SIGINT is inherited through fork and exec, and Python started with it ignored keeps
+    it so: every later test's child would then never see a Ctrl-C. Twice, on 2026-12-08, in full runs on 2 workers,
+    the Ctrl-C tests' children ignored SIGINT (test_host_hygiene's step loop ran on; test_interrupts_unit's embedded
+    run got its caller's handler back, and that handler was SIG_IGN), while 290 trials of the same child started
+    from a clean process never did."""
+    def keep(when: str) -> None:
+        now = signal.getsignal(signal.SIGINT)
+        if now is not SESSION_SIGINT:
+            signal.signal(signal.SIGINT, SESSION_SIGINT)
+            warnings.warn(f"SIGINT's handler was {now!r} {when} {request.node.nodeid}, not the session's "
+                          f"{SESSION_SIGINT!r}: put back", stacklevel=1)  # fmt: skip
+
+    keep("before")  # a session fixture's doing, or a test's whose own teardown ran after this check
+    yield
+    keep("after")
+
+
+SESSION_SIGINT = signal.getsignal(signal.SIGINT)
+"""The Ctrl-C handler this test process began with (Python's own)."""
 
 
 @pytest.fixture(scope="session", autouse=True)
