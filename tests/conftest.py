@@ -167,26 +167,41 @@ def cross_check_tree(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, in
 
 @pytest.fixture(autouse=True)
 def sigint_handler_kept(request: pytest.FixtureRequest) -> Iterator[None]:
-    """No test leaves this process another Ctrl-C handler than it found: one that does is named in a warning and the
-    handler put back. An ignored SIGINT is inherited through fork and exec, and Python started with it ignored keeps
-    it so: every later test's child would then never see a Ctrl-C. Twice, on 2026-12-08, in full runs on 2 workers,
-    the Ctrl-C tests' children ignored SIGINT (test_host_hygiene's step loop ran on; test_interrupts_unit's embedded
-    run got its caller's handler back, and that handler was SIG_IGN), while 290 trials of the same child started
-    from a clean process never did."""
+    """No test leaves this process another Ctrl-C handler than it found, in Python's table or in the kernel's: one
+    that does is named in a warning and the session's handler put back. An ignored SIGINT is inherited through fork
+    and exec, and Python started with it ignored keeps it so: every later test's child would then never see a
+    Ctrl-C. On 2026-12-08, in three full runs on 2 workers, the Ctrl-C tests' children ignored SIGINT
+    (test_host_hygiene's step loop ran on, its faulthandler dump showed it stepping; test_interrupts_unit's embedded
+    run got SIG_IGN back as its caller's handler; test_app's server did not end on SIGINT) while Python's own table
+    in their worker still said ``default_int_handler``, and 290 trials of the same child from a clean process never
+    hung: something in the worker had set the kernel's disposition behind Python's back."""
     def keep(when: str) -> None:
-        now = signal.getsignal(signal.SIGINT)
-        if now is not SESSION_SIGINT:
-            signal.signal(signal.SIGINT, SESSION_SIGINT)
-            warnings.warn(f"SIGINT's handler was {now!r} {when} {request.node.nodeid}, not the session's "
-                          f"{SESSION_SIGINT!r}: put back", stacklevel=1)  # fmt: skip
+        now, ignored = signal.getsignal(signal.SIGINT), kernel_ignores_sigint()
+        if now is not SESSION_SIGINT or ignored != SESSION_SIGINT_IGNORED:
+            signal.signal(signal.SIGINT, SESSION_SIGINT)  # sets the kernel's disposition to match Python's again
+            warnings.warn(f"SIGINT's handler was {now!r} (kernel: {'ignored' if ignored else 'not ignored'}) {when} "
+                          f"{request.node.nodeid}, not the session's {SESSION_SIGINT!r}: put back", stacklevel=1)
 
     keep("before")  # a session fixture's doing, or a test's whose own teardown ran after this check
     yield
     keep("after")
 
 
+def kernel_ignores_sigint() -> bool:
+    """Whether the kernel's disposition of SIGINT for this process is SIG_IGN (Linux: ``SigIgn`` of
+    /proc/self/status; elsewhere Python's table, which is all there is to read)."""
+    try:
+        with open("/proc/self/status") as f:
+            mask = next(int(line.split()[1], 16) for line in f if line.startswith("SigIgn:"))
+    except (OSError, StopIteration, ValueError):
+        return signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    return bool(mask >> (signal.SIGINT - 1) & 1)
+
+
 SESSION_SIGINT = signal.getsignal(signal.SIGINT)
 """The Ctrl-C handler this test process began with (Python's own)."""
+SESSION_SIGINT_IGNORED = kernel_ignores_sigint()
+"""Whether the kernel ignored SIGINT for this test process when it began (no)."""
 
 
 @pytest.fixture(scope="session", autouse=True)

@@ -49,7 +49,8 @@ SLAVE = textwrap.dedent("""
 # ------------------------------------------------------------------------------------------------- Ctrl-C
 
 INTERRUPTED = SLAVE + textwrap.dedent("""
-    import sys
+    import signal, sys
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # a Python host's Ctrl-C, whatever this child inherited
     folder, guid, mode = sys.argv[1], sys.argv[2], sys.argv[3]
     fmu, refs = slave(folder, guid)
     fmu.instantiate()

@@ -59,6 +59,8 @@ ENDING = """
 import os, signal, sys, time
 from double_pendulum.runs import interrupts
 
+signal.signal(signal.SIGINT, signal.default_int_handler)  # the caller's handler: Python's, whatever was inherited
+
 if sys.argv[1] == "process":
     interrupts.ends_the_process()
 try:
