@@ -167,14 +167,12 @@ def cross_check_tree(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, in
 
 @pytest.fixture(autouse=True)
 def sigint_handler_kept(request: pytest.FixtureRequest) -> Iterator[None]:
-    """No test leaves this process another Ctrl-C handler than it found, in Python's table or in the kernel's: one
-    that does is named in a warning and the session's handler put back. An ignored SIGINT is inherited through fork
-    and exec, and Python started with it ignored keeps it so: every later test's child would then never see a
-    Ctrl-C. On 2026-12-08, in three full runs on 2 workers, the Ctrl-C tests' children ignored SIGINT
-    (test_host_hygiene's step loop ran on, its faulthandler dump showed it stepping; test_interrupts_unit's embedded
-    run got SIG_IGN back as its caller's handler; test_app's server did not end on SIGINT) while Python's own table
-    in their worker still said ``default_int_handler``, and 290 trials of the same child from a clean process never
-    hung: something in the worker had set the kernel's disposition behind Python's back."""
+    """No test leaves this process another Ctrl-C handler than it began with, in Python's table or in the kernel's:
+    one that does is named in a warning and the handler put back. An ignored SIGINT is inherited through fork and
+    exec, and Python started with it ignored keeps it so, so a leak would make every later test's child deaf to
+    Ctrl-C. (On 2026-12-08 three Ctrl-C tests failed for that reason in runs started as background jobs of a shell
+    without job control, which ignores SIGINT for the whole session: their children now set Python's handler
+    themselves.)"""
     def keep(when: str) -> None:
         now, ignored = signal.getsignal(signal.SIGINT), kernel_ignores_sigint()
         if now is not SESSION_SIGINT or ignored != SESSION_SIGINT_IGNORED:

@@ -79,9 +79,15 @@ def test_every_value_the_fmu_s_component_refuses_is_refused_beside_its_field(fie
     assert {f.name for f in (*OWN_PENDULUM, *SUSPENSION)} <= {f.name for f in NUMBER_FIELDS}
 
 
+SERVER = ("import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+          "runpy.run_module('double_pendulum.app.server', run_name='__main__', alter_sys=True)")
+"""``python -m double_pendulum.app.server`` with Python's own Ctrl-C handler, as a terminal starts it: a test session
+started as a background job of a shell without job control ignores SIGINT, and its children would inherit that."""
+
+
 def _launch(fmu_path: Path, printed: Path, *port: str) -> subprocess.Popen:
     with printed.open("w") as out:
-        return subprocess.Popen([sys.executable, "-m", "double_pendulum.app.server", *port, "--fmu", str(fmu_path)],
+        return subprocess.Popen([sys.executable, "-c", SERVER, *port, "--fmu", str(fmu_path)],
                                 stdout=out, stderr=subprocess.STDOUT, text=True)
 
 

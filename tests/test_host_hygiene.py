@@ -82,8 +82,8 @@ INTERRUPTED = SLAVE + textwrap.dedent("""
 def interrupted_trial(folder: Path, guid: str, mode: str, delay: float, tmp_path: Path) -> tuple[str, str]:
     """One child interrupted after ``delay`` [s]. A child still running 60 s later is stopped with SIGABRT, on which
     its faulthandler (PYTHONFAULTHANDLER) prints every thread's Python stack, and the failure shows where it hung
-    (once, on 2026-12-08, a step-mode child printed nothing within 60 s under a load of 4 on 2 cores; 290 trials
-    under load after it did not hang)."""
+    (on 2026-12-08 it showed the step loop running on: the child had inherited an ignored SIGINT from a test session
+    started as a background job, hence the child's own handler in INTERRUPTED)."""
     child = subprocess.Popen([sys.executable, "-c", INTERRUPTED, str(folder), guid, mode], stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, text=True, cwd=tmp_path,
                              env={**os.environ, "PYTHONFAULTHANDLER": "1"})  # fmt: skip
