@@ -28,7 +28,7 @@ fit's parameters, with the run budget of its fit item (:data:`REFIT_RUN_BUDGET`)
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -167,8 +167,3 @@ def refit_models(fits: Sequence[ModelFit], problem: FitProblem, pool: Any = None
     items = [RefitItem.of(f, max_runs) for f in fits]
     out, _ = parallel_map(refit_ar1, items, shared=problem, max_workers=max_workers, label="AR(1) re-fits", pool=pool)
     return {r.model: r for r in out}
-
-
-def refit_shares(refits: Mapping[str, Ar1Refit]) -> dict[str, dict[str, float]]:
-    """The mechanisms' shares of the dissipated work at each model's AR(1) optimum, by model."""
-    return {m: dict(r.shares) for m, r in refits.items()}
